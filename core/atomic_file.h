@@ -1,0 +1,22 @@
+// Atomic writes (DESIGN §5): write under a temporary name in the same folder, then rename.
+// Temporary names start with '.', keep the extension (so encoders pick the format) and are
+// ignored by every folder watcher.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace lumislab {
+
+// "dir/.name.tmp<pid>_<n>.ext" for "dir/name.ext".
+std::string TemporaryPathFor(const std::string& final_path);
+// Calls write(tmp_path), then renames tmp_path onto final_path. On any exception the temporary
+// file is removed and the exception rethrown; a failed rename is an IoError (exit 3).
+void WriteAtomically(const std::string& final_path,
+                     const std::function<void(const std::string& tmp_path)>& write);
+void WriteTextAtomically(const std::string& final_path, const std::string& text);
+std::string ReadTextFile(const std::string& path);  // IoError when missing/unreadable
+bool IsTemporaryName(const std::string& filename);  // starts with '.'
+void MakeDirectories(const std::string& dir);       // IoError on failure
+
+}  // namespace lumislab

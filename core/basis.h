@@ -1,0 +1,49 @@
+// The 1D bell basis (DESIGN §2), its exact dual and the truncated printed filter.
+// x is in units of the grid spacing h (dimensionless).
+#pragma once
+
+#include <vector>
+
+namespace lumislab {
+
+// phi(x) = 1-2x^2 (|x|<=1/2), 2(|x|-1)^2 (1/2<|x|<=1), 0 otherwise.
+double Bell(double x);
+// d phi / dx.
+double BellDerivative(double x);
+// Exact integral of phi over [a, b].
+double BellIntegral(double a, double b);
+// Gram entries: G(0) = 23/30, G(1) = 7/60, 0 beyond.
+double BellGram(int k);
+
+// Exact dual phi~ = sum_k c_k phi(x-k) with c_k = a r^|k| (infinite support).
+struct ExactDual {
+  static double Ratio();             // r ~ -0.1559
+  static double Amplitude();         // a ~ 1.3693
+  static double Coefficient(int k);  // a r^|k|
+};
+
+// A dual truncated to support [-(K+1), K+1]: phi~ = c0 phi(x) + sum_{k=1..K} c_k
+// (phi(x-k)+phi(x+k)). Coefficients are the exact dual's, rescaled so that the integral of phi~ is
+// 1 (constants are reproduced). K = 1 is the printed filter of DESIGN §2 (support +-2h).
+class DualFilter {
+ public:
+  static DualFilter Truncated(int k_max = 1);
+  static DualFilter FromCoefficients(std::vector<double> coefficients);  // as in dataset.json
+
+  double Eval(double x) const;    // phi~(x)
+  double Integral() const;        // integral of phi~ (1 by construction)
+  double CrossTalk(int k) const;  // integral phi~(x) phi(x-k) dx
+  double Peak1D() const;          // max |phi~(x)|
+  double Peak2D() const;          // max |phi~(u) phi~(v)| = Peak1D()^2
+  double SupportHalfWidth() const { return coefficients_.size(); }  // in units of h
+  const std::vector<double>& coefficients() const { return coefficients_; }
+
+  // 2D filter value Phi~(u,v) = phi~(u) phi~(v), u, v in units of h relative to the centre.
+  double Eval2D(double u, double v) const { return Eval(u) * Eval(v); }
+
+ private:
+  explicit DualFilter(std::vector<double> c) : coefficients_(std::move(c)) {}
+  std::vector<double> coefficients_;
+};
+
+}  // namespace lumislab

@@ -1,0 +1,130 @@
+#include "core/dataset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <tuple>
+
+#include "core/error.h"
+#include "core/json.h"
+
+namespace lumislab {
+
+std::string PhotoFileName(int i, int j, bool positive, const std::string& ext,
+                          const std::string& exposure_tag) {
+  std::string name =
+      "pos_" + std::to_string(i) + "_" + std::to_string(j) + "_" + (positive ? "p" : "n");
+  if (!exposure_tag.empty()) name += "_" + exposure_tag;
+  return name + "." + ext;
+}
+
+std::vector<PhotoEntry> Dataset::PhotosOf(int i, int j) const {
+  std::vector<PhotoEntry> out;
+  for (const auto& p : photos)
+    if (p.i == i && p.j == j) out.push_back(p);
+  return out;
+}
+
+Dataset Dataset::Load(const std::string& dir) {
+  const std::string file = dir + "/dataset.json";
+  const JsonDocument doc = JsonDocument::Load(file);
+  doc.CheckSchemaVersion(kDatasetSchemaVersion);
+  const JsonView root = doc.root();
+  Dataset ds;
+  ds.dir = dir;
+  ds.synthetic = root.BoolOr("synthetic", false);
+
+  const JsonView setup = root["setup"];
+  ds.distance_mm = setup["distance_mm"].Positive();
+  ds.grid.nu = setup["grid"]["nu"].IntIn(1, 1000);
+  ds.grid.nv = setup["grid"]["nv"].IntIn(1, 1000);
+  ds.grid.spacing_mm = setup["grid"]["spacing_mm"].Positive();
+  const std::vector<double> screen = setup["screen_mm"].Numbers(2);
+  if (!(screen[0] > 0) || !(screen[1] > 0))
+    setup["screen_mm"].Fail("two lengths > 0 (width, height in mm)");
+  ds.screen_w_mm = screen[0];
+  ds.screen_h_mm = screen[1];
+
+  const JsonView filter = root["filter"];
+  ds.filter.basis = filter["basis"].OneOf({"bell"});
+  ds.filter.spacing_mm = filter["spacing_mm"].Positive();
+  if (std::abs(ds.filter.spacing_mm - ds.grid.spacing_mm) > 1e-9 * ds.grid.spacing_mm)
+    filter["spacing_mm"].Fail("the grid spacing (" + std::to_string(ds.grid.spacing_mm) + " mm)");
+  ds.filter.dual_coefficients = filter["dual_coefficients"].Numbers();
+  if (ds.filter.dual_coefficients.size() > 17)
+    filter["dual_coefficients"].Fail("at most 17 coefficients");
+  ds.filter.peak = filter["peak"].Positive();
+
+  const JsonView radiometry = root["radiometry"];
+  if (radiometry.Has("scale_w_m2")) ds.radiometric_scale = radiometry["scale_w_m2"].Positive();
+  ds.saturation_level =
+      radiometry.Has("saturation_level") ? radiometry["saturation_level"].Positive() : 1.0;
+
+  const JsonView calib = root["calibration"];
+  ds.calibration.photo = calib["photo"].String();
+  const JsonView target = calib["target"];
+  target["type"].OneOf({"checkerboard"});
+  ds.calibration.squares_x = target["squares"][0].IntIn(3, 200);
+  ds.calibration.squares_y = target["squares"][1].IntIn(3, 200);
+  ds.calibration.square_mm = target["square_mm"].Positive();
+  const std::vector<double> origin = target["origin_mm"].Numbers(2);
+  ds.calibration.origin_mm = {origin[0], origin[1]};
+
+  const JsonView photos = root["photos"];
+  std::set<std::tuple<int, int, bool>> slides;
+  for (size_t k = 0; k < photos.Size(); ++k) {
+    const JsonView p = photos[k];
+    PhotoEntry e;
+    e.i = p["i"].IntIn(0, ds.grid.nu - 1);
+    e.j = p["j"].IntIn(0, ds.grid.nv - 1);
+    e.positive = p["slide"].OneOf({"p", "n"}) == "p";
+    e.file = p["file"].String();
+    if (e.file.empty() || e.file[0] == '/' || e.file.find("..") != std::string::npos)
+      p["file"].Fail("a path relative to the dataset folder");
+    e.exposure = p.Has("exposure") ? p["exposure"].Positive() : 1.0;
+    slides.insert({e.i, e.j, e.positive});
+    ds.photos.push_back(e);
+  }
+  for (int j = 0; j < ds.grid.nv; ++j)
+    for (int i = 0; i < ds.grid.nu; ++i)
+      for (bool positive : {true, false})
+        if (!slides.count({i, j, positive}))
+          throw InputError(
+              file, "photos",
+              std::string("a photo through slide ") + (positive ? "p" : "n") +
+                  " for every grid position",
+              "none for position (" + std::to_string(i) + ", " + std::to_string(j) + ")");
+  return ds;
+}
+
+void Dataset::Save(const std::string& out_dir) const {
+  nlohmann::json j;
+  j["schema_version"] = kDatasetSchemaVersion;
+  j["synthetic"] = synthetic;
+  j["setup"] = {{"distance_mm", distance_mm},
+                {"grid", {{"nu", grid.nu}, {"nv", grid.nv}, {"spacing_mm", grid.spacing_mm}}},
+                {"screen_mm", {screen_w_mm, screen_h_mm}}};
+  j["filter"] = {{"basis", filter.basis},
+                 {"spacing_mm", filter.spacing_mm},
+                 {"dual_coefficients", filter.dual_coefficients},
+                 {"peak", filter.peak}};
+  j["radiometry"] = {{"saturation_level", saturation_level}};
+  if (radiometric_scale) j["radiometry"]["scale_w_m2"] = *radiometric_scale;
+  j["calibration"] = {{"photo", calibration.photo},
+                      {"target",
+                       {{"type", "checkerboard"},
+                        {"squares", {calibration.squares_x, calibration.squares_y}},
+                        {"square_mm", calibration.square_mm},
+                        {"origin_mm", {calibration.origin_mm.x(), calibration.origin_mm.y()}}}}};
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& p : photos)
+    list.push_back({{"i", p.i},
+                    {"j", p.j},
+                    {"slide", p.positive ? "p" : "n"},
+                    {"file", p.file},
+                    {"exposure", p.exposure}});
+  j["photos"] = list;
+  WriteJsonAtomically(out_dir + "/dataset.json", j);
+}
+
+}  // namespace lumislab

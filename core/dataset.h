@@ -1,0 +1,71 @@
+// dataset.json (DESIGN §5): the setup, the printed filter, the radiometric scale and the photos.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/basis.h"
+#include "core/grid.h"
+
+namespace lumislab {
+
+constexpr int kDatasetSchemaVersion = 1;
+
+struct FilterInfo {
+  std::string basis = "bell";
+  double spacing_mm = 0;
+  std::vector<double> dual_coefficients;  // [c0, c1, ...] as in DESIGN §2
+  double peak = 0;                        // max |Phi~| of the 2D filter; slides are Phi~/peak
+  DualFilter Filter() const { return DualFilter::FromCoefficients(dual_coefficients); }
+};
+
+// Checkerboard lying on the screen plane, photographed once for the screen calibration.
+// Board square (a, b) has its lower-left corner at origin + (a, b) * square (lab mm, screen
+// plane); square (0, 0) is black and carries a white dot at its centre that fixes orientation.
+struct CalibrationTarget {
+  std::string photo;  // relative to the dataset folder, e.g. photos/calib_0.png
+  int squares_x = 0;  // number of squares along x
+  int squares_y = 0;
+  double square_mm = 0;
+  Eigen::Vector2d origin_mm{0, 0};  // lab frame, screen plane
+};
+
+struct PhotoEntry {
+  int i = 0;
+  int j = 0;
+  bool positive = true;   // slide T+ (true) or T- (false)
+  std::string file;       // relative to the dataset folder
+  double exposure = 1.0;  // relative exposure; linear value / exposure is comparable
+};
+
+struct Dataset {
+  std::string dir;         // folder it was loaded from
+  double distance_mm = 0;  // d
+  SamplingGrid grid;
+  double screen_w_mm = 0;  // physical screen (lab frame), also the slab window
+  double screen_h_mm = 0;
+  FilterInfo filter;
+  // Irradiance on the screen (W m^-2) per unit of normalised linear pixel value at exposure 1.
+  std::optional<double> radiometric_scale;
+  double saturation_level = 1.0;  // normalised linear value at or above which a pixel is clipped
+  CalibrationTarget calibration;
+  std::vector<PhotoEntry> photos;
+  bool synthetic = false;
+
+  static Dataset Load(const std::string& dir);  // validates, errors name dataset.json and field
+  void Save(const std::string& dir) const;      // atomic
+  std::string Path(const std::string& relative) const { return dir + "/" + relative; }
+  // Photos of one position (both slides, all exposures), in file order.
+  std::vector<PhotoEntry> PhotosOf(int i, int j) const;
+  SlabLayout Layout(int resolution) const {
+    return {screen_w_mm, screen_h_mm, resolution, resolution};
+  }
+};
+
+// Canonical photo file name: pos_<i>_<j>_<p|n>[_<exposure>].<ext>
+std::string PhotoFileName(int i, int j, bool positive, const std::string& ext,
+                          const std::string& exposure_tag = "");
+
+}  // namespace lumislab

@@ -1,0 +1,116 @@
+#include "core/exr_io.h"
+
+#include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+
+#include <filesystem>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace lumislab {
+
+void WriteExr(const std::string& path, const ImageF& image,
+              const std::vector<std::string>& channel_names, const ExrAttributes& attributes,
+              const ExrOptions& options) {
+  if (int(channel_names.size()) != image.channels || image.empty())
+    throw Failure(path + ": WriteExr: channel names do not match the image");
+  WriteAtomically(path, [&](const std::string& tmp) {
+    try {
+      Imf::Header header(image.width, image.height);
+      header.compression() = options.compress ? Imf::PIZ_COMPRESSION : Imf::NO_COMPRESSION;
+      const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
+      for (const auto& name : channel_names) header.channels().insert(name, Imf::Channel(type));
+      for (const auto& [k, v] : attributes.strings) header.insert(k, Imf::StringAttribute(v));
+      for (const auto& [k, v] : attributes.doubles) header.insert(k, Imf::DoubleAttribute(v));
+      for (const auto& [k, v] : attributes.ints) header.insert(k, Imf::IntAttribute(v));
+      // Half channels need half data: convert through a per-channel buffer.
+      std::vector<std::vector<half>> halves;
+      Imf::FrameBuffer fb;
+      const size_t xs = sizeof(float) * image.channels;
+      for (int c = 0; c < image.channels; ++c) {
+        if (options.half) {
+          halves.emplace_back(size_t(image.width) * image.height);
+          auto& h = halves.back();
+          for (size_t p = 0; p < h.size(); ++p) h[p] = half(image.data[p * image.channels + c]);
+          fb.insert(channel_names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(h.data()),
+                                                 sizeof(half), sizeof(half) * image.width));
+        } else {
+          char* base = reinterpret_cast<char*>(const_cast<float*>(image.data.data()) + c);
+          fb.insert(channel_names[c], Imf::Slice(Imf::FLOAT, base, xs, xs * image.width));
+        }
+      }
+      Imf::OutputFile file(tmp.c_str(), header);
+      file.setFrameBuffer(fb);
+      file.writePixels(image.height);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw IoError(path, std::string("cannot write EXR: ") + e.what());
+    }
+  });
+}
+
+ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_names,
+               ExrAttributes* attributes) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw BadInput(path + ": file not found");
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imf::Header& header = file.header();
+    const Imath::Box2i dw = header.dataWindow();
+    const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
+    if (width <= 0 || height <= 0 || width > 1 << 15 || height > 1 << 15)
+      throw InputError(path, "dataWindow", "a sane image size",
+                       std::to_string(width) + "x" + std::to_string(height));
+    ImageF image(width, height, int(channel_names.size()));
+    Imf::FrameBuffer fb;
+    const size_t xs = sizeof(float) * image.channels;
+    for (int c = 0; c < image.channels; ++c) {
+      if (header.channels().findChannel(channel_names[c]) == nullptr)
+        throw InputError(path, "channel " + channel_names[c], "present", "missing");
+      // Offset so that pixel (dw.min.x, dw.min.y) lands at index 0.
+      char* base = reinterpret_cast<char*>(image.data.data() + c) -
+                   (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * width) * ptrdiff_t(xs);
+      fb.insert(channel_names[c], Imf::Slice(Imf::FLOAT, base, xs, xs * width));
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    if (attributes) {
+      for (auto it = header.begin(); it != header.end(); ++it) {
+        const std::string name = it.name();
+        if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+          attributes->strings[name] = s->value();
+        else if (auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute()))
+          attributes->doubles[name] = d->value();
+        else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&it.attribute()))
+          attributes->ints[name] = i->value();
+      }
+    }
+    return image;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw BadInput(path + ": not a readable EXR file: " + e.what());
+  }
+}
+
+std::vector<std::string> ExrChannelNames(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    std::vector<std::string> names;
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
+      names.push_back(it.name());
+    return names;
+  } catch (const std::exception& e) {
+    throw BadInput(path + ": not a readable EXR file: " + e.what());
+  }
+}
+
+}  // namespace lumislab

@@ -1,0 +1,33 @@
+// The one EXR reader/writer (OpenEXR). Float channels plus typed header attributes.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+
+namespace lumislab {
+
+struct ExrAttributes {
+  std::map<std::string, std::string> strings;
+  std::map<std::string, double> doubles;
+  std::map<std::string, int> ints;
+};
+
+struct ExrOptions {
+  bool half = false;     // store HALF instead of FLOAT
+  bool compress = true;  // PIZ (fast on noisy float data); false: none
+};
+
+// Writes image channels named `channel_names` (size == image.channels) atomically.
+void WriteExr(const std::string& path, const ImageF& image,
+              const std::vector<std::string>& channel_names, const ExrAttributes& attributes = {},
+              const ExrOptions& options = {});
+// Reads the named channels (missing channel -> BadInput naming file and channel). If
+// `attributes` is given, fills it with the string/double/int attributes of the header.
+ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_names,
+               ExrAttributes* attributes = nullptr);
+std::vector<std::string> ExrChannelNames(const std::string& path);
+
+}  // namespace lumislab

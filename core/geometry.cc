@@ -1,0 +1,39 @@
+#include "core/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lumislab {
+
+double GeometryTerm(double d, double u, double v, double s, double t) {
+  const double r2 = d * d + (s - u) * (s - u) + (t - v) * (t - v);
+  return d * d / (r2 * r2);
+}
+
+double ShiftInvariantGeometry(double d, const Eigen::Vector2d& c, double s, double t) {
+  return GeometryTerm(d, c.x(), c.y(), s, t);
+}
+
+double ShiftInvariantError(double theta0, double relative_width) {
+  // A point of M at angle theta0 from the filter centre, i.e. at s = d tan(theta0) (d = 1); the
+  // basis support spans u in [-w/2, w/2] on S. cos^4 is monotonic in |s - u|, so its extremes
+  // over the support are at the ends, or at |s - u| = 0 when the support straddles s.
+  const double s = std::tan(theta0);
+  const double half = 0.5 * relative_width;
+  auto cos4 = [](double du) {
+    const double c2 = 1.0 / (1.0 + du * du);
+    return c2 * c2;
+  };
+  const double a = cos4(s - half), b = cos4(s + half);
+  double hi = std::max(a, b), lo = std::min(a, b);
+  if (std::abs(s) <= half) hi = 1.0;
+  return (hi - lo) / cos4(s);
+}
+
+Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                                double z_plane) {
+  const double t = (z_plane - p.z()) / (q.z() - p.z());
+  return (p + t * (q - p)).head<2>();
+}
+
+}  // namespace lumislab

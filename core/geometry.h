@@ -1,0 +1,19 @@
+// Geometry terms of DESIGN §3. Lengths in mm; d is the S-M distance.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace lumislab {
+
+// g = cos^2(theta) / R^2 = d^2 / R^4 between (u,v) on S and (s,t) on M, in mm^-2.
+double GeometryTerm(double d, double u, double v, double s, double t);
+// Shift-invariant g_ij(s,t): the geometry term frozen at the filter centre c.
+double ShiftInvariantGeometry(double d, const Eigen::Vector2d& c, double s, double t);
+// E_r(theta0) = (max cos^4 - min cos^4) / cos^4(theta0) over one basis support of relative width
+// w (support width / d) seen from M at angle theta0 (radians) — paper Fig. 3.
+double ShiftInvariantError(double theta0, double relative_width);
+
+// Where the line from point p (luminaire frame, mm) through q crosses the plane z = z_plane.
+Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q, double z_plane);
+
+}  // namespace lumislab

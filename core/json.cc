@@ -1,0 +1,178 @@
+#include "core/json.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace lumislab {
+namespace {
+std::string Got(const nlohmann::json* value) {
+  if (value == nullptr) return "nothing (missing)";
+  std::string text = value->dump();
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return text;
+}
+std::string FormatNumber(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+}  // namespace
+
+JsonView JsonView::operator[](const std::string& key) const {
+  const std::string child = path_.empty() ? key : path_ + "." + key;
+  if (value_ == nullptr || !value_->is_object()) Fail("an object with member \"" + key + "\"");
+  auto it = value_->find(key);
+  if (it == value_->end()) {
+    throw InputError(*file_, child, "a value", "nothing (missing)");
+  }
+  return JsonView(&*it, file_, child);
+}
+
+JsonView JsonView::operator[](size_t index) const {
+  if (value_ == nullptr || !value_->is_array()) Fail("an array");
+  const std::string child = path_ + "[" + std::to_string(index) + "]";
+  if (index >= value_->size()) throw InputError(*file_, child, "a value", "nothing (missing)");
+  return JsonView(&(*value_)[index], file_, child);
+}
+
+bool JsonView::Has(const std::string& key) const {
+  return value_ != nullptr && value_->is_object() && value_->contains(key) &&
+         !(*value_)[key].is_null();
+}
+
+size_t JsonView::Size() const {
+  if (value_ == nullptr || !value_->is_array()) Fail("an array");
+  return value_->size();
+}
+
+std::vector<std::string> JsonView::Keys() const {
+  if (value_ == nullptr || !value_->is_object()) Fail("an object");
+  std::vector<std::string> keys;
+  for (auto it = value_->begin(); it != value_->end(); ++it) keys.push_back(it.key());
+  return keys;
+}
+
+double JsonView::Number() const {
+  if (value_ == nullptr || !value_->is_number()) Fail("number");
+  const double v = value_->get<double>();
+  if (!std::isfinite(v)) Fail("finite number");
+  return v;
+}
+
+double JsonView::NumberIn(double lo, double hi) const {
+  const double v = Number();
+  if (v < lo || v > hi) Fail("number in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+  return v;
+}
+
+double JsonView::Positive() const {
+  const double v = Number();
+  if (!(v > 0)) Fail("number > 0");
+  return v;
+}
+
+int JsonView::Int() const {
+  if (value_ == nullptr || !value_->is_number_integer()) Fail("integer");
+  const auto v = value_->get<long long>();
+  if (v < -2147483647LL || v > 2147483647LL) Fail("integer of 32 bits");
+  return int(v);
+}
+
+int JsonView::IntAtLeast(int lo) const {
+  if (value_ == nullptr || !value_->is_number_integer()) Fail("integer >= " + std::to_string(lo));
+  const auto v = value_->get<long long>();
+  if (v < lo || v > 2147483647LL) Fail("integer >= " + std::to_string(lo));
+  return int(v);
+}
+
+int JsonView::IntIn(int lo, int hi) const {
+  const std::string range = "integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (value_ == nullptr || !value_->is_number_integer()) Fail(range);
+  const auto v = value_->get<long long>();
+  if (v < lo || v > hi) Fail(range);
+  return int(v);
+}
+
+bool JsonView::Bool() const {
+  if (value_ == nullptr || !value_->is_boolean()) Fail("true or false");
+  return value_->get<bool>();
+}
+
+std::string JsonView::String() const {
+  if (value_ == nullptr || !value_->is_string()) Fail("string");
+  return value_->get<std::string>();
+}
+
+std::string JsonView::OneOf(const std::vector<std::string>& allowed) const {
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : "|") + a;
+  if (value_ == nullptr || !value_->is_string()) Fail("one of " + list);
+  const std::string v = value_->get<std::string>();
+  for (const auto& a : allowed)
+    if (a == v) return v;
+  Fail("one of " + list);
+}
+
+std::vector<double> JsonView::Numbers(size_t expected_size) const {
+  const std::string what = expected_size ? "array of " + std::to_string(expected_size) + " numbers"
+                                         : "non-empty array of numbers";
+  if (value_ == nullptr || !value_->is_array()) Fail(what);
+  if (expected_size ? value_->size() != expected_size : value_->empty()) Fail(what);
+  std::vector<double> out;
+  for (size_t k = 0; k < value_->size(); ++k) out.push_back((*this)[k].Number());
+  return out;
+}
+
+double JsonView::NumberOr(const std::string& key, double fallback) const {
+  return Has(key) ? (*this)[key].Number() : fallback;
+}
+int JsonView::IntOr(const std::string& key, int fallback) const {
+  return Has(key) ? (*this)[key].Int() : fallback;
+}
+std::string JsonView::StringOr(const std::string& key, const std::string& fallback) const {
+  return Has(key) ? (*this)[key].String() : fallback;
+}
+bool JsonView::BoolOr(const std::string& key, bool fallback) const {
+  return Has(key) ? (*this)[key].Bool() : fallback;
+}
+
+void JsonView::Fail(const std::string& expected) const {
+  throw InputError(*file_, path_.empty() ? "(top level)" : path_, expected, Got(value_));
+}
+
+JsonDocument JsonDocument::Load(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw BadInput(path + ": file not found (or not a regular file)");
+  return Parse(ReadTextFile(path), path);
+}
+
+JsonDocument JsonDocument::Parse(const std::string& text, const std::string& name) {
+  JsonDocument doc;
+  doc.file_ = std::make_shared<const std::string>(name);
+  try {
+    doc.json_ = std::make_shared<nlohmann::json>(nlohmann::json::parse(text));
+  } catch (const nlohmann::json::parse_error& e) {
+    throw BadInput(name + ": not valid JSON: " + e.what());
+  }
+  return doc;
+}
+
+void JsonDocument::CheckSchemaVersion(int max_supported) const {
+  const int v = root()["schema_version"].IntAtLeast(1);
+  if (v > max_supported)
+    throw InputError(
+        *file_, "schema_version",
+        "schema_version <= " + std::to_string(max_supported) + " (written by a newer lumislab?)",
+        std::to_string(v));
+}
+
+void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
+  WriteTextAtomically(path, value.dump(2) + "\n");
+}
+
+}  // namespace lumislab

@@ -1,0 +1,94 @@
+#include "core/screen_calibration.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/json.h"
+
+namespace lumislab {
+
+Eigen::Vector2d ScreenCalibration::Undistort(const Eigen::Vector2d& pixel) const {
+  const Eigen::Vector2d d = pixel - centre_px;
+  const double r2 = d.squaredNorm() / (scale_px * scale_px);
+  return centre_px + d * (1.0 + k1 * r2 + k2 * r2 * r2);
+}
+
+Eigen::Vector2d ScreenCalibration::Distort(const Eigen::Vector2d& undistorted) const {
+  if (k1 == 0 && k2 == 0) return undistorted;
+  // Solve Undistort(p) = q by Newton on the radius (the model is radial).
+  const Eigen::Vector2d q = undistorted - centre_px;
+  const double rq = q.norm() / scale_px;
+  if (rq == 0) return undistorted;
+  double r = rq;
+  for (int it = 0; it < 20; ++it) {
+    const double r2 = r * r;
+    const double f = r * (1 + k1 * r2 + k2 * r2 * r2) - rq;
+    const double df = 1 + 3 * k1 * r2 + 5 * k2 * r2 * r2;
+    if (std::abs(df) < 1e-12) break;
+    const double step = f / df;
+    r -= step;
+    if (std::abs(step) < 1e-14) break;
+  }
+  return centre_px + q * (r / rq);
+}
+
+Eigen::Vector2d ScreenCalibration::ScreenFromImage(const Eigen::Vector2d& pixel) const {
+  const Eigen::Vector3d h = screen_from_image * Undistort(pixel).homogeneous();
+  return h.hnormalized();
+}
+
+Eigen::Vector2d ScreenCalibration::ImageFromScreen(const Eigen::Vector2d& screen_mm) const {
+  const Eigen::Vector3d h = screen_from_image.inverse() * screen_mm.homogeneous();
+  return Distort(h.hnormalized());
+}
+
+ScreenCalibration ScreenCalibration::Load(const std::string& path) {
+  const JsonDocument doc = JsonDocument::Load(path);
+  doc.CheckSchemaVersion(kScreenCalibrationSchemaVersion);
+  const JsonView root = doc.root();
+  ScreenCalibration c;
+  c.image_width = root["image_size"][0].IntIn(1, 1 << 16);
+  c.image_height = root["image_size"][1].IntIn(1, 1 << 16);
+  const std::vector<double> h = root["screen_from_image"].Numbers(9);
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) c.screen_from_image(r, k) = h[r * 3 + k];
+  const double det = c.screen_from_image.determinant();
+  if (!std::isfinite(det) || std::abs(det) < 1e-300)
+    root["screen_from_image"].Fail("an invertible 3x3 homography");
+  const JsonView dist = root["distortion"];
+  dist["model"].OneOf({"radial2"});
+  c.k1 = dist["k1"].Number();
+  c.k2 = dist["k2"].Number();
+  const std::vector<double> centre = dist["centre_px"].Numbers(2);
+  c.centre_px = {centre[0], centre[1]};
+  c.scale_px = dist["scale_px"].Positive();
+  const JsonView report = root["report"];
+  c.rms_px = report["rms_px"].NumberIn(0, 1e9);
+  c.rms_mm = report["rms_mm"].NumberIn(0, 1e9);
+  c.corners_used = report["corners_used"].IntAtLeast(0);
+  c.photo = report.StringOr("photo", "");
+  return c;
+}
+
+void ScreenCalibration::Save(const std::string& path) const {
+  nlohmann::json j;
+  j["schema_version"] = kScreenCalibrationSchemaVersion;
+  j["image_size"] = {image_width, image_height};
+  std::vector<double> h;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) h.push_back(screen_from_image(r, k));
+  j["screen_from_image"] = h;
+  j["screen_from_image_note"] = "row-major; undistorted pixel (OpenCV centres) -> lab mm on screen";
+  j["distortion"] = {{"model", "radial2"},
+                     {"k1", k1},
+                     {"k2", k2},
+                     {"centre_px", {centre_px.x(), centre_px.y()}},
+                     {"scale_px", scale_px}};
+  j["report"] = {
+      {"rms_px", rms_px}, {"rms_mm", rms_mm}, {"corners_used", corners_used}, {"photo", photo}};
+  WriteJsonAtomically(path, j);
+}
+
+}  // namespace lumislab

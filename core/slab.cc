@@ -1,0 +1,162 @@
+#include "core/slab.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/exr_io.h"
+#include "core/json.h"
+
+namespace lumislab {
+
+bool SlabInfo::IsPresent(int i, int j) const {
+  return std::binary_search(present.begin(), present.end(), std::make_pair(i, j));
+}
+
+void SlabInfo::MarkPresent(int i, int j) {
+  const auto p = std::make_pair(i, j);
+  auto it = std::lower_bound(present.begin(), present.end(), p);
+  if (it == present.end() || *it != p) present.insert(it, p);
+}
+
+SlabInfo SlabInfo::FromDataset(const Dataset& dataset, int resolution) {
+  SlabInfo info;
+  info.distance_mm = dataset.distance_mm;
+  info.grid = dataset.grid;
+  info.layout = dataset.Layout(resolution);
+  info.units = dataset.radiometric_scale ? "W/m^2" : "relative";
+  info.filter = dataset.filter;
+  return info;
+}
+
+SlabInfo SlabInfo::Load(const std::string& slab_dir) {
+  const std::string file = slab_dir + "/slab.json";
+  const JsonDocument doc = JsonDocument::Load(file);
+  doc.CheckSchemaVersion(kSlabSchemaVersion);
+  const JsonView root = doc.root();
+  SlabInfo info;
+  info.distance_mm = root["distance_mm"].Positive();
+  info.grid.nu = root["grid"]["nu"].IntIn(1, 1000);
+  info.grid.nv = root["grid"]["nv"].IntIn(1, 1000);
+  info.grid.spacing_mm = root["grid"]["spacing_mm"].Positive();
+  const std::vector<double> window = root["window_mm"].Numbers(2);
+  if (!(window[0] > 0 && window[1] > 0)) root["window_mm"].Fail("two lengths > 0");
+  info.layout.window_w_mm = window[0];
+  info.layout.window_h_mm = window[1];
+  info.layout.res_x = root["resolution"][0].IntIn(1, 16384);
+  info.layout.res_y = root["resolution"][1].IntIn(1, 16384);
+  info.units = root["units"].OneOf({"W/m^2", "relative"});
+  const JsonView filter = root["filter"];
+  info.filter.basis = filter["basis"].OneOf({"bell"});
+  info.filter.spacing_mm = filter["spacing_mm"].Positive();
+  info.filter.dual_coefficients = filter["dual_coefficients"].Numbers();
+  info.filter.peak = filter["peak"].Positive();
+  const JsonView present = root["present"];
+  for (size_t k = 0; k < present.Size(); ++k)
+    info.MarkPresent(present[k][0].IntIn(0, info.grid.nu - 1),
+                     present[k][1].IntIn(0, info.grid.nv - 1));
+  return info;
+}
+
+void SlabInfo::Save(const std::string& slab_dir) const {
+  nlohmann::json j;
+  j["schema_version"] = kSlabSchemaVersion;
+  j["distance_mm"] = distance_mm;
+  j["grid"] = {{"nu", grid.nu}, {"nv", grid.nv}, {"spacing_mm", grid.spacing_mm}};
+  j["window_mm"] = {layout.window_w_mm, layout.window_h_mm};
+  j["resolution"] = {layout.res_x, layout.res_y};
+  j["units"] = units;
+  j["filter"] = {{"basis", filter.basis},
+                 {"spacing_mm", filter.spacing_mm},
+                 {"dual_coefficients", filter.dual_coefficients},
+                 {"peak", filter.peak}};
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [i, jj] : present) list.push_back({i, jj});
+  j["present"] = list;
+  j["complete"] = Complete();
+  WriteJsonAtomically(slab_dir + "/slab.json", j);
+}
+
+std::string SlabPositionPath(const std::string& slab_dir, int i, int j) {
+  return slab_dir + "/pos_" + std::to_string(i) + "_" + std::to_string(j) + ".exr";
+}
+
+void WriteSlabPosition(const std::string& slab_dir, const SlabInfo& info, const SlabPosition& p) {
+  const int w = info.layout.res_x, h = info.layout.res_y;
+  if (p.irradiance.width != w || p.irradiance.height != h || p.irradiance.channels != 3 ||
+      p.mask.width != w || p.mask.height != h || p.mask.channels != 1)
+    throw Failure("WriteSlabPosition: image size does not match the slab layout");
+  ImageF out(w, h, 4);
+  for (size_t k = 0; k < size_t(w) * h; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = p.irradiance.data[k * 3 + c];
+      if (!std::isfinite(v))
+        throw Failure(SlabPositionPath(slab_dir, p.i, p.j) +
+                      ": refusing to write a non-finite value");
+      out.data[k * 4 + c] = v;
+    }
+    out.data[k * 4 + 3] = p.mask.data[k];
+  }
+  ExrAttributes attr;
+  attr.ints["lumislab.schema_version"] = kSlabSchemaVersion;
+  attr.ints["lumislab.i"] = p.i;
+  attr.ints["lumislab.j"] = p.j;
+  attr.doubles["lumislab.distance_mm"] = info.distance_mm;
+  attr.doubles["lumislab.spacing_mm"] = info.grid.spacing_mm;
+  const Eigen::Vector2d c = info.grid.Centre(p.i, p.j);
+  attr.doubles["lumislab.centre_x_mm"] = c.x();
+  attr.doubles["lumislab.centre_y_mm"] = c.y();
+  attr.doubles["lumislab.window_w_mm"] = info.layout.window_w_mm;
+  attr.doubles["lumislab.window_h_mm"] = info.layout.window_h_mm;
+  attr.strings["lumislab.units"] = info.units;
+  attr.strings["lumislab.quantity"] = "E_ij: irradiance on M through filter (i,j), luminaire frame";
+  ExrOptions options;
+  options.compress = false;  // PIZ/ZIP on noisy float data costs time for little gain
+  WriteExr(SlabPositionPath(slab_dir, p.i, p.j), out, {"R", "G", "B", "mask"}, attr, options);
+}
+
+SlabPosition ReadSlabPosition(const std::string& slab_dir, const SlabInfo& info, int i, int j) {
+  const std::string path = SlabPositionPath(slab_dir, i, j);
+  ExrAttributes attr;
+  const ImageF in = ReadExr(path, {"R", "G", "B", "mask"}, &attr);
+  if (in.width != info.layout.res_x || in.height != info.layout.res_y)
+    throw InputError(path, "dataWindow",
+                     std::to_string(info.layout.res_x) + "x" + std::to_string(info.layout.res_y) +
+                         " texels (slab.json resolution)",
+                     std::to_string(in.width) + "x" + std::to_string(in.height));
+  if (attr.ints.count("lumislab.i") &&
+      (attr.ints["lumislab.i"] != i || attr.ints["lumislab.j"] != j))
+    throw InputError(
+        path, "lumislab.i/j", "position " + std::to_string(i) + "," + std::to_string(j),
+        std::to_string(attr.ints["lumislab.i"]) + "," + std::to_string(attr.ints["lumislab.j"]));
+  SlabPosition p;
+  p.i = i;
+  p.j = j;
+  p.irradiance = ImageF(in.width, in.height, 3);
+  p.mask = ImageF(in.width, in.height, 1);
+  for (size_t k = 0; k < size_t(in.width) * in.height; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = in.data[k * 4 + c];
+      if (!std::isfinite(v)) throw InputError(path, "pixel data", "finite values", "NaN or Inf");
+      p.irradiance.data[k * 3 + c] = v;
+    }
+    p.mask.data[k] = in.data[k * 4 + 3];
+  }
+  return p;
+}
+
+std::vector<std::pair<int, int>> ScanSlabPositions(const std::string& slab_dir,
+                                                   const SamplingGrid& grid) {
+  std::vector<std::pair<int, int>> found;
+  std::error_code ec;
+  for (int j = 0; j < grid.nv; ++j)
+    for (int i = 0; i < grid.nu; ++i)
+      if (std::filesystem::is_regular_file(SlabPositionPath(slab_dir, i, j), ec))
+        found.emplace_back(i, j);
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace lumislab

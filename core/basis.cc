@@ -58,13 +58,31 @@ double ExactDual::Coefficient(int k) { return Amplitude() * std::pow(Ratio(), st
 
 DualFilter DualFilter::Truncated(int k_max) {
   if (k_max < 0 || k_max > 16) throw BadInput("dual filter: k_max must be in [0, 16]");
-  std::vector<double> c(k_max + 1);
-  double integral = 0;  // the integral of phi is 1, so that of phi~ is c0 + 2 sum c_k
-  for (int k = 0; k <= k_max; ++k) {
+  if (k_max == 0) return DualFilter({1.0});  // phi itself: integral 1, but no deconvolution
+  // Closest to the exact dual (least squares, each coefficient weighted by how often it occurs)
+  // subject to the two conditions a truncation must keep: the integral is 1 (constants are
+  // reproduced, so the flux is right) and <phi~, phi> = 1 (biorthogonal to its own centre).
+  // Each condition is a row a . c = 1; c = c* + M^-1 A^T lambda.
+  const int n = k_max + 1;
+  std::vector<double> c(n), mult(n), a_int(n), a_bio(n, 0.0);
+  for (int k = 0; k < n; ++k) {
     c[k] = ExactDual::Coefficient(k);
-    integral += (k == 0 ? 1.0 : 2.0) * c[k];
+    mult[k] = k == 0 ? 1.0 : 2.0;
+    a_int[k] = mult[k];
   }
-  for (double& v : c) v /= integral;
+  a_bio[0] = BellGram(0);
+  a_bio[1] = 2.0 * BellGram(1);
+  double s11 = 0, s12 = 0, s22 = 0, r1 = 1, r2 = 1;
+  for (int k = 0; k < n; ++k) {
+    s11 += a_int[k] * a_int[k] / mult[k];
+    s12 += a_int[k] * a_bio[k] / mult[k];
+    s22 += a_bio[k] * a_bio[k] / mult[k];
+    r1 -= a_int[k] * c[k];
+    r2 -= a_bio[k] * c[k];
+  }
+  const double det = s11 * s22 - s12 * s12;
+  const double l1 = (r1 * s22 - r2 * s12) / det, l2 = (s11 * r2 - s12 * r1) / det;
+  for (int k = 0; k < n; ++k) c[k] += (a_int[k] * l1 + a_bio[k] * l2) / mult[k];
   return DualFilter(std::move(c));
 }
 

@@ -1,0 +1,224 @@
+// Round trips of the on-disk formats: EXR (pixels + attributes), slab, dataset.json,
+// calib/screen.json, and the atomic-write guarantee.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/atomic_file.h"
+#include "core/dataset.h"
+#include "core/error.h"
+#include "core/exr_io.h"
+#include "core/screen_calibration.h"
+#include "core/slab.h"
+
+namespace fs = std::filesystem;
+
+namespace lumislab {
+namespace {
+
+class IoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("lumislab_io_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  // Files whose name does not start with '.', i.e. everything under a final name.
+  int FinalFiles() const {
+    int n = 0;
+    for (auto& e : fs::directory_iterator(dir_)) n += !IsTemporaryName(e.path().string());
+    return n;
+  }
+  int AllFiles() const {
+    int n = 0;
+    for (auto& e : fs::directory_iterator(dir_)) n += 1 + 0 * e.is_regular_file();
+    return n;
+  }
+  fs::path dir_;
+};
+
+Dataset SmallDataset() {
+  Dataset ds;
+  ds.distance_mm = 750;
+  ds.grid = {3, 2, 5};
+  ds.screen_w_mm = 1200;
+  ds.screen_h_mm = 800;
+  const DualFilter f = DualFilter::Truncated(1);
+  ds.filter = {"bell", 5, f.coefficients(), f.Peak2D()};
+  ds.radiometric_scale = 2.5;
+  ds.calibration = {"photos/calib_0.png", 14, 11, 60, {-420, -330}};
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 3; ++i)
+      for (bool p : {true, false})
+        ds.photos.push_back({i, j, p, "photos/" + PhotoFileName(i, j, p, "exr"), 1});
+  return ds;
+}
+
+TEST_F(IoTest, ExrRoundTripsPixelsAndAttributes) {
+  ImageF img(5, 3, 2);
+  for (size_t k = 0; k < img.data.size(); ++k) img.data[k] = 0.25f * k - 1;
+  ExrAttributes attr;
+  attr.strings["units"] = "W/m^2";
+  attr.doubles["d_mm"] = 750.5;
+  attr.ints["i"] = 4;
+  const std::string path = (dir_ / "a.exr").string();
+  WriteExr(path, img, {"R", "mask"}, attr);
+  ExrAttributes back;
+  const ImageF in = ReadExr(path, {"R", "mask"}, &back);
+  EXPECT_EQ(in.width, 5);
+  EXPECT_EQ(in.height, 3);
+  EXPECT_EQ(in.data, img.data);
+  EXPECT_EQ(back.strings["units"], "W/m^2");
+  EXPECT_DOUBLE_EQ(back.doubles["d_mm"], 750.5);
+  EXPECT_EQ(back.ints["i"], 4);
+  EXPECT_EQ(FinalFiles(), 1);
+  EXPECT_EQ(AllFiles(), 1);  // no temporary left behind
+  try {
+    ReadExr(path, {"G"});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_NE(std::string(e.what()).find("channel G"), std::string::npos);
+  }
+}
+
+TEST_F(IoTest, CorruptExrIsBadInputNamingTheFile) {
+  const std::string path = (dir_ / "bad.exr").string();
+  std::ofstream(path) << "not an exr at all";
+  try {
+    ReadExr(path, {"R"});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
+  }
+}
+
+TEST_F(IoTest, FailedWriteLeavesNothingUnderTheFinalName) {
+  const std::string path = (dir_ / "out.txt").string();
+  EXPECT_THROW(WriteAtomically(path,
+                               [](const std::string& tmp) {
+                                 std::ofstream(tmp) << "half";
+                                 throw IoError(tmp, "disk full (simulated)");
+                               }),
+               Error);
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_EQ(AllFiles(), 0);
+  WriteTextAtomically(path, "whole");
+  EXPECT_EQ(ReadTextFile(path), "whole");
+}
+
+TEST_F(IoTest, SlabRoundTripAndPartialSlabs) {
+  const Dataset ds = SmallDataset();
+  SlabInfo info = SlabInfo::FromDataset(ds, 8);
+  EXPECT_EQ(info.layout.res_x, 8);
+  SlabPosition p;
+  p.i = 2;
+  p.j = 1;
+  p.irradiance = ImageF(8, 8, 3);
+  p.mask = ImageF(8, 8, 1, 1.f);
+  for (size_t k = 0; k < p.irradiance.data.size(); ++k) p.irradiance.data[k] = 1e-6f * k - 3e-5f;
+  p.mask.data[5] = 0;
+  WriteSlabPosition(dir_.string(), info, p);
+  info.MarkPresent(2, 1);
+  info.MarkPresent(0, 0);
+  info.MarkPresent(2, 1);
+  info.Save(dir_.string());
+
+  const SlabInfo back = SlabInfo::Load(dir_.string());
+  EXPECT_EQ(back.present.size(), 2u);
+  EXPECT_TRUE(back.IsPresent(2, 1));
+  EXPECT_FALSE(back.IsPresent(1, 1));
+  EXPECT_FALSE(back.Complete());
+  EXPECT_EQ(back.units, "W/m^2");
+  EXPECT_EQ(back.filter.dual_coefficients, ds.filter.dual_coefficients);
+  const SlabPosition q = ReadSlabPosition(dir_.string(), back, 2, 1);
+  EXPECT_EQ(q.irradiance.data, p.irradiance.data);
+  EXPECT_EQ(q.mask.data, p.mask.data);
+  ExrAttributes attr;
+  ReadExr(SlabPositionPath(dir_.string(), 2, 1), {"R"}, &attr);
+  EXPECT_DOUBLE_EQ(attr.doubles["lumislab.centre_x_mm"], 5.0);
+  EXPECT_DOUBLE_EQ(attr.doubles["lumislab.distance_mm"], 750.0);
+  EXPECT_EQ(attr.ints["lumislab.j"], 1);
+  const auto scanned = ScanSlabPositions(dir_.string(), back.grid);
+  ASSERT_EQ(scanned.size(), 1u);  // (0,0) is listed but its file is not there yet
+  EXPECT_EQ(scanned[0], std::make_pair(2, 1));
+  // Reading under the wrong position or resolution is refused.
+  EXPECT_THROW(ReadSlabPosition(dir_.string(), SlabInfo::FromDataset(ds, 9), 2, 1), Error);
+}
+
+TEST_F(IoTest, SlabRefusesNonFiniteValues) {
+  const SlabInfo info = SlabInfo::FromDataset(SmallDataset(), 4);
+  SlabPosition p{0, 0, ImageF(4, 4, 3), ImageF(4, 4, 1, 1.f)};
+  p.irradiance.data[7] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(WriteSlabPosition(dir_.string(), info, p), Error);
+  EXPECT_EQ(FinalFiles(), 0);
+}
+
+TEST_F(IoTest, DatasetRoundTripAndValidation) {
+  const Dataset ds = SmallDataset();
+  ds.Save(dir_.string());
+  const Dataset back = Dataset::Load(dir_.string());
+  EXPECT_EQ(back.grid.nu, 3);
+  EXPECT_EQ(back.photos.size(), 12u);
+  EXPECT_EQ(back.PhotosOf(1, 1).size(), 2u);
+  EXPECT_DOUBLE_EQ(*back.radiometric_scale, 2.5);
+  EXPECT_EQ(back.calibration.squares_x, 14);
+  EXPECT_DOUBLE_EQ(back.calibration.origin_mm.y(), -330);
+  EXPECT_EQ(back.filter.dual_coefficients, ds.filter.dual_coefficients);
+
+  auto expect_error = [&](const std::string& from, const std::string& to, const std::string& msg) {
+    std::string text = ReadTextFile((dir_ / "dataset.json").string());
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    const fs::path bad = dir_ / "bad";
+    fs::create_directories(bad);
+    std::ofstream(bad / "dataset.json") << text;
+    try {
+      Dataset::Load(bad.string());
+      ADD_FAILURE() << "accepted " << to;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.exit_code(), 2);
+      EXPECT_NE(std::string(e.what()).find(msg), std::string::npos) << e.what();
+    }
+  };
+  expect_error("\"nu\": 3", "\"nu\": -3",
+               "dataset.json: setup.grid.nu: expected integer in [1, 1000], got -3");
+  expect_error("\"peak\": ", "\"peak\": -", "filter.peak: expected number > 0");
+  expect_error("\"slide\": \"n\"", "\"slide\": \"q\"", "photos[1].slide: expected one of p|n");
+  expect_error("\"file\": \"photos/pos_2_1_n.exr\"", "\"file\": \"/etc/passwd\"",
+               "photos[11].file");
+}
+
+TEST_F(IoTest, ScreenCalibrationRoundTripAndDistortionInverse) {
+  ScreenCalibration c;
+  c.image_width = 1600;
+  c.image_height = 1200;
+  c.screen_from_image << 0.9, 0.05, -700, -0.02, -0.95, 560, 1e-5, 2e-5, 1;
+  c.k1 = -0.08;
+  c.k2 = 0.01;
+  c.centre_px = {799.5, 599.5};
+  c.scale_px = 1000;
+  c.rms_px = 0.03;
+  c.corners_used = 143;
+  const std::string path = (dir_ / "screen.json").string();
+  c.Save(path);
+  const ScreenCalibration b = ScreenCalibration::Load(path);
+  EXPECT_TRUE(b.screen_from_image.isApprox(c.screen_from_image));
+  EXPECT_DOUBLE_EQ(b.k1, -0.08);
+  EXPECT_EQ(b.corners_used, 143);
+  for (double x : {0.0, 400.0, 1599.0})
+    for (double y : {0.0, 700.0, 1199.0}) {
+      const Eigen::Vector2d px(x, y);
+      EXPECT_LT((b.Distort(b.Undistort(px)) - px).norm(), 1e-9);
+      EXPECT_LT((b.ImageFromScreen(b.ScreenFromImage(px)) - px).norm(), 1e-7);
+    }
+}
+
+}  // namespace
+}  // namespace lumislab

@@ -1,0 +1,75 @@
+#include "core/json.h"
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+
+namespace lumislab {
+namespace {
+
+std::string MessageOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    return e.what();
+  }
+  ADD_FAILURE() << "no error thrown";
+  return "";
+}
+
+TEST(JsonTest, NamesFileFieldExpectedAndGot) {
+  const JsonDocument doc = JsonDocument::Parse(
+      R"({"setup": {"grid": {"nu": -3, "h": "x"}, "list": [1, 2]}})", "dataset.json");
+  EXPECT_EQ(MessageOf([&] { doc.root()["setup"]["grid"]["nu"].IntAtLeast(1); }),
+            "dataset.json: setup.grid.nu: expected integer >= 1, got -3");
+  EXPECT_EQ(MessageOf([&] { doc.root()["setup"]["grid"]["h"].Positive(); }),
+            "dataset.json: setup.grid.h: expected number, got \"x\"");
+  EXPECT_EQ(MessageOf([&] { doc.root()["setup"]["grid"]["nv"]; }),
+            "dataset.json: setup.grid.nv: expected a value, got nothing (missing)");
+  EXPECT_EQ(MessageOf([&] { doc.root()["setup"]["list"][2]; }),
+            "dataset.json: setup.list[2]: expected a value, got nothing (missing)");
+  EXPECT_EQ(MessageOf([&] { doc.root()["setup"]["list"].Numbers(3); }),
+            "dataset.json: setup.list: expected array of 3 numbers, got [1,2]");
+}
+
+TEST(JsonTest, TypedAccessAndDefaults) {
+  const JsonDocument doc =
+      JsonDocument::Parse(R"({"a": 1.5, "b": 3, "s": "bell", "t": true})", "x.json");
+  const JsonView r = doc.root();
+  EXPECT_DOUBLE_EQ(r["a"].Number(), 1.5);
+  EXPECT_EQ(r["b"].IntIn(1, 4), 3);
+  EXPECT_EQ(r["s"].OneOf({"bell", "box"}), "bell");
+  EXPECT_TRUE(r["t"].Bool());
+  EXPECT_EQ(r.IntOr("missing", 7), 7);
+  EXPECT_DOUBLE_EQ(r.NumberOr("a", 0), 1.5);
+  EXPECT_THROW(r["a"].Int(), Error);  // 1.5 is not an integer
+  EXPECT_NE(MessageOf([&] { r["s"].OneOf({"box"}); }).find("expected one of box"),
+            std::string::npos);
+}
+
+TEST(JsonTest, ParseErrorsAndMissingFilesAreBadInput) {
+  EXPECT_NE(MessageOf([] {
+              JsonDocument::Parse("{not json", "scene.json");
+            }).find("scene.json: not valid JSON"),
+            std::string::npos);
+  EXPECT_NE(MessageOf([] {
+              JsonDocument::Load("/nonexistent/dataset.json");
+            }).find("/nonexistent/dataset.json"),
+            std::string::npos);
+}
+
+TEST(JsonTest, SchemaVersionIsChecked) {
+  EXPECT_NE(MessageOf([] {
+              JsonDocument::Parse("{}", "s.json").CheckSchemaVersion(1);
+            }).find("s.json: schema_version"),
+            std::string::npos);
+  EXPECT_NE(MessageOf([] {
+              JsonDocument::Parse(R"({"schema_version": 9})", "s.json").CheckSchemaVersion(1);
+            }).find("newer"),
+            std::string::npos);
+  EXPECT_NO_THROW(JsonDocument::Parse(R"({"schema_version": 1})", "s.json").CheckSchemaVersion(1));
+}
+
+}  // namespace
+}  // namespace lumislab

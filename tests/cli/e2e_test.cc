@@ -1,0 +1,147 @@
+// End to end on synthetic captures: acquire -> calibrate -> reconstruct, compared with the
+// analytic truth/ that the synthetic acquisition writes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/dataset.h"
+#include "core/exr_io.h"
+#include "core/screen_calibration.h"
+#include "core/slab_compare.h"
+#include "test_util.h"
+
+namespace lumislab {
+namespace {
+
+using testing::FreshDir;
+using testing::RunTool;
+using testing::SceneJson;
+using testing::WriteFile;
+
+const char* kFrontalCamera =
+    R"({"size_px": [1600, 1200], "focal_px": 1300, "position_mm": [0, -400, 2400],
+        "look_at_mm": [0, 0, 750]})";
+// About 50 degrees off the screen normal, from the side and below.
+const char* kObliqueCamera =
+    R"({"size_px": [1600, 1200], "focal_px": 1100, "position_mm": [1400, -300, 1900],
+        "look_at_mm": [0, 0, 750]})";
+const char* kNoise =
+    R"([{"type": "sensor_noise", "full_well_e": 20000, "read_noise_e": 3, "seed": 7},
+        {"type": "quantization", "bit_depth": 16}])";
+constexpr double kFullWell = 20000, kReadNoise = 3;
+
+// acquire (scene file or "default") -> calibrate -> reconstruct; returns the dataset folder.
+std::string RunPipeline(const std::string& name, const std::string& scene_json) {
+  const std::string dir = FreshDir(name);
+  std::string scene = "default";
+  if (!scene_json.empty()) {
+    scene = dir + "/scene.json";
+    WriteFile(scene, scene_json);
+  }
+  const std::string ds = dir + "/ds";
+  auto r = RunTool("lumislab-acquire", "synth --scene " + scene + " --out " + ds);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = RunTool("lumislab-calibrate", "screen --dataset " + ds);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = RunTool("lumislab-reconstruct", "--dataset " + ds);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return ds;
+}
+
+TEST(EndToEnd, DefaultSceneNoiseFreeMatchesTruth) {
+  const std::string ds = RunPipeline("e2e_default", "");
+  const SlabComparison c = CompareSlabs(ds + "/slab", ds + "/truth");
+  std::printf("default scene, noise-free: %s\n", c.Summary().c_str());
+  ASSERT_EQ(c.positions.size(), 63u);
+  for (const auto& p : c.positions) {
+    EXPECT_LE(p.relative_l2, 0.005) << "position " << p.i << "," << p.j;
+    EXPECT_GT(p.lit_texels, 1000) << "position " << p.i << "," << p.j;
+  }
+}
+
+// The photo of an oblique camera is resampled much more unevenly; the slab must be as good.
+TEST(EndToEnd, ObliqueViewAsAccurateAsFrontal) {
+  const std::string frontal = RunPipeline("e2e_frontal", SceneJson(3, 3, kFrontalCamera, "[]"));
+  const std::string oblique = RunPipeline("e2e_oblique", SceneJson(3, 3, kObliqueCamera, "[]"));
+  const SlabComparison f = CompareSlabs(frontal + "/slab", frontal + "/truth");
+  const SlabComparison o = CompareSlabs(oblique + "/slab", oblique + "/truth");
+  std::printf("frontal 3x3: %s\noblique 3x3: %s\n", f.Summary().c_str(), o.Summary().c_str());
+  EXPECT_LE(f.max_relative_l2, 0.005);
+  EXPECT_LE(o.max_relative_l2, 0.005);
+  EXPECT_LE(o.max_relative_l2, std::max(1.5 * f.max_relative_l2, 0.002));
+  for (const auto& p : o.positions) EXPECT_GT(p.lit_texels - p.unseen_lit_texels, 1000);
+}
+
+// Noise floor predicted from the sensor model: per photo pixel the normalised value v has
+// variance (v FW + read^2) / FW^2 + q^2/12; a texel averages N = texel area / pixel area pixels;
+// E = peak (E+ - E-) adds the two slides; the deconvolution with the stencil [b, a, b]
+// (a = 5/6, b = 1/12) multiplies white-noise variance by (a / (a^2 - 4 b^2)^1.5)^2 in 2D.
+double PredictedNoiseFloor(const std::string& noisy, const std::string& clean) {
+  const Dataset ds = Dataset::Load(clean);
+  const ScreenCalibration cal = ScreenCalibration::Load(clean + "/calib/screen.json");
+  const SlabInfo truth_info = SlabInfo::Load(clean + "/truth");
+  const SlabInfo info = SlabInfo::Load(noisy + "/slab");
+  const double a = 5.0 / 6, b = 1.0 / 12;
+  const double gain_1d = a / std::pow(a * a - 4 * b * b, 1.5);
+  const double deconv_gain = gain_1d * gain_1d;
+  const double q = 1.0 / 65535;
+  const double scale = *ds.radiometric_scale, peak = ds.filter.peak;
+  const double texel_area = info.layout.TexelW() * info.layout.TexelH();
+  double var_sum = 0, ref2 = 0;
+  for (const auto& [i, j] : info.present) {
+    const SlabPosition truth = ReadSlabPosition(clean + "/truth", truth_info, i, j);
+    const SlabPosition slab = ReadSlabPosition(noisy + "/slab", info, i, j);
+    const ImageF plus = ReadExr(clean + "/" + ds.PhotosOf(i, j)[0].file, {"R", "G", "B"});
+    const ImageF minus = ReadExr(clean + "/" + ds.PhotosOf(i, j)[1].file, {"R", "G", "B"});
+    float max_ref = 0;
+    for (float v : truth.irradiance.data) max_ref = std::max(max_ref, std::abs(v));
+    const Eigen::Vector2d c = ds.grid.Centre(i, j);
+    for (int row = 0; row < info.layout.res_y; ++row)
+      for (int col = 0; col < info.layout.res_x; ++col) {
+        const size_t k = size_t(row) * info.layout.res_x + col;
+        float mag = 0;
+        for (int ch = 0; ch < 3; ++ch)
+          mag = std::max(mag, std::abs(truth.irradiance.data[k * 3 + ch]));
+        if (mag < 0.01 * max_ref || slab.mask.data[k] < 0.5f) continue;
+        const Eigen::Vector2d lab = info.layout.TexelCentre(col, row) - c;
+        const Eigen::Vector2d px = cal.ImageFromScreen(lab);
+        // Pixel footprint on the screen (mm^2) from the calibration's Jacobian.
+        const Eigen::Vector2d dx = cal.ScreenFromImage(px + Eigen::Vector2d(0.5, 0)) -
+                                   cal.ScreenFromImage(px - Eigen::Vector2d(0.5, 0));
+        const Eigen::Vector2d dy = cal.ScreenFromImage(px + Eigen::Vector2d(0, 0.5)) -
+                                   cal.ScreenFromImage(px - Eigen::Vector2d(0, 0.5));
+        const double pixel_area = std::abs(dx.x() * dy.y() - dx.y() * dy.x());
+        const double n = texel_area / pixel_area;
+        const int x = int(std::lround(px.x())), y = int(std::lround(px.y()));
+        for (int ch = 0; ch < 3; ++ch) {
+          double var = 0;
+          for (const ImageF* photo : {&plus, &minus}) {
+            const double v = std::max(0.0f, photo->at(x, y, ch));
+            var += (v * kFullWell + kReadNoise * kReadNoise) / (kFullWell * kFullWell) + q * q / 12;
+          }
+          var_sum += peak * peak * scale * scale * var / n * deconv_gain;
+          const double t = truth.irradiance.data[k * 3 + ch];
+          ref2 += t * t;
+        }
+      }
+  }
+  return std::sqrt(var_sum / ref2);
+}
+
+TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
+  const std::string clean = RunPipeline("e2e_clean", SceneJson(3, 3, kFrontalCamera, "[]"));
+  const std::string noisy = RunPipeline("e2e_noisy", SceneJson(3, 3, kFrontalCamera, kNoise));
+  const SlabComparison c = CompareSlabs(noisy + "/slab", noisy + "/truth");
+  const double floor = PredictedNoiseFloor(noisy, clean);
+  std::printf("noisy 3x3: %s; predicted noise floor %.3f %%, ratio %.2f\n", c.Summary().c_str(),
+              100 * floor, c.overall_relative_l2 / floor);
+  EXPECT_GT(floor, 0.0);
+  EXPECT_LE(c.overall_relative_l2, 1.5 * floor);
+  // The noise must be visible at all (otherwise this test would not test the fit with noise).
+  const SlabComparison clean_c = CompareSlabs(clean + "/slab", clean + "/truth");
+  EXPECT_GT(c.overall_relative_l2, 1.5 * clean_c.overall_relative_l2);
+}
+
+}  // namespace
+}  // namespace lumislab

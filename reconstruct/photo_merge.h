@@ -1,0 +1,38 @@
+// Photos of one grid position -> one image of E = peak * scale * (E+ - E-) in photo pixel space.
+// Linearisation: 16-bit PNG/TIFF value / 65535, 8-bit through the sRGB curve, EXR as is.
+// Brackets: per slide and channel, sum of values / sum of exposures over the exposures that are
+// not saturated (an exposure-weighted average of value / exposure).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/dataset.h"
+
+namespace lumislab {
+
+struct DecodedPhoto {
+  PhotoEntry entry;
+  std::string path;  // full path, for messages
+  cv::Mat pixels;    // as decoded: 8U/16U (OpenCV BGR or gray) or 32FC3 RGB (EXR)
+  bool rgb_order = false;
+};
+
+// Decodes one photo; a missing or undecodable file is bad input naming the photo (exit 2).
+DecodedPhoto DecodePhoto(const Dataset& dataset, const PhotoEntry& entry);
+
+// Checks that every photo has the calibration's image size (bad input naming the photo).
+void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,
+                     const std::string& calibration_file);
+
+struct MergedPosition {
+  cv::Mat signal;            // CV_32FC4: R, G, B = gain * (E+ - E-); A = 1 where saturated
+  int saturated_pixels = 0;  // pixels with a channel saturated in every exposure of a slide
+};
+
+// gain = filter peak * radiometric scale. Needs at least one photo of each slide.
+MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double saturation_level,
+                             double gain);
+
+}  // namespace lumislab

@@ -1,0 +1,125 @@
+#include "reconstruct/reconstructor.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/log.h"
+
+namespace lumislab {
+
+namespace {
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+void ReconstructOptions::Check() const {
+  if (resolution < 4 || resolution > 8192)
+    throw BadInput("--resolution: expected an integer in [4, 8192], got " +
+                   std::to_string(resolution));
+  if (!(lambda >= 0 && lambda <= 1))
+    throw BadInput("--lambda: expected a number in [0, 1], got " + std::to_string(lambda));
+  if (samples_per_texel < 0 || samples_per_texel > 64)
+    throw BadInput("samples per texel: expected 0 (auto) .. 64, got " +
+                   std::to_string(samples_per_texel));
+}
+
+std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
+                                         const ScreenCalibration& calibration, int i, int j) {
+  const std::vector<PhotoEntry> entries = dataset.PhotosOf(i, j);
+  bool has_p = false, has_n = false;
+  for (const auto& e : entries) (e.positive ? has_p : has_n) = true;
+  if (!has_p || !has_n)
+    throw InputError(dataset.Path("dataset.json"), "photos",
+                     "photos of both slides (p and n) for every grid position",
+                     "position " + std::to_string(i) + "," + std::to_string(j) + " lacks " +
+                         (has_p ? "n" : "p"));
+  std::vector<DecodedPhoto> photos;
+  for (const auto& e : entries) photos.push_back(DecodePhoto(dataset, e));
+  CheckPhotoSizes(photos, calibration.image_width, calibration.image_height,
+                  dataset.Path("calib/screen.json"));
+  return photos;
+}
+
+SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration& calibration,
+                                const SlabInfo& info, int i, int j,
+                                const std::vector<DecodedPhoto>& photos,
+                                const ReconstructOptions& options, PositionReport* report) {
+  PositionReport local;
+  PositionReport& r = report ? *report : local;
+  r.i = i, r.j = j;
+  auto t0 = std::chrono::steady_clock::now();
+  // 1. Linear, merged, E = peak * scale * (E+ - E-) in photo space, saturation flagged.
+  const double gain = dataset.filter.peak * dataset.radiometric_scale.value_or(1.0);
+  const MergedPosition merged = MergePosition(photos, dataset.saturation_level, gain);
+  r.saturated_pixels = merged.saturated_pixels;
+  // 2. Into the luminaire frame, area-averaged per texel.
+  const SlabLayout& layout = info.layout;
+  const RectifyMap map =
+      BuildRectifyMap(calibration, layout, dataset.grid.Centre(i, j), dataset.screen_w_mm,
+                      dataset.screen_h_mm, options.samples_per_texel);
+  r.samples_per_texel = map.samples_per_texel;
+  const cv::Mat texels = Rectify(merged.signal, map);
+  const size_t n = size_t(layout.res_x) * layout.res_y;
+  std::vector<unsigned char> seen(n, 0);
+  std::vector<double> data(n * 3, 0.0);
+  r.seen_texels = 0;
+  r.saturated_texels = 0;
+  for (int row = 0; row < layout.res_y; ++row) {
+    const float* t = texels.ptr<float>(row);
+    for (int col = 0; col < layout.res_x; ++col, t += 4) {
+      const size_t k = size_t(row) * layout.res_x + col;
+      if (!map.inside[k]) continue;
+      if (t[3] > 0) {
+        ++r.saturated_texels;
+        continue;
+      }
+      seen[k] = 1;
+      ++r.seen_texels;
+      for (int c = 0; c < 3; ++c) data[k * 3 + c] = t[c];
+    }
+  }
+  r.rectify_s = SecondsSince(t0);
+  // 3. Deconvolution onto the bell basis.
+  t0 = std::chrono::steady_clock::now();
+  BellFitOptions fit_options;
+  fit_options.lambda = options.lambda;
+  BellFitReport fit_report;
+  const std::vector<double> c =
+      FitBell(data, seen, layout.res_x, layout.res_y, 3, fit_options, &fit_report);
+  r.fit_iterations = fit_report.iterations;
+  r.fit_residual = fit_report.relative_residual;
+  SlabPosition out;
+  out.i = i, out.j = j;
+  out.irradiance = ImageF(layout.res_x, layout.res_y, 3);
+  out.mask = ImageF(layout.res_x, layout.res_y, 1);
+  for (size_t k = 0; k < n; ++k) {
+    if (!seen[k]) continue;
+    out.mask.data[k] = 1.f;
+    for (int ch = 0; ch < 3; ++ch) {
+      const float v = float(c[k * 3 + ch]);
+      if (!std::isfinite(v))
+        throw Failure("position " + std::to_string(i) + "," + std::to_string(j) +
+                      ": non-finite value after the fit");
+      out.irradiance.data[k * 3 + ch] = v;
+    }
+  }
+  r.fit_s = SecondsSince(t0);
+  return out;
+}
+
+SlabPosition ReconstructPosition(const Dataset& dataset, const ScreenCalibration& calibration,
+                                 const SlabInfo& info, int i, int j,
+                                 const ReconstructOptions& options, PositionReport* report) {
+  PositionReport local;
+  PositionReport& r = report ? *report : local;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<DecodedPhoto> photos = DecodePosition(dataset, calibration, i, j);
+  const double decode_s = SecondsSince(t0);
+  SlabPosition out = ReconstructDecoded(dataset, calibration, info, i, j, photos, options, &r);
+  r.decode_s = decode_s;
+  return out;
+}
+
+}  // namespace lumislab

@@ -1,0 +1,51 @@
+// The reconstruct stage: photos of one grid position -> fitted E_ij in the slab layout.
+#pragma once
+
+#include <string>
+
+#include "core/dataset.h"
+#include "core/screen_calibration.h"
+#include "core/slab.h"
+#include "reconstruct/bell_fit.h"
+#include "reconstruct/photo_merge.h"
+#include "reconstruct/rectify.h"
+
+namespace lumislab {
+
+struct ReconstructOptions {
+  int resolution = 300;       // slab texels per side
+  double lambda = 1e-4;       // regulariser of the fit (relative to B^T B, diagonal ~0.5)
+  int samples_per_texel = 0;  // K; 0 = automatic (at least as dense as the photo pixels)
+  void Check() const;         // throws BadInput naming the option
+};
+
+struct PositionReport {
+  int i = 0, j = 0;
+  int saturated_pixels = 0;  // photo pixels clipped in every exposure of a slide
+  int saturated_texels = 0;  // texels dropped because a sample touched a saturated pixel
+  int seen_texels = 0;
+  int samples_per_texel = 0;
+  int fit_iterations = 0;
+  double fit_residual = 0;
+  // Seconds per stage.
+  double decode_s = 0, rectify_s = 0, fit_s = 0, write_s = 0;
+};
+
+// Photos of (i, j), decoded (both slides, all exposures); checks that both slides exist and
+// that the sizes match the calibration.
+std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
+                                         const ScreenCalibration& calibration, int i, int j);
+// From decoded photos (the bench times decoding on its own).
+SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration& calibration,
+                                const SlabInfo& info, int i, int j,
+                                const std::vector<DecodedPhoto>& photos,
+                                const ReconstructOptions& options, PositionReport* report);
+SlabPosition ReconstructPosition(const Dataset& dataset, const ScreenCalibration& calibration,
+                                 const SlabInfo& info, int i, int j,
+                                 const ReconstructOptions& options, PositionReport* report);
+
+// lumislab-reconstruct --dataset <dir> [--resolution N] [--watch] [--force] [--threads N]
+// [--lambda x] [--verbose]
+int RunReconstruct(int argc, char** argv);
+
+}  // namespace lumislab

@@ -1,0 +1,37 @@
+// Photo pixel space -> slab texels of one grid position, with area averaging (DESIGN §3, §5).
+// The texel at (s, t) (luminaire frame) sees the lab screen point (s, t) - c_ij, which the screen
+// calibration maps to a photo pixel. Each texel is sampled on a K x K grid (K chosen so the
+// samples are at least as dense as the photo pixels), bilinearly (cv::remap), and the K x K
+// blocks are box-averaged (cv::resize INTER_AREA with an integer factor).
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "core/grid.h"
+#include "core/screen_calibration.h"
+
+namespace lumislab {
+
+struct RectifyMap {
+  int res_x = 0;
+  int res_y = 0;
+  int samples_per_texel = 0;  // K
+  cv::Mat map_x, map_y;       // CV_32FC1, (res_y K) x (res_x K): photo pixel of each sample
+  // Per texel: every sample lies inside the photo and on the physical screen.
+  std::vector<unsigned char> inside;
+  double max_texel_px = 0;  // largest texel extent in photo pixels (what K follows)
+};
+
+// screen_w/h_mm: the physical screen, [-W/2, W/2] x [-H/2, H/2] in the lab frame.
+// samples_per_texel = 0 picks K = clamp(ceil(max texel extent in pixels), 2, kMaxSamples).
+constexpr int kMaxSamplesPerTexel = 12;
+RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayout& layout,
+                           const Eigen::Vector2d& centre_mm, double screen_w_mm, double screen_h_mm,
+                           int samples_per_texel = 0);
+
+// signal: CV_32FC4 photo-space image. Returns res_y x res_x CV_32FC4 texel box averages.
+cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map);
+
+}  // namespace lumislab

@@ -1,0 +1,34 @@
+// Writes positions of one slab folder from several threads; slab.json has exactly one writer.
+#pragma once
+
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/dataset.h"
+#include "core/slab.h"
+
+namespace lumislab {
+
+class SlabWriter {
+ public:
+  // Opens dataset/slab: keeps positions whose EXR already exists (unless `force`), rejects an
+  // existing slab of another resolution unless `force`; writes a valid slab.json right away.
+  SlabWriter(const Dataset& dataset, int resolution, bool force);
+
+  const SlabInfo& info() const { return info_; }
+  const std::string& dir() const { return dir_; }
+  bool IsPresent(int i, int j) const;
+  bool Complete() const;
+  int PresentCount() const;
+  // Writes slab/pos_<i>_<j>.exr atomically, then marks it present in slab.json.
+  void Write(const SlabPosition& position);
+
+ private:
+  std::string dir_;
+  SlabInfo info_;  // layout/grid fixed at construction; `present` guarded by mutex_
+  mutable std::mutex mutex_;
+};
+
+}  // namespace lumislab

@@ -1,0 +1,271 @@
+// ReconstructPosition and RunReconstruct on tiny analytic datasets (no acquire stage needed):
+// accuracy against the analytic E_ij, masks, saturation, brackets, errors, skip/force, --watch.
+#include "reconstruct/reconstructor.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "core/error.h"
+#include "core/slab.h"
+#include "synthetic_dataset.h"
+
+namespace fs = std::filesystem;
+
+namespace lumislab {
+namespace {
+
+using testing::ExpectedFit;
+using testing::FreshTestDir;
+using testing::MakeSyntheticDataset;
+using testing::PointTruth;
+using testing::RelativeL2;
+using testing::SyntheticDataset;
+using testing::SyntheticOptions;
+
+constexpr int kRes = 40;  // 3 mm texels on the 120 mm screen
+
+SlabPosition Reconstruct(const SyntheticDataset& s, int i, int j, PositionReport* report,
+                         ReconstructOptions options = {}) {
+  options.resolution = kRes;
+  const SlabInfo info = SlabInfo::FromDataset(s.dataset, kRes);
+  return ReconstructPosition(s.dataset, s.calibration, info, i, j, options, report);
+}
+
+// Accuracy of one reconstructed position: against what the fit must give for perfect data
+// (tight: rectification and area averaging), and against E at the texel centres (looser: the
+// bell basis's approximation error for this deliberately sharp light, ~0.4 %).
+struct Accuracy {
+  double vs_fit = 0, vs_centres = 0;
+};
+Accuracy Measure(const SyntheticDataset& s, int i, int j, const SlabPosition& p,
+                 const SlabLayout& layout) {
+  Accuracy a;
+  a.vs_fit = RelativeL2(p, ExpectedFit(s, i, j, layout, p));
+  a.vs_centres = RelativeL2(p, PointTruth(s, i, j, layout));
+  return a;
+}
+constexpr double kFitTolerance = 3e-4, kCentreTolerance = 6e-3;
+
+int RunCli(std::vector<std::string> args) {
+  std::vector<char*> argv;
+  static char name[] = "lumislab-reconstruct";
+  argv.push_back(name);
+  for (auto& a : args) argv.push_back(a.data());
+  return RunReconstruct(int(argv.size()), argv.data());
+}
+
+TEST(Reconstruct, FrontalExrMatchesAnalyticTruth) {
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("frontal"), SyntheticOptions());
+  const SlabLayout layout = s.dataset.Layout(kRes);
+  for (int i = 0; i < 2; ++i) {
+    PositionReport r;
+    const SlabPosition p = Reconstruct(s, i, 0, &r);
+    const Accuracy a = Measure(s, i, 0, p, layout);
+    std::printf(
+        "frontal position %d: relative L2 %.2e vs exact fit, %.2e vs centres, K=%d, %d CG "
+        "iterations\n",
+        i, a.vs_fit, a.vs_centres, r.samples_per_texel, r.fit_iterations);
+    EXPECT_LE(a.vs_fit, kFitTolerance);
+    EXPECT_LE(a.vs_centres, kCentreTolerance);
+    EXPECT_EQ(r.saturated_pixels, 0);
+    EXPECT_GE(r.samples_per_texel, 9);  // 3 mm texels, 3 px/mm: samples as dense as pixels
+    EXPECT_LE(r.fit_iterations, 40);
+  }
+}
+
+// The fit matches box averages (it conserves the flux through each texel), so its coefficients
+// differ from the centre values by -(texel^2 / 24) Laplacian(E) to leading order, while the plain
+// box averages differ by +(texel^2 / 24) Laplacian(E). Both predictions are checked here.
+TEST(Reconstruct, FitDeviatesFromCentresByTheBellModelError) {
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("fit_vs_box"), SyntheticOptions());
+  const SlabLayout layout = s.dataset.Layout(kRes);
+  const SlabPosition fitted = Reconstruct(s, 1, 0, nullptr);
+  const ImageF centres = PointTruth(s, 1, 0, layout);
+  // Predicted centre value + model error, Laplacian by central differences (0.5 mm steps).
+  SlabPosition predicted_fit = fitted, predicted_box = fitted;
+  const double h2 = layout.TexelW() * layout.TexelH(), e = 0.5;
+  for (int row = 0; row < kRes; ++row)
+    for (int col = 0; col < kRes; ++col) {
+      const Eigen::Vector2d st = layout.TexelCentre(col, row);
+      for (int c = 0; c < 3; ++c) {
+        auto f = [&](double ds, double dt) { return s.Truth(1, 0, c, st.x() + ds, st.y() + dt); };
+        const double lap = (f(e, 0) + f(-e, 0) + f(0, e) + f(0, -e) - 4 * f(0, 0)) / (e * e);
+        predicted_fit.irradiance.at(col, row, c) = float(f(0, 0) - h2 / 24 * lap);
+        predicted_box.irradiance.at(col, row, c) = float(f(0, 0) + h2 / 24 * lap);
+      }
+    }
+  const double err_centres = RelativeL2(fitted, centres);
+  const double err_model = RelativeL2(fitted, predicted_fit.irradiance);
+  const double box_vs_centres = RelativeL2(predicted_box, centres);
+  std::printf(
+      "fit vs centres %.2e, fit vs centres - h^2/24 Laplacian %.2e, box model vs centres "
+      "%.2e\n",
+      err_centres, err_model, box_vs_centres);
+  EXPECT_LT(err_model, 0.2 * err_centres);  // the deviation is the predicted model error
+  EXPECT_NEAR(err_centres, box_vs_centres, 0.2 * box_vs_centres);
+}
+
+TEST(Reconstruct, ObliqueDistortedPngAsAccurate) {
+  SyntheticOptions o;
+  o.perspective = 0.002;  // the pixel footprint varies by +-12 % across the screen
+  o.k1 = 0.03;
+  o.ext = ".png";
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("oblique"), o);
+  const SlabLayout layout = s.dataset.Layout(kRes);
+  for (int i = 0; i < 2; ++i) {
+    const SlabPosition p = Reconstruct(s, i, 0, nullptr);
+    const Accuracy a = Measure(s, i, 0, p, layout);
+    std::printf(
+        "oblique distorted png position %d: relative L2 %.2e vs exact fit, %.2e vs "
+        "centres\n",
+        i, a.vs_fit, a.vs_centres);
+    EXPECT_LE(a.vs_fit, kFitTolerance);
+    EXPECT_LE(a.vs_centres, kCentreTolerance);
+  }
+}
+
+TEST(Reconstruct, OffScreenTexelsAreMaskedAndZero) {
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("mask"), SyntheticOptions());
+  // Position (0, 0) has c = (-2.5, 0) mm: the texel column at s = +60 sees lab x = 62.5 beyond
+  // the screen edge; the column at s = -60 is on the screen.
+  const SlabPosition p = Reconstruct(s, 0, 0, nullptr);
+  for (int row = 0; row < kRes; ++row) {
+    EXPECT_EQ(p.mask.at(kRes - 1, row, 0), 0.f) << row;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(p.irradiance.at(kRes - 1, row, c), 0.f);
+    EXPECT_EQ(p.mask.at(0, row, 0), 1.f) << row;
+    EXPECT_EQ(p.mask.at(kRes / 2, row, 0), 1.f) << row;
+  }
+}
+
+TEST(Reconstruct, SaturatedPixelsAreCountedAndLeftOut) {
+  SyntheticOptions o;
+  o.amplitude = 1.3;  // the centre of the T+ photo clips
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("saturated"), o);
+  ASSERT_GT(s.saturated_pixels_total, 100);
+  const SlabLayout layout = s.dataset.Layout(kRes);
+  int counted = 0;
+  for (int i = 0; i < 2; ++i) {
+    PositionReport r;
+    const SlabPosition p = Reconstruct(s, i, 0, &r);
+    counted += r.saturated_pixels;
+    EXPECT_GT(r.saturated_texels, 0);
+    // Texels whose centre is clipped in the photo are not seen; what is seen is still exact.
+    for (int row = 0; row < kRes; ++row)
+      for (int col = 0; col < kRes; ++col) {
+        const Eigen::Vector2d st = layout.TexelCentre(col, row);
+        const Eigen::Vector2d lab = st - s.dataset.grid.Centre(i, 0);
+        if (s.Photo(i, 0, true, 0, lab.x(), lab.y()) >= 1.0) {
+          ASSERT_EQ(p.mask.at(col, row, 0), 0.f) << col << "," << row;
+        }
+      }
+    EXPECT_LE(Measure(s, i, 0, p, layout).vs_fit, kFitTolerance);
+  }
+  EXPECT_EQ(counted, s.saturated_pixels_total);
+}
+
+TEST(Reconstruct, ExposureBracketsRecoverClippedHighlights) {
+  SyntheticOptions o;
+  o.amplitude = 1.6;  // clipped at exposure 1, fine at exposure 0.25
+  o.exposures = {1.0, 0.25};
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("brackets"), o);
+  EXPECT_EQ(s.saturated_pixels_total, 0);
+  const SlabLayout layout = s.dataset.Layout(kRes);
+  PositionReport r;
+  const SlabPosition p = Reconstruct(s, 1, 0, &r);
+  EXPECT_EQ(r.saturated_pixels, 0);
+  EXPECT_EQ(r.saturated_texels, 0);
+  EXPECT_LE(Measure(s, 1, 0, p, layout).vs_fit, kFitTolerance);
+}
+
+Error CaughtError(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e;
+  }
+  return Failure("no error thrown");
+}
+
+TEST(Reconstruct, BadPhotosNameTheFile) {
+  SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("bad_photos"), SyntheticOptions());
+  fs::remove(s.dir + "/photos/pos_1_0_n.exr");
+  Error e = CaughtError([&] { Reconstruct(s, 1, 0, nullptr); });
+  EXPECT_EQ(e.code(), ExitCode::kBadInput);
+  EXPECT_NE(std::string(e.what()).find("pos_1_0_n.exr"), std::string::npos) << e.what();
+  // Wrong image size against the calibration.
+  s.calibration.image_width = 500;
+  e = CaughtError([&] { Reconstruct(s, 0, 0, nullptr); });
+  EXPECT_EQ(e.code(), ExitCode::kBadInput);
+  EXPECT_NE(std::string(e.what()).find("image size"), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find("pos_0_0_p.exr"), std::string::npos) << e.what();
+}
+
+TEST(RunReconstruct, WritesSlabSkipsExistingAndForces) {
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("run"), SyntheticOptions());
+  ASSERT_EQ(RunCli({"--dataset", s.dir, "--resolution", "40", "--threads", "2"}), 0);
+  const SlabInfo info = SlabInfo::Load(s.dir + "/slab");
+  EXPECT_TRUE(info.Complete());
+  EXPECT_EQ(info.units, "W/m^2");
+  const SlabPosition p = ReadSlabPosition(s.dir + "/slab", info, 1, 0);
+  EXPECT_LE(Measure(s, 1, 0, p, info.layout).vs_fit, kFitTolerance);
+  const std::string exr = SlabPositionPath(s.dir + "/slab", 1, 0);
+  const auto t0 = fs::last_write_time(exr);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(RunCli({"--dataset", s.dir, "--resolution", "40"}), 0);
+  EXPECT_EQ(fs::last_write_time(exr), t0);  // skipped
+  // Another resolution over an existing slab needs --force.
+  const Error e = CaughtError([&] { RunCli({"--dataset", s.dir, "--resolution", "30"}); });
+  EXPECT_EQ(e.code(), ExitCode::kBadInput);
+  EXPECT_NE(std::string(e.what()).find("slab.json"), std::string::npos) << e.what();
+  ASSERT_EQ(RunCli({"--dataset", s.dir, "--resolution", "40", "--force"}), 0);
+  EXPECT_NE(fs::last_write_time(exr), t0);
+  for (const auto& entry : fs::recursive_directory_iterator(s.dir))
+    EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();  // no temporaries
+}
+
+TEST(RunReconstruct, MissingCalibrationIsBadInputAndWritesNothing) {
+  SyntheticOptions o;
+  o.write_calibration = false;
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("no_calib"), o);
+  const Error e = CaughtError([&] { RunCli({"--dataset", s.dir, "--resolution", "40"}); });
+  EXPECT_EQ(e.code(), ExitCode::kBadInput);
+  EXPECT_NE(std::string(e.what()).find("calib/screen.json"), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find("lumislab-calibrate screen"), std::string::npos);
+  EXPECT_FALSE(fs::exists(s.dir + "/slab"));
+}
+
+// --watch: photos arrive one position at a time while the watcher runs; it stops when the grid
+// is complete and the result equals the batch result.
+TEST(RunReconstruct, WatchProcessesPositionsAsTheyArrive) {
+  SyntheticOptions o;
+  o.nu = 2;
+  o.nv = 2;
+  o.write_calibration = false;  // the calibration also arrives late
+  SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("watch"), o, /*write_photos=*/false);
+  int code = -1;
+  std::thread watcher([&] {
+    code = RunCli({"--dataset", s.dir, "--resolution", "40", "--watch", "--poll", "0.02",
+                   "--idle-timeout", "30"});
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  s.calibration.Save(s.dir + "/calib/screen.json");
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      s.WritePhotos(i, j);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  watcher.join();
+  ASSERT_EQ(code, 0);
+  const SlabInfo info = SlabInfo::Load(s.dir + "/slab");
+  EXPECT_TRUE(info.Complete());
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i)
+      EXPECT_LE(Measure(s, i, j, ReadSlabPosition(s.dir + "/slab", info, i, j), info.layout).vs_fit,
+                kFitTolerance);
+}
+
+}  // namespace
+}  // namespace lumislab

@@ -17,183 +17,234 @@ BellStencil BellStencil::FromBasis() {
 
 namespace {
 
-// The masked operators on a width x height grid with interleaved channels.
+// The masked operators on a width x height grid, CH interleaved channels. Only seen texels are
+// touched; every neighbour index of a seen texel points to the texel itself when that neighbour
+// is unseen or outside (the Neumann mirror), so the loops are branch-free gathers. Unseen
+// entries of every vector stay 0.
+template <int CH>
 class MaskedGrid {
  public:
-  MaskedGrid(const std::vector<unsigned char>& seen, int width, int height, int channels)
-      : seen_(seen), w_(width), h_(height), ch_(channels), s_(BellStencil::FromBasis()) {}
-
-  bool Seen(int x, int y) const {
-    return x >= 0 && y >= 0 && x < w_ && y < h_ && seen_[size_t(y) * w_ + x] != 0;
-  }
-  size_t Size() const { return size_t(w_) * h_ * ch_; }
-
-  // out = the 1D box operator along x (dx = 1) or y (dy = 1); unseen neighbours mirror the texel.
-  void Apply1D(const std::vector<double>& in, std::vector<double>& out, int dx, int dy) const {
-    for (int y = 0; y < h_; ++y)
-      for (int x = 0; x < w_; ++x) {
-        const size_t k = (size_t(y) * w_ + x) * ch_;
-        if (!Seen(x, y)) {
-          for (int c = 0; c < ch_; ++c) out[k + c] = 0;
-          continue;
-        }
-        const bool lo = Seen(x - dx, y - dy), hi = Seen(x + dx, y + dy);
-        const size_t klo = lo ? k - (size_t(dy) * w_ + dx) * ch_ : k;
-        const size_t khi = hi ? k + (size_t(dy) * w_ + dx) * ch_ : k;
-        for (int c = 0; c < ch_; ++c)
-          out[k + c] = s_.w0 * in[k + c] + s_.w1 * (in[klo + c] + in[khi + c]);
+  MaskedGrid(const std::vector<unsigned char>& seen, int width, int height)
+      : n_(size_t(width) * height), s_(BellStencil::FromBasis()) {
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const int k = y * width + x;
+        if (!seen[k]) continue;
+        auto nb = [&](int nx, int ny) {
+          const bool ok =
+              nx >= 0 && ny >= 0 && nx < width && ny < height && seen[size_t(ny) * width + nx] != 0;
+          return ok ? ny * width + nx : k;
+        };
+        active_.push_back(k);
+        xlo_.push_back(nb(x - 1, y));
+        xhi_.push_back(nb(x + 1, y));
+        ylo_.push_back(nb(x, y - 1));
+        yhi_.push_back(nb(x, y + 1));
       }
+    tmp_.assign(n_ * CH, 0.0);
+    tmp2_.assign(n_ * CH, 0.0);
+  }
+  size_t Size() const { return n_ * CH; }
+  const std::vector<int>& active() const { return active_; }
+
+  // out = 1D box operator with neighbours lo/hi.
+  void Apply1D(const double* in, double* out, const std::vector<int>& lo,
+               const std::vector<int>& hi) const {
+    const double w0 = s_.w0, w1 = s_.w1;
+    for (size_t a = 0; a < active_.size(); ++a) {
+      const size_t k = size_t(active_[a]) * CH, l = size_t(lo[a]) * CH, h = size_t(hi[a]) * CH;
+      for (int c = 0; c < CH; ++c) out[k + c] = w0 * in[k + c] + w1 * (in[l + c] + in[h + c]);
+    }
   }
   // B c = Bx (By c); both factors are symmetric, so B^T v = By (Bx v).
   void ApplyB(const std::vector<double>& c, std::vector<double>& out) const {
-    tmp_.resize(Size());
-    Apply1D(c, tmp_, 0, 1);
-    Apply1D(tmp_, out, 1, 0);
+    Apply1D(c.data(), tmp_.data(), ylo_, yhi_);
+    Apply1D(tmp_.data(), out.data(), xlo_, xhi_);
   }
   void ApplyBt(const std::vector<double>& v, std::vector<double>& out) const {
-    tmp_.resize(Size());
-    Apply1D(v, tmp_, 1, 0);
-    Apply1D(tmp_, out, 0, 1);
+    Apply1D(v.data(), tmp_.data(), xlo_, xhi_);
+    Apply1D(tmp_.data(), out.data(), ylo_, yhi_);
   }
-  // out = B^T B c + lambda D^T D c.
+  // out = B^T B c + lambda D^T D c. With mirrored neighbours, (D^T D c)_k = 4 c_k - sum of the
+  // four neighbour entries (a mirrored neighbour contributes c_k - c_k = 0).
   void ApplyNormal(const std::vector<double>& coef, double lambda, std::vector<double>& out) const {
-    tmp2_.resize(Size());
     ApplyB(coef, tmp2_);
-    ApplyBt(tmp2_, out);
-    if (lambda == 0) return;
-    for (int y = 0; y < h_; ++y)
-      for (int x = 0; x < w_; ++x) {
-        if (!Seen(x, y)) continue;
-        const size_t k = (size_t(y) * w_ + x) * ch_;
-        const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-        for (int n = 0; n < 4; ++n) {
-          if (!Seen(nx[n], ny[n])) continue;
-          const size_t kn = (size_t(ny[n]) * w_ + nx[n]) * ch_;
-          for (int c = 0; c < ch_; ++c) out[k + c] += lambda * (coef[k + c] - coef[kn + c]);
-        }
-      }
+    Apply1D(tmp2_.data(), tmp_.data(), xlo_, xhi_);
+    const double w0 = s_.w0, w1 = s_.w1;
+    const double* in = tmp_.data();
+    const double* cf = coef.data();
+    for (size_t a = 0; a < active_.size(); ++a) {
+      const size_t k = size_t(active_[a]) * CH;
+      const size_t yl = size_t(ylo_[a]) * CH, yh = size_t(yhi_[a]) * CH;
+      const size_t xl = size_t(xlo_[a]) * CH, xh = size_t(xhi_[a]) * CH;
+      for (int c = 0; c < CH; ++c)
+        out[k + c] = w0 * in[k + c] + w1 * (in[yl + c] + in[yh + c]) +
+                     lambda * (4 * cf[k + c] - cf[xl + c] - cf[xh + c] - cf[yl + c] - cf[yh + c]);
+    }
   }
-  // Diagonal of B^T B + lambda D^T D per texel (the Jacobi preconditioner).
+  // Diagonal of B^T B + lambda D^T D per active texel (the Jacobi preconditioner): the squared
+  // norm of column k of B (By spreads e_k vertically, Bx each of those horizontally).
   std::vector<double> Diagonal(double lambda) const {
-    std::vector<double> d(size_t(w_) * h_, 1.0);
-    auto self = [&](int x, int y, int dx, int dy) {
-      return s_.w0 + s_.w1 * ((Seen(x - dx, y - dy) ? 0 : 1) + (Seen(x + dx, y + dy) ? 0 : 1));
+    std::vector<double> d(active_.size());
+    std::vector<int> slot(n_, -1);
+    for (size_t a = 0; a < active_.size(); ++a) slot[active_[a]] = int(a);
+    const double w0 = s_.w0, w1 = s_.w1;
+    auto self = [&](size_t a, const std::vector<int>& lo, const std::vector<int>& hi) {
+      const int k = active_[a];
+      return w0 + w1 * ((lo[a] == k ? 1 : 0) + (hi[a] == k ? 1 : 0));
     };
-    // Squared norm of the x-operator's column at (x, y).
-    auto col_x = [&](int x, int y) {
-      const double a = self(x, y, 1, 0);
-      return a * a + s_.w1 * s_.w1 * ((Seen(x - 1, y) ? 1 : 0) + (Seen(x + 1, y) ? 1 : 0));
+    auto col_x = [&](size_t a) {
+      const int k = active_[a];
+      const double t = self(a, xlo_, xhi_);
+      return t * t + w1 * w1 * ((xlo_[a] != k ? 1 : 0) + (xhi_[a] != k ? 1 : 0));
     };
-    for (int y = 0; y < h_; ++y)
-      for (int x = 0; x < w_; ++x) {
-        if (!Seen(x, y)) continue;
-        const double t = self(x, y, 0, 1);
-        double sum = t * t * col_x(x, y);
-        int neighbours = 0;
-        for (int dy : {-1, 1})
-          if (Seen(x, y + dy)) sum += s_.w1 * s_.w1 * col_x(x, y + dy);
-        for (int n = 0; n < 4; ++n)
-          neighbours += Seen(x + (n == 0) - (n == 1), y + (n == 2) - (n == 3)) ? 1 : 0;
-        d[size_t(y) * w_ + x] = sum + lambda * neighbours;
-      }
+    for (size_t a = 0; a < active_.size(); ++a) {
+      const int k = active_[a];
+      const double t = self(a, ylo_, yhi_);
+      double sum = t * t * col_x(a);
+      int neighbours = 0;
+      for (int nb : {ylo_[a], yhi_[a]})
+        if (nb != k) sum += w1 * w1 * col_x(size_t(slot[nb]));
+      for (int nb : {xlo_[a], xhi_[a], ylo_[a], yhi_[a]}) neighbours += nb != k ? 1 : 0;
+      d[a] = sum + lambda * neighbours;
+    }
     return d;
   }
-  int channels() const { return ch_; }
 
  private:
-  const std::vector<unsigned char>& seen_;
-  int w_, h_, ch_;
+  size_t n_;
   BellStencil s_;
+  std::vector<int> active_, xlo_, xhi_, ylo_, yhi_;
   mutable std::vector<double> tmp_, tmp2_;
 };
+
+template <int CH>
+std::vector<double> Solve(const std::vector<double>& data, const std::vector<unsigned char>& seen,
+                          int width, int height, const BellFitOptions& options,
+                          BellFitReport* report) {
+  const MaskedGrid<CH> grid(seen, width, height);
+  const std::vector<int>& act = grid.active();
+  const size_t n = grid.Size();
+  // Warm start c = b (the box average is within a few percent of the centre value).
+  std::vector<double> x(n, 0.0), b(n, 0.0);
+  for (int k : act)
+    for (int c = 0; c < CH; ++c)
+      b[size_t(k) * CH + c] = x[size_t(k) * CH + c] = data[size_t(k) * CH + c];
+  std::vector<double> rhs(n, 0.0), r(n, 0.0), z(n, 0.0), p(n, 0.0), ap(n, 0.0);
+  grid.ApplyBt(b, rhs);
+  grid.ApplyNormal(x, options.lambda, ap);
+  const std::vector<double> diag = grid.Diagonal(options.lambda);
+  std::vector<double> inv_diag(diag.size());
+  for (size_t a = 0; a < diag.size(); ++a) inv_diag[a] = diag[a] > 0 ? 1.0 / diag[a] : 0.0;
+  double rhs_norm[CH] = {}, rz[CH] = {}, rr[CH] = {};
+  for (size_t a = 0; a < act.size(); ++a) {
+    const size_t k = size_t(act[a]) * CH;
+    for (int c = 0; c < CH; ++c) {
+      r[k + c] = rhs[k + c] - ap[k + c];
+      z[k + c] = inv_diag[a] * r[k + c];
+      p[k + c] = z[k + c];
+      rhs_norm[c] += rhs[k + c] * rhs[k + c];
+      rz[c] += r[k + c] * z[k + c];
+      rr[c] += r[k + c] * r[k + c];
+    }
+  }
+  bool done[CH];
+  bool all_done = true;
+  for (int c = 0; c < CH; ++c) {
+    rhs_norm[c] = std::sqrt(rhs_norm[c]);
+    done[c] = rhs_norm[c] == 0 || std::sqrt(rr[c]) <= options.tolerance * rhs_norm[c];
+    all_done = all_done && done[c];
+  }
+  int it = 0;
+  while (!all_done && it < options.max_iterations) {
+    ++it;
+    grid.ApplyNormal(p, options.lambda, ap);
+    double pap[CH] = {}, alpha[CH] = {};
+    for (int k : act)
+      for (int c = 0; c < CH; ++c) pap[c] += p[size_t(k) * CH + c] * ap[size_t(k) * CH + c];
+    for (int c = 0; c < CH; ++c) alpha[c] = (!done[c] && pap[c] > 0) ? rz[c] / pap[c] : 0.0;
+    double rz_new[CH] = {};
+    for (int c = 0; c < CH; ++c) rr[c] = 0;
+    for (size_t a = 0; a < act.size(); ++a) {
+      const size_t k = size_t(act[a]) * CH;
+      for (int c = 0; c < CH; ++c) {
+        x[k + c] += alpha[c] * p[k + c];
+        r[k + c] -= alpha[c] * ap[k + c];
+        z[k + c] = inv_diag[a] * r[k + c];
+        rz_new[c] += r[k + c] * z[k + c];
+        rr[c] += r[k + c] * r[k + c];
+      }
+    }
+    double beta[CH] = {};
+    all_done = true;
+    for (int c = 0; c < CH; ++c) {
+      beta[c] = rz[c] > 0 ? rz_new[c] / rz[c] : 0.0;
+      rz[c] = rz_new[c];
+      if (!done[c]) done[c] = std::sqrt(rr[c]) <= options.tolerance * rhs_norm[c];
+      all_done = all_done && done[c];
+    }
+    for (int k : act)
+      for (int c = 0; c < CH; ++c)
+        p[size_t(k) * CH + c] = z[size_t(k) * CH + c] + beta[c] * p[size_t(k) * CH + c];
+  }
+  double worst = 0;
+  for (int c = 0; c < CH; ++c)
+    if (rhs_norm[c] > 0) worst = std::max(worst, std::sqrt(rr[c]) / rhs_norm[c]);
+  for (double v : x)
+    if (!std::isfinite(v)) throw Failure("FitBell: non-finite coefficient (bad input data?)");
+  if (report) {
+    report->iterations = it;
+    report->relative_residual = worst;
+  }
+  return x;
+}
 
 }  // namespace
 
 std::vector<double> ApplyBellBoxOperator(const std::vector<double>& coefficients,
                                          const std::vector<unsigned char>& seen, int width,
                                          int height, int channels) {
-  const MaskedGrid grid(seen, width, height, channels);
-  LUMISLAB_CHECK(coefficients.size() == grid.Size(), "ApplyBellBoxOperator: size mismatch");
-  std::vector<double> out(grid.Size());
-  grid.ApplyB(coefficients, out);
+  LUMISLAB_CHECK(channels >= 1 && channels <= 4, "ApplyBellBoxOperator: 1..4 channels");
+  LUMISLAB_CHECK(coefficients.size() == size_t(width) * height * channels &&
+                     seen.size() == size_t(width) * height,
+                 "ApplyBellBoxOperator: size mismatch");
+  std::vector<double> out(coefficients.size(), 0.0);
+  auto run = [&](auto grid) { grid.ApplyB(coefficients, out); };
+  switch (channels) {
+    case 1:
+      run(MaskedGrid<1>(seen, width, height));
+      break;
+    case 2:
+      run(MaskedGrid<2>(seen, width, height));
+      break;
+    case 3:
+      run(MaskedGrid<3>(seen, width, height));
+      break;
+    default:
+      run(MaskedGrid<4>(seen, width, height));
+      break;
+  }
   return out;
 }
 
 std::vector<double> FitBell(const std::vector<double>& data, const std::vector<unsigned char>& seen,
                             int width, int height, int channels, const BellFitOptions& options,
                             BellFitReport* report) {
-  const MaskedGrid grid(seen, width, height, channels);
-  LUMISLAB_CHECK(data.size() == grid.Size() && seen.size() == size_t(width) * height,
-                 "FitBell: data/mask size does not match the grid");
+  LUMISLAB_CHECK(channels >= 1 && channels <= 4, "FitBell: 1..4 channels");
+  LUMISLAB_CHECK(
+      data.size() == size_t(width) * height * channels && seen.size() == size_t(width) * height,
+      "FitBell: data/mask size does not match the grid");
   LUMISLAB_CHECK(options.lambda >= 0 && std::isfinite(options.lambda), "FitBell: lambda >= 0");
-  const size_t n = grid.Size();
-  const int ch = channels;
-  // Warm start c = b (the box average is within a few percent of the centre value).
-  std::vector<double> x(n, 0.0);
-  for (size_t k = 0; k < n; ++k)
-    if (seen[k / ch]) x[k] = data[k];
-  std::vector<double> rhs(n), r(n), z(n), p(n), ap(n);
-  grid.ApplyBt(x, rhs);  // B^T b (x == b on seen texels here)
-  grid.ApplyNormal(x, options.lambda, ap);
-  for (size_t k = 0; k < n; ++k) r[k] = rhs[k] - ap[k];
-  const std::vector<double> diag = grid.Diagonal(options.lambda);
-  std::vector<double> inv_diag(diag.size());
-  for (size_t t = 0; t < diag.size(); ++t) inv_diag[t] = diag[t] > 0 ? 1.0 / diag[t] : 0.0;
-
-  auto dot = [&](const std::vector<double>& a, const std::vector<double>& b, int c) {
-    double s = 0;
-    for (size_t k = size_t(c); k < n; k += ch) s += a[k] * b[k];
-    return s;
-  };
-  std::vector<double> rhs_norm(ch), rz(ch);
-  for (size_t k = 0; k < n; ++k) z[k] = inv_diag[k / ch] * r[k];
-  p = z;
-  for (int c = 0; c < ch; ++c) {
-    rhs_norm[c] = std::sqrt(dot(rhs, rhs, c));
-    rz[c] = dot(r, z, c);
+  switch (channels) {
+    case 1:
+      return Solve<1>(data, seen, width, height, options, report);
+    case 2:
+      return Solve<2>(data, seen, width, height, options, report);
+    case 3:
+      return Solve<3>(data, seen, width, height, options, report);
+    default:
+      return Solve<4>(data, seen, width, height, options, report);
   }
-  auto converged = [&](int c) {
-    const double rn = std::sqrt(dot(r, r, c));
-    return rhs_norm[c] == 0 || rn <= options.tolerance * rhs_norm[c];
-  };
-  int it = 0;
-  std::vector<bool> done(ch);
-  bool all_done = true;
-  for (int c = 0; c < ch; ++c) all_done = (done[c] = converged(c)) && all_done;
-  while (!all_done && it < options.max_iterations) {
-    ++it;
-    grid.ApplyNormal(p, options.lambda, ap);
-    std::vector<double> alpha(ch, 0.0);
-    for (int c = 0; c < ch; ++c) {
-      const double pap = dot(p, ap, c);
-      if (!done[c] && pap > 0) alpha[c] = rz[c] / pap;
-    }
-    for (size_t k = 0; k < n; ++k) {
-      x[k] += alpha[k % ch] * p[k];
-      r[k] -= alpha[k % ch] * ap[k];
-      z[k] = inv_diag[k / ch] * r[k];
-    }
-    std::vector<double> beta(ch, 0.0);
-    all_done = true;
-    for (int c = 0; c < ch; ++c) {
-      const double rz_new = dot(r, z, c);
-      beta[c] = rz[c] > 0 ? rz_new / rz[c] : 0.0;
-      rz[c] = rz_new;
-      if (!done[c]) done[c] = converged(c);
-      all_done = all_done && done[c];
-    }
-    for (size_t k = 0; k < n; ++k) p[k] = z[k] + beta[k % ch] * p[k];
-  }
-  double worst = 0;
-  for (int c = 0; c < ch; ++c)
-    if (rhs_norm[c] > 0) worst = std::max(worst, std::sqrt(dot(r, r, c)) / rhs_norm[c]);
-  for (size_t k = 0; k < n; ++k)
-    if (!std::isfinite(x[k])) throw Failure("FitBell: non-finite coefficient (bad input data?)");
-  if (report) {
-    report->iterations = it;
-    report->relative_residual = worst;
-  }
-  return x;
 }
 
 }  // namespace lumislab

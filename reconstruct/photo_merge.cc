@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
 #include "core/exr_io.h"
@@ -104,8 +105,84 @@ void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int hei
           std::to_string(p.pixels.cols) + "x" + std::to_string(p.pixels.rows));
 }
 
+namespace {
+
+// Box average over factor x factor pixel blocks (exact: integer factor, cropped to a multiple).
+cv::Mat Downsample(const cv::Mat& image, int factor) {
+  if (factor == 1) return image;
+  const int w = image.cols / factor, h = image.rows / factor;
+  cv::Mat out;
+  cv::resize(image(cv::Rect(0, 0, w * factor, h * factor)), out, cv::Size(w, h), 0, 0,
+             cv::INTER_AREA);
+  return out;
+}
+
+// Any value at or above the saturation level (or not a number) anywhere in the photo.
+bool AnySaturated(const DecodedPhoto& p, double saturation_level) {
+  const cv::Mat flat = p.pixels.reshape(1);
+  double threshold = saturation_level;
+  if (p.pixels.depth() == CV_16U) threshold = std::ceil(saturation_level * 65535 - 1e-9);
+  if (p.pixels.depth() == CV_8U) return true;  // sRGB 8-bit: the general path
+  if (p.pixels.depth() == CV_32F && !cv::checkRange(flat)) return true;  // NaN or Inf
+  double max_value = 0;
+  cv::minMaxLoc(flat, nullptr, &max_value);
+  return max_value >= threshold;
+}
+
+// gain_p * P - gain_n * N for two 3-channel images of the same type, RGB output.
+template <typename T>
+void Difference(const cv::Mat& plus, bool plus_rgb, double gain_p, const cv::Mat& minus,
+                bool minus_rgb, double gain_n, cv::Mat& out) {
+  out.create(plus.rows, plus.cols, CV_32FC3);
+  const float gp = float(gain_p), gn = float(gain_n);
+  const int pr = plus_rgb ? 0 : 2, nr = minus_rgb ? 0 : 2;
+  cv::parallel_for_(cv::Range(0, plus.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const T* p = plus.ptr<T>(y);
+      const T* n = minus.ptr<T>(y);
+      float* o = out.ptr<float>(y);
+      for (int x = 0; x < plus.cols; ++x, p += 3, n += 3, o += 3) {
+        o[0] = gp * float(p[pr]) - gn * float(n[nr]);
+        o[1] = gp * float(p[1]) - gn * float(n[1]);
+        o[2] = gp * float(p[2 - pr]) - gn * float(n[2 - nr]);
+      }
+    }
+  });
+}
+
+}  // namespace
+
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double saturation_level,
-                             double gain) {
+                             double gain, int downsample) {
+  LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
+  // Fast path: one photo per slide, same 16-bit or float 3-channel type, nothing saturated.
+  // Averaging is linear, so averaging first and merging after gives the same numbers.
+  if (photos.size() == 2 && photos[0].entry.positive != photos[1].entry.positive) {
+    const DecodedPhoto& p = photos[0].entry.positive ? photos[0] : photos[1];
+    const DecodedPhoto& n = photos[0].entry.positive ? photos[1] : photos[0];
+    const int type = p.pixels.type();
+    if (type == n.pixels.type() && (type == CV_16UC3 || type == CV_32FC3) &&
+        !AnySaturated(p, saturation_level) && !AnySaturated(n, saturation_level)) {
+      MergedPosition out;
+      out.fast_path = true;
+      const double unit = type == CV_16UC3 ? 1.0 / 65535 : 1.0;
+      const cv::Mat lp = Downsample(p.pixels, downsample), ln = Downsample(n.pixels, downsample);
+      if (type == CV_16UC3)
+        Difference<uint16_t>(lp, p.rgb_order, gain * unit / p.entry.exposure, ln, n.rgb_order,
+                             gain * unit / n.entry.exposure, out.signal);
+      else
+        Difference<float>(lp, p.rgb_order, gain / p.entry.exposure, ln, n.rgb_order,
+                          gain / n.entry.exposure, out.signal);
+      return out;
+    }
+  }
+  MergedPosition out = MergeFullResolution(photos, saturation_level, gain);
+  out.signal = Downsample(out.signal, downsample);
+  return out;
+}
+
+MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double saturation_level,
+                                   double gain) {
   LUMISLAB_CHECK(!photos.empty(), "MergePosition: no photos");
   const int w = photos[0].pixels.cols, h = photos[0].pixels.rows;
   std::vector<LinearReader> readers;

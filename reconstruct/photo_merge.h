@@ -27,12 +27,20 @@ void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int hei
                      const std::string& calibration_file);
 
 struct MergedPosition {
-  cv::Mat signal;            // CV_32FC4: R, G, B = gain * (E+ - E-); A = 1 where saturated
+  // R, G, B = gain * (E+ - E-) at the photo pixels box-averaged `downsample` x `downsample`
+  // (exact INTER_AREA on the top-left multiple of the factor). CV_32FC3 when no pixel is
+  // saturated; otherwise CV_32FC4 with A > 0 wherever a saturated pixel contributed.
+  cv::Mat signal;
   int saturated_pixels = 0;  // pixels with a channel saturated in every exposure of a slide
+  bool fast_path = false;    // one exposure per slide, nothing saturated: merged after averaging
 };
 
 // gain = filter peak * radiometric scale. Needs at least one photo of each slide.
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double saturation_level,
-                             double gain);
+                             double gain, int downsample = 1);
+// The general path (brackets, saturation, 8-bit sRGB), per pixel at full resolution; the
+// signal is CV_32FC4 with A = 1 where saturated.
+MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double saturation_level,
+                                   double gain);
 
 }  // namespace lumislab

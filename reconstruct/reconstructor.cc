@@ -50,17 +50,26 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   PositionReport& r = report ? *report : local;
   r.i = i, r.j = j;
   auto t0 = std::chrono::steady_clock::now();
-  // 1. Linear, merged, E = peak * scale * (E+ - E-) in photo space, saturation flagged.
-  const double gain = dataset.filter.peak * dataset.radiometric_scale.value_or(1.0);
-  const MergedPosition merged = MergePosition(photos, dataset.saturation_level, gain);
-  r.saturated_pixels = merged.saturated_pixels;
-  // 2. Into the luminaire frame, area-averaged per texel.
+  // 1. Geometry: where each texel's samples fall in the photo (and how much to pre-average).
   const SlabLayout& layout = info.layout;
   const RectifyMap map =
       BuildRectifyMap(calibration, layout, dataset.grid.Centre(i, j), dataset.screen_w_mm,
                       dataset.screen_h_mm, options.samples_per_texel);
   r.samples_per_texel = map.samples_per_texel;
+  r.downsample = map.downsample;
+  r.map_s = SecondsSince(t0);
+  auto t1 = std::chrono::steady_clock::now();
+  // 2. Linear, merged, E = peak * scale * (E+ - E-) in photo space, saturation flagged.
+  const double gain = dataset.filter.peak * dataset.radiometric_scale.value_or(1.0);
+  const MergedPosition merged =
+      MergePosition(photos, dataset.saturation_level, gain, map.downsample);
+  r.saturated_pixels = merged.saturated_pixels;
+  r.merge_s = SecondsSince(t1);
+  t1 = std::chrono::steady_clock::now();
+  // 3. Into the luminaire frame, area-averaged per texel.
   const cv::Mat texels = Rectify(merged.signal, map);
+  const int tc = texels.channels();
+  r.remap_s = SecondsSince(t1);
   const size_t n = size_t(layout.res_x) * layout.res_y;
   std::vector<unsigned char> seen(n, 0);
   std::vector<double> data(n * 3, 0.0);
@@ -68,10 +77,10 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   r.saturated_texels = 0;
   for (int row = 0; row < layout.res_y; ++row) {
     const float* t = texels.ptr<float>(row);
-    for (int col = 0; col < layout.res_x; ++col, t += 4) {
+    for (int col = 0; col < layout.res_x; ++col, t += tc) {
       const size_t k = size_t(row) * layout.res_x + col;
       if (!map.inside[k]) continue;
-      if (t[3] > 0) {
+      if (tc == 4 && t[3] > 0) {
         ++r.saturated_texels;
         continue;
       }

@@ -25,10 +25,13 @@ struct PositionReport {
   int saturated_texels = 0;  // texels dropped because a sample touched a saturated pixel
   int seen_texels = 0;
   int samples_per_texel = 0;
+  int downsample = 1;  // photo box-averaged F x F before the remap
   int fit_iterations = 0;
   double fit_residual = 0;
   // Seconds per stage.
   double decode_s = 0, rectify_s = 0, fit_s = 0, write_s = 0;
+  // rectify_s split: building the map, merging the photos, remap + area average.
+  double map_s = 0, merge_s = 0, remap_s = 0;
 };
 
 // Photos of (i, j), decoded (both slides, all exposures); checks that both slides exist and

@@ -37,63 +37,77 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
         corner[size_t(cy) * nx + cx] = px.cast<float>();
       }
   });
-  const float max_x = float(calibration.image_width - 1),
-              max_y = float(calibration.image_height - 1);
+  float max_x = float(calibration.image_width - 1), max_y = float(calibration.image_height - 1);
   auto in_photo = [&](const Eigen::Vector2f& p) {
     return p.x() >= 0 && p.y() >= 0 && p.x() <= max_x && p.y() <= max_y;  // false for NaN
   };
   // Texel extent in pixels, over texels whose corners are in the photo.
-  double max_px = 0;
+  std::vector<float> extents;
   for (int cy = 0; cy + 1 < ny; ++cy)
     for (int cx = 0; cx + 1 < nx; ++cx) {
       const Eigen::Vector2f& p00 = corner[size_t(cy) * nx + cx];
       const Eigen::Vector2f& p10 = corner[size_t(cy) * nx + cx + 1];
       const Eigen::Vector2f& p01 = corner[size_t(cy + 1) * nx + cx];
       if (!in_photo(p00) || !in_photo(p10) || !in_photo(p01)) continue;
-      max_px = std::max({max_px, double((p10 - p00).norm()), double((p01 - p00).norm())});
+      extents.push_back((p10 - p00).norm());
+      extents.push_back((p01 - p00).norm());
     }
-  m.max_texel_px = max_px;
-  const int k = samples_per_texel > 0 ? samples_per_texel
-                                      : std::clamp(int(std::ceil(max_px)), 2, kMaxSamplesPerTexel);
+  double median_px = 1;
+  if (!extents.empty()) {
+    m.max_texel_px = *std::max_element(extents.begin(), extents.end());
+    m.min_texel_px = *std::min_element(extents.begin(), extents.end());
+    std::nth_element(extents.begin(), extents.begin() + extents.size() / 2, extents.end());
+    median_px = extents[extents.size() / 2];
+  }
+  const int f = samples_per_texel > 0 ? 1 : std::max(1, int(std::lround(median_px / 3)));
+  const int k = samples_per_texel > 0
+                    ? samples_per_texel
+                    : std::clamp(int(std::ceil(m.max_texel_px / f)), 2, kMaxSamplesPerTexel);
   m.samples_per_texel = k;
-  m.map_x.create(m.res_y * k, m.res_x * k, CV_32FC1);
-  m.map_y.create(m.res_y * k, m.res_x * k, CV_32FC1);
+  m.downsample = f;
+  // Pixel p of the photo is at (p - (F - 1) / 2) / F in the F x F averaged image, whose size is
+  // floor(size / F).
+  if (f > 1) {
+    const float shift = 0.5f * (f - 1), scale = 1.0f / f;
+    for (auto& p : corner) p = (p.array() - shift) * scale;
+    max_x = float(calibration.image_width / f - 1);
+    max_y = float(calibration.image_height / f - 1);
+  }
+  // Seen geometrically: all four corners inside the photo (the samples interpolate them, so
+  // they are inside too) and the texel's lab rectangle on the physical screen.
   m.inside.assign(size_t(m.res_x) * m.res_y, 0);
-  const double half_w = 0.5 * screen_w_mm, half_h = 0.5 * screen_h_mm;
-  cv::parallel_for_(cv::Range(0, m.res_y), [&](const cv::Range& rows) {
-    for (int row = rows.start; row < rows.end; ++row)
-      for (int col = 0; col < m.res_x; ++col) {
-        const Eigen::Vector2f& p00 = corner[size_t(row) * nx + col];
-        const Eigen::Vector2f& p10 = corner[size_t(row) * nx + col + 1];
-        const Eigen::Vector2f& p01 = corner[size_t(row + 1) * nx + col];
-        const Eigen::Vector2f& p11 = corner[size_t(row + 1) * nx + col + 1];
-        bool all_inside = true;
-        for (int b = 0; b < k; ++b) {
-          const float fy = (b + 0.5f) / k;
-          float* mx = m.map_x.ptr<float>(row * k + b) + size_t(col) * k;
-          float* my = m.map_y.ptr<float>(row * k + b) + size_t(col) * k;
-          for (int a = 0; a < k; ++a) {
-            const float fx = (a + 0.5f) / k;
-            const Eigen::Vector2f p =
-                (1 - fy) * ((1 - fx) * p00 + fx * p10) + fy * ((1 - fx) * p01 + fx * p11);
-            const Eigen::Vector2d lab = lab_of(col + fx, row + fy);
-            const bool ok =
-                in_photo(p) && std::abs(lab.x()) <= half_w && std::abs(lab.y()) <= half_h;
-            all_inside = all_inside && ok;
-            mx[a] = ok ? p.x() : -10.f;  // outside: remap reads the constant border (0)
-            my[a] = ok ? p.y() : -10.f;
-          }
-        }
-        m.inside[size_t(row) * m.res_x + col] = all_inside ? 1 : 0;
-      }
-  });
+  const double half_w = 0.5 * screen_w_mm + 1e-9, half_h = 0.5 * screen_h_mm + 1e-9;
+  for (int row = 0; row < m.res_y; ++row)
+    for (int col = 0; col < m.res_x; ++col) {
+      const Eigen::Vector2d lo = lab_of(col, row + 1), hi = lab_of(col + 1, row);
+      const bool on_screen =
+          lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h;
+      const bool in = in_photo(corner[size_t(row) * nx + col]) &&
+                      in_photo(corner[size_t(row) * nx + col + 1]) &&
+                      in_photo(corner[size_t(row + 1) * nx + col]) &&
+                      in_photo(corner[size_t(row + 1) * nx + col + 1]);
+      m.inside[size_t(row) * m.res_x + col] = (on_screen && in) ? 1 : 0;
+    }
+  // Sample (a, b) of texel (col, row) is at corner coordinates (col + (a + 0.5) / K, ...): the
+  // sample map is the corner map resampled bilinearly by one affine warp.
+  cv::Mat corners(ny, nx, CV_32FC2);
+  for (int cy = 0; cy < ny; ++cy)
+    for (int cx = 0; cx < nx; ++cx) {
+      const Eigen::Vector2f& p = corner[size_t(cy) * nx + cx];
+      const bool finite = std::isfinite(p.x()) && std::isfinite(p.y());
+      corners.at<cv::Vec2f>(cy, cx) = finite ? cv::Vec2f(p.x(), p.y()) : cv::Vec2f(-10.f, -10.f);
+    }
+  const cv::Matx23d sample_to_corner(1.0 / k, 0, 0.5 / k, 0, 1.0 / k, 0.5 / k);
+  cv::warpAffine(corners, m.map, sample_to_corner, cv::Size(m.res_x * k, m.res_y * k),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
   return m;
 }
 
 cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
-  LUMISLAB_CHECK(signal.type() == CV_32FC4, "Rectify: expects a CV_32FC4 image");
+  LUMISLAB_CHECK(signal.type() == CV_32FC4 || signal.type() == CV_32FC3,
+                 "Rectify: expects a CV_32FC3/4 image");
   cv::Mat samples, texels;
-  cv::remap(signal, samples, map.map_x, map.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+  cv::remap(signal, samples, map.map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));
   if (map.samples_per_texel == 1) return samples;
   cv::resize(samples, texels, cv::Size(map.res_x, map.res_y), 0, 0, cv::INTER_AREA);

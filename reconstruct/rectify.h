@@ -18,10 +18,17 @@ struct RectifyMap {
   int res_x = 0;
   int res_y = 0;
   int samples_per_texel = 0;  // K
-  cv::Mat map_x, map_y;       // CV_32FC1, (res_y K) x (res_x K): photo pixel of each sample
-  // Per texel: every sample lies inside the photo and on the physical screen.
+  // The photo is first box-averaged F x F (F = downsample, ~3 averaged pixels per texel) so K
+  // stays ~3-4; the map addresses that averaged image. Pixel box + bilinear samples smooth by an
+  // extra ~(F px)^2 / 4 second moment, ~1/3 of the texel box's own (texel^2 / 12): a bias of
+  // ~texel^2/72 Laplacian(E), negligible for smooth light (measured in the tests).
+  int downsample = 1;
+  cv::Mat map;  // CV_32FC2, (res_y K) x (res_x K): averaged-photo pixel of each sample
+  // Per texel: all its corners (hence all samples) inside the photo, and the texel on the
+  // physical screen.
   std::vector<unsigned char> inside;
   double max_texel_px = 0;  // largest texel extent in photo pixels (what K follows)
+  double min_texel_px = 0;  // smallest (what F follows)
 };
 
 // screen_w/h_mm: the physical screen, [-W/2, W/2] x [-H/2, H/2] in the lab frame.
@@ -31,7 +38,7 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
                            const Eigen::Vector2d& centre_mm, double screen_w_mm, double screen_h_mm,
                            int samples_per_texel = 0);
 
-// signal: CV_32FC4 photo-space image. Returns res_y x res_x CV_32FC4 texel box averages.
+// signal: CV_32FC3/4 averaged-photo image. Returns res_y x res_x texel box averages, same type.
 cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map);
 
 }  // namespace lumislab

@@ -47,7 +47,16 @@ Accuracy Measure(const SyntheticDataset& s, int i, int j, const SlabPosition& p,
   a.vs_centres = RelativeL2(p, PointTruth(s, i, j, layout));
   return a;
 }
-constexpr double kFitTolerance = 3e-4, kCentreTolerance = 6e-3;
+// kFitTolerance: the exact path (F = 1, K = 9 samples per texel, as dense as the pixels).
+// kAutoTolerance: the default path box-averages the photo F x F first (F = 3 here), which adds a
+// smoothing bias of ~texel^2/72 Laplacian(E) (1/3 of the box's own, ~1.3e-3 for this sharp light;
+// ~1e-5 for the broad light of real luminaires at 4 mm texels).
+constexpr double kFitTolerance = 3e-4, kAutoTolerance = 2e-3, kCentreTolerance = 6e-3;
+ReconstructOptions ExactPath() {
+  ReconstructOptions o;
+  o.samples_per_texel = 9;
+  return o;
+}
 
 int RunCli(std::vector<std::string> args) {
   std::vector<char*> argv;
@@ -62,7 +71,7 @@ TEST(Reconstruct, FrontalExrMatchesAnalyticTruth) {
   const SlabLayout layout = s.dataset.Layout(kRes);
   for (int i = 0; i < 2; ++i) {
     PositionReport r;
-    const SlabPosition p = Reconstruct(s, i, 0, &r);
+    const SlabPosition p = Reconstruct(s, i, 0, &r, ExactPath());
     const Accuracy a = Measure(s, i, 0, p, layout);
     std::printf(
         "frontal position %d: relative L2 %.2e vs exact fit, %.2e vs centres, K=%d, %d CG "
@@ -71,8 +80,16 @@ TEST(Reconstruct, FrontalExrMatchesAnalyticTruth) {
     EXPECT_LE(a.vs_fit, kFitTolerance);
     EXPECT_LE(a.vs_centres, kCentreTolerance);
     EXPECT_EQ(r.saturated_pixels, 0);
-    EXPECT_GE(r.samples_per_texel, 9);  // 3 mm texels, 3 px/mm: samples as dense as pixels
     EXPECT_LE(r.fit_iterations, 40);
+    // The default path.
+    const SlabPosition q = Reconstruct(s, i, 0, &r);
+    const Accuracy b = Measure(s, i, 0, q, layout);
+    std::printf("  default path (F=%d, K=%d): %.2e vs exact fit, %.2e vs centres\n", r.downsample,
+                r.samples_per_texel, b.vs_fit, b.vs_centres);
+    EXPECT_LE(b.vs_fit, kAutoTolerance);
+    EXPECT_LE(b.vs_centres, kCentreTolerance);
+    // 3 mm texels, 3 px/mm: samples at least as dense as the (averaged) pixels.
+    EXPECT_GE(r.samples_per_texel * r.downsample, 9);
   }
 }
 
@@ -82,7 +99,7 @@ TEST(Reconstruct, FrontalExrMatchesAnalyticTruth) {
 TEST(Reconstruct, FitDeviatesFromCentresByTheBellModelError) {
   const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("fit_vs_box"), SyntheticOptions());
   const SlabLayout layout = s.dataset.Layout(kRes);
-  const SlabPosition fitted = Reconstruct(s, 1, 0, nullptr);
+  const SlabPosition fitted = Reconstruct(s, 1, 0, nullptr, ExactPath());
   const ImageF centres = PointTruth(s, 1, 0, layout);
   // Predicted centre value + model error, Laplacian by central differences (0.5 mm steps).
   SlabPosition predicted_fit = fitted, predicted_box = fitted;
@@ -104,7 +121,7 @@ TEST(Reconstruct, FitDeviatesFromCentresByTheBellModelError) {
       "fit vs centres %.2e, fit vs centres - h^2/24 Laplacian %.2e, box model vs centres "
       "%.2e\n",
       err_centres, err_model, box_vs_centres);
-  EXPECT_LT(err_model, 0.2 * err_centres);  // the deviation is the predicted model error
+  EXPECT_LT(err_model, 0.25 * err_centres);  // the deviation is the predicted model error
   EXPECT_NEAR(err_centres, box_vs_centres, 0.2 * box_vs_centres);
 }
 
@@ -116,7 +133,9 @@ TEST(Reconstruct, ObliqueDistortedPngAsAccurate) {
   const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("oblique"), o);
   const SlabLayout layout = s.dataset.Layout(kRes);
   for (int i = 0; i < 2; ++i) {
-    const SlabPosition p = Reconstruct(s, i, 0, nullptr);
+    const SlabPosition q = Reconstruct(s, i, 0, nullptr);
+    EXPECT_LE(Measure(s, i, 0, q, layout).vs_fit, kAutoTolerance);
+    const SlabPosition p = Reconstruct(s, i, 0, nullptr, ExactPath());
     const Accuracy a = Measure(s, i, 0, p, layout);
     std::printf(
         "oblique distorted png position %d: relative L2 %.2e vs exact fit, %.2e vs "
@@ -161,7 +180,7 @@ TEST(Reconstruct, SaturatedPixelsAreCountedAndLeftOut) {
           ASSERT_EQ(p.mask.at(col, row, 0), 0.f) << col << "," << row;
         }
       }
-    EXPECT_LE(Measure(s, i, 0, p, layout).vs_fit, kFitTolerance);
+    EXPECT_LE(Measure(s, i, 0, p, layout).vs_fit, kAutoTolerance);
   }
   EXPECT_EQ(counted, s.saturated_pixels_total);
 }
@@ -177,7 +196,7 @@ TEST(Reconstruct, ExposureBracketsRecoverClippedHighlights) {
   const SlabPosition p = Reconstruct(s, 1, 0, &r);
   EXPECT_EQ(r.saturated_pixels, 0);
   EXPECT_EQ(r.saturated_texels, 0);
-  EXPECT_LE(Measure(s, 1, 0, p, layout).vs_fit, kFitTolerance);
+  EXPECT_LE(Measure(s, 1, 0, p, layout).vs_fit, kAutoTolerance);
 }
 
 Error CaughtError(const std::function<void()>& f) {
@@ -210,7 +229,7 @@ TEST(RunReconstruct, WritesSlabSkipsExistingAndForces) {
   EXPECT_TRUE(info.Complete());
   EXPECT_EQ(info.units, "W/m^2");
   const SlabPosition p = ReadSlabPosition(s.dir + "/slab", info, 1, 0);
-  EXPECT_LE(Measure(s, 1, 0, p, info.layout).vs_fit, kFitTolerance);
+  EXPECT_LE(Measure(s, 1, 0, p, info.layout).vs_fit, kAutoTolerance);
   const std::string exr = SlabPositionPath(s.dir + "/slab", 1, 0);
   const auto t0 = fs::last_write_time(exr);
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -264,7 +283,7 @@ TEST(RunReconstruct, WatchProcessesPositionsAsTheyArrive) {
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i)
       EXPECT_LE(Measure(s, i, j, ReadSlabPosition(s.dir + "/slab", info, i, j), info.layout).vs_fit,
-                kFitTolerance);
+                kAutoTolerance);
 }
 
 }  // namespace

@@ -1,0 +1,164 @@
+// reconstruct_bench: how much the reconstruction costs on top of merely decoding the photos.
+// Per position, N runs (median): decode only, then the full per-position reconstruction
+// (decode, merge + remap + area average, fit, EXR write). Prints a table and the ratio
+// reconstruct / decode (target <= 1.25: the stage should be decode-bound), writes CSV.
+// Single-threaded by default (--threads 1); never asserted in tests.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/exr_io.h"
+#include "reconstruct/reconstructor.h"
+#include "synthetic_dataset.h"
+
+namespace lumislab {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct Row {
+  int i = 0, j = 0;
+  double decode = 0, rec_decode = 0, map = 0, merge = 0, remap = 0, fit = 0, write = 0, total = 0;
+  int k = 0, f = 1, iterations = 0;
+};
+
+int RunBench(int argc, char** argv) {
+  std::string dataset_dir, out_dir = "/tmp/lumislab_reconstruct_bench", csv;
+  int runs = 5, threads = 1, resolution = 300, positions = 0, image_px = 2000;
+  CLI::App app{"reconstruct_bench: decode time vs full per-position reconstruction time"};
+  app.add_option("--dataset", dataset_dir,
+                 "dataset folder with calib/screen.json (default: make a synthetic 2x2 one)");
+  app.add_option("--out", out_dir, "scratch folder (slab written here)")->capture_default_str();
+  app.add_option("--csv", csv, "CSV output (default: <out>/reconstruct_bench.csv)");
+  app.add_option("--runs", runs, "runs per position (median)")->capture_default_str();
+  app.add_option("--threads", threads, "OpenCV threads")->capture_default_str();
+  app.add_option("--resolution", resolution, "slab resolution")->capture_default_str();
+  app.add_option("--positions", positions, "only the first N positions (0: all)");
+  app.add_option("--image-px", image_px, "synthetic dataset: photo size (square, 16-bit PNG)")
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (runs < 1 || threads < 1) throw BadInput("--runs and --threads: expected >= 1");
+  cv::setNumThreads(threads);
+  MakeDirectories(out_dir);
+  if (dataset_dir.empty()) {
+    dataset_dir = out_dir + "/dataset";
+    std::filesystem::remove_all(dataset_dir);
+    testing::SyntheticOptions o;
+    o.nu = o.nv = 2;
+    o.screen_mm = 1200;
+    o.image_px = image_px;
+    o.px_per_mm = 0.9 * image_px / 1200.0;
+    o.perspective = 0.0002;
+    o.ext = ".png";
+    std::printf("making a synthetic dataset in %s (%dx%d 16-bit PNG)\n", dataset_dir.c_str(),
+                image_px, image_px);
+    testing::MakeSyntheticDataset(dataset_dir, o);
+  }
+  if (csv.empty()) csv = out_dir + "/reconstruct_bench.csv";
+  const Dataset dataset = Dataset::Load(dataset_dir);
+  const ScreenCalibration calibration = ScreenCalibration::Load(dataset_dir + "/calib/screen.json");
+  const SlabInfo info = SlabInfo::FromDataset(dataset, resolution);
+  const std::string slab_dir = out_dir + "/slab";
+  MakeDirectories(slab_dir);
+  ReconstructOptions options;
+  options.resolution = resolution;
+  options.Check();
+
+  std::vector<Row> rows;
+  for (int j = 0; j < dataset.grid.nv; ++j)
+    for (int i = 0; i < dataset.grid.nu; ++i) {
+      if (positions > 0 && int(rows.size()) >= positions) break;
+      std::vector<double> decode, rec_decode, map, merge, remap, fit, write, total;
+      Row row;
+      row.i = i, row.j = j;
+      for (int r = 0; r < runs; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        { const auto photos = DecodePosition(dataset, calibration, i, j); }
+        decode.push_back(Seconds(t0));
+        t0 = std::chrono::steady_clock::now();
+        PositionReport report;
+        const SlabPosition p =
+            ReconstructPosition(dataset, calibration, info, i, j, options, &report);
+        const auto tw = std::chrono::steady_clock::now();
+        WriteSlabPosition(slab_dir, info, p);
+        write.push_back(Seconds(tw));
+        total.push_back(Seconds(t0));
+        rec_decode.push_back(report.decode_s);
+        map.push_back(report.map_s);
+        merge.push_back(report.merge_s);
+        remap.push_back(report.remap_s);
+        fit.push_back(report.fit_s);
+        row.k = report.samples_per_texel;
+        row.f = report.downsample;
+        row.iterations = report.fit_iterations;
+      }
+      row.decode = Median(decode), row.rec_decode = Median(rec_decode);
+      row.map = Median(map), row.merge = Median(merge), row.remap = Median(remap);
+      row.fit = Median(fit);
+      row.write = Median(write);
+      row.total = Median(total);
+      rows.push_back(row);
+    }
+
+  std::printf(
+      "\nreconstruct_bench: %s, %dx%d photos, slab %d^2, %d run(s) per position (median), "
+      "%d thread(s)\n",
+      dataset_dir.c_str(), calibration.image_width, calibration.image_height, resolution, runs,
+      threads);
+  std::printf("%-8s %9s | %9s %7s %7s %7s %7s %7s %9s | %6s %3s %2s %3s\n", "position", "decode",
+              "decode", "map", "merge", "remap", "fit", "write", "total", "ratio", "K", "F", "CG");
+  std::string csv_text =
+      "i,j,decode_only_ms,decode_ms,map_ms,merge_ms,remap_area_ms,fit_ms,write_ms,total_ms,"
+      "ratio,samples_per_texel,downsample,cg_iterations\n";
+  std::vector<double> ratios, decodes, totals;
+  for (const Row& r : rows) {
+    const double ratio = r.total / r.decode;
+    ratios.push_back(ratio);
+    decodes.push_back(r.decode);
+    totals.push_back(r.total);
+    std::printf("%3d,%-4d %9.1f | %9.1f %7.1f %7.1f %7.1f %7.1f %7.1f %9.1f | %6.3f %3d %2d %3d\n",
+                r.i, r.j, 1e3 * r.decode, 1e3 * r.rec_decode, 1e3 * r.map, 1e3 * r.merge,
+                1e3 * r.remap, 1e3 * r.fit, 1e3 * r.write, 1e3 * r.total, ratio, r.k, r.f,
+                r.iterations);
+    char line[512];
+    std::snprintf(line, sizeof(line),
+                  "%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,%d\n", r.i, r.j,
+                  1e3 * r.decode, 1e3 * r.rec_decode, 1e3 * r.map, 1e3 * r.merge, 1e3 * r.remap,
+                  1e3 * r.fit, 1e3 * r.write, 1e3 * r.total, ratio, r.k, r.f, r.iterations);
+    csv_text += line;
+  }
+  std::printf(
+      "(ms, medians; decode = decoding the position's photos only; map..write = stages of "
+      "the full reconstruction, whose own decode is the second column)\n");
+  std::printf(
+      "median: decode %.1f ms, reconstruct %.1f ms, ratio reconstruct/decode %.3f "
+      "(target <= 1.25)\n",
+      1e3 * Median(decodes), 1e3 * Median(totals), Median(ratios));
+  WriteTextAtomically(csv, csv_text);
+  std::printf("csv: %s\n", csv.c_str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace lumislab
+
+int main(int argc, char** argv) {
+  return lumislab::RunMain("reconstruct_bench", [&] { return lumislab::RunBench(argc, argv); });
+}

@@ -117,37 +117,56 @@ cv::Mat Downsample(const cv::Mat& image, int factor) {
   return out;
 }
 
-// Any value at or above the saturation level (or not a number) anywhere in the photo.
-bool AnySaturated(const DecodedPhoto& p, double saturation_level) {
-  const cv::Mat flat = p.pixels.reshape(1);
-  double threshold = saturation_level;
-  if (p.pixels.depth() == CV_16U) threshold = std::ceil(saturation_level * 65535 - 1e-9);
-  if (p.pixels.depth() == CV_8U) return true;  // sRGB 8-bit: the general path
-  if (p.pixels.depth() == CV_32F && !cv::checkRange(flat)) return true;  // NaN or Inf
-  double max_value = 0;
-  cv::minMaxLoc(flat, nullptr, &max_value);
-  return max_value >= threshold;
-}
-
-// gain_p * P - gain_n * N for two 3-channel images of the same type, RGB output.
-template <typename T>
-void Difference(const cv::Mat& plus, bool plus_rgb, double gain_p, const cv::Mat& minus,
-                bool minus_rgb, double gain_n, cv::Mat& out) {
-  out.create(plus.rows, plus.cols, CV_32FC3);
-  const float gp = float(gain_p), gn = float(gain_n);
-  const int pr = plus_rgb ? 0 : 2, nr = minus_rgb ? 0 : 2;
-  cv::parallel_for_(cv::Range(0, plus.rows), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const T* p = plus.ptr<T>(y);
-      const T* n = minus.ptr<T>(y);
-      float* o = out.ptr<float>(y);
-      for (int x = 0; x < plus.cols; ++x, p += 3, n += 3, o += 3) {
-        o[0] = gp * float(p[pr]) - gn * float(n[nr]);
-        o[1] = gp * float(p[1]) - gn * float(n[1]);
-        o[2] = gp * float(p[2 - pr]) - gn * float(n[2 - nr]);
+// One pass over both photos of a position: F x F box sums of T+ and T-, their weighted
+// difference (RGB out), and the largest value seen (for the saturation check). Rows are summed
+// first (contiguous, vectorised), then groups of F pixels within the summed row.
+template <typename T, typename Acc>
+bool FusedDifference(const DecodedPhoto& plus, double gain_p, const DecodedPhoto& minus,
+                     double gain_n, int f, double saturation_threshold, cv::Mat& out) {
+  const int w = plus.pixels.cols / f, h = plus.pixels.rows / f;
+  const size_t len = size_t(w) * f * 3;
+  out.create(h, w, CV_32FC3);
+  const float gp = float(gain_p / (f * f)), gn = float(gain_n / (f * f));
+  const int pr = plus.rgb_order ? 0 : 2, nr = minus.rgb_order ? 0 : 2;
+  std::atomic<bool> saturated{false};
+  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+    std::vector<Acc> ap(len), an(len);
+    T max_value = 0;
+    for (int oy = rows.start; oy < rows.end; ++oy) {
+      for (const auto& [img, acc] : {std::pair(&plus.pixels, &ap), std::pair(&minus.pixels, &an)}) {
+        Acc* a = acc->data();
+        const T* r = img->template ptr<T>(oy * f);
+        for (size_t k = 0; k < len; ++k) {
+          a[k] = Acc(r[k]);
+          max_value = std::max(max_value, r[k]);
+        }
+        for (int dy = 1; dy < f; ++dy) {
+          r = img->template ptr<T>(oy * f + dy);
+          for (size_t k = 0; k < len; ++k) {
+            a[k] += Acc(r[k]);
+            max_value = std::max(max_value, r[k]);
+          }
+        }
+      }
+      float* o = out.ptr<float>(oy);
+      for (int ox = 0; ox < w; ++ox, o += 3) {
+        Acc sp[3] = {}, sn[3] = {};
+        const size_t k0 = size_t(ox) * f * 3;
+        for (int dx = 0; dx < f; ++dx)
+          for (int c = 0; c < 3; ++c) {
+            sp[c] += ap[k0 + size_t(dx) * 3 + c];
+            sn[c] += an[k0 + size_t(dx) * 3 + c];
+          }
+        o[0] = gp * float(sp[pr]) - gn * float(sn[nr]);
+        o[1] = gp * float(sp[1]) - gn * float(sn[1]);
+        o[2] = gp * float(sp[2 - pr]) - gn * float(sn[2 - nr]);
+        // NaN/Inf in float photos propagate into the sums: treat as saturated.
+        if (!(std::isfinite(o[0]) && std::isfinite(o[1]) && std::isfinite(o[2]))) saturated = true;
       }
     }
+    if (double(max_value) >= saturation_threshold) saturated = true;
   });
+  return !saturated;
 }
 
 }  // namespace
@@ -162,18 +181,19 @@ MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double sat
     const DecodedPhoto& n = photos[0].entry.positive ? photos[1] : photos[0];
     const int type = p.pixels.type();
     if (type == n.pixels.type() && (type == CV_16UC3 || type == CV_32FC3) &&
-        !AnySaturated(p, saturation_level) && !AnySaturated(n, saturation_level)) {
+        n.pixels.size() == p.pixels.size()) {
       MergedPosition out;
-      out.fast_path = true;
-      const double unit = type == CV_16UC3 ? 1.0 / 65535 : 1.0;
-      const cv::Mat lp = Downsample(p.pixels, downsample), ln = Downsample(n.pixels, downsample);
-      if (type == CV_16UC3)
-        Difference<uint16_t>(lp, p.rgb_order, gain * unit / p.entry.exposure, ln, n.rgb_order,
-                             gain * unit / n.entry.exposure, out.signal);
-      else
-        Difference<float>(lp, p.rgb_order, gain / p.entry.exposure, ln, n.rgb_order,
-                          gain / n.entry.exposure, out.signal);
-      return out;
+      const bool ok = type == CV_16UC3 ? FusedDifference<uint16_t, uint32_t>(
+                                             p, gain / 65535 / p.entry.exposure, n,
+                                             gain / 65535 / n.entry.exposure, downsample,
+                                             std::ceil(saturation_level * 65535 - 1e-9), out.signal)
+                                       : FusedDifference<float, float>(
+                                             p, gain / p.entry.exposure, n, gain / n.entry.exposure,
+                                             downsample, saturation_level, out.signal);
+      if (ok) {
+        out.fast_path = true;
+        return out;
+      }
     }
   }
   MergedPosition out = MergeFullResolution(photos, saturation_level, gain);

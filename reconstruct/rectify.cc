@@ -88,18 +88,39 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
                       in_photo(corner[size_t(row + 1) * nx + col + 1]);
       m.inside[size_t(row) * m.res_x + col] = (on_screen && in) ? 1 : 0;
     }
-  // Sample (a, b) of texel (col, row) is at corner coordinates (col + (a + 0.5) / K, ...): the
-  // sample map is the corner map resampled bilinearly by one affine warp.
-  cv::Mat corners(ny, nx, CV_32FC2);
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) {
-      const Eigen::Vector2f& p = corner[size_t(cy) * nx + cx];
-      const bool finite = std::isfinite(p.x()) && std::isfinite(p.y());
-      corners.at<cv::Vec2f>(cy, cx) = finite ? cv::Vec2f(p.x(), p.y()) : cv::Vec2f(-10.f, -10.f);
-    }
-  const cv::Matx23d sample_to_corner(1.0 / k, 0, 0.5 / k, 0, 1.0 / k, 0.5 / k);
-  cv::warpAffine(corners, m.map, sample_to_corner, cv::Size(m.res_x * k, m.res_y * k),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  // Sample (a, b) of texel (col, row) interpolates the texel's corners bilinearly at
+  // ((a + 0.5) / K, (b + 0.5) / K). Written directly in OpenCV's fixed-point remap format
+  // (integer pixel + 1/32 fraction, what remap converts float maps to anyway).
+  constexpr int kBits = cv::INTER_BITS, kTab = cv::INTER_TAB_SIZE;
+  m.map_xy.create(m.res_y * k, m.res_x * k, CV_16SC2);
+  m.map_frac.create(m.res_y * k, m.res_x * k, CV_16UC1);
+  std::vector<float> fr(k);
+  for (int a = 0; a < k; ++a) fr[a] = (a + 0.5f) / k;
+  cv::parallel_for_(cv::Range(0, m.res_y), [&](const cv::Range& rows) {
+    for (int row = rows.start; row < rows.end; ++row)
+      for (int b = 0; b < k; ++b) {
+        const float fy = fr[b];
+        int16_t* xy = m.map_xy.ptr<int16_t>(row * k + b);
+        uint16_t* frac = m.map_frac.ptr<uint16_t>(row * k + b);
+        for (int col = 0; col < m.res_x; ++col) {
+          const Eigen::Vector2f& p00 = corner[size_t(row) * nx + col];
+          const Eigen::Vector2f& p10 = corner[size_t(row) * nx + col + 1];
+          const Eigen::Vector2f& p01 = corner[size_t(row + 1) * nx + col];
+          const Eigen::Vector2f& p11 = corner[size_t(row + 1) * nx + col + 1];
+          const Eigen::Vector2f left = p00 + fy * (p01 - p00), right = p10 + fy * (p11 - p10);
+          const bool ok = m.inside[size_t(row) * m.res_x + col] != 0;
+          for (int a = 0; a < k; ++a, xy += 2, ++frac) {
+            const Eigen::Vector2f p = left + fr[a] * (right - left);
+            // Unseen texels read the constant border; their values are never used.
+            const int ix = ok ? cvRound(p.x() * kTab) : -10 * kTab;
+            const int iy = ok ? cvRound(p.y() * kTab) : -10 * kTab;
+            xy[0] = int16_t(ix >> kBits);
+            xy[1] = int16_t(iy >> kBits);
+            frac[0] = uint16_t((iy & (kTab - 1)) * kTab + (ix & (kTab - 1)));
+          }
+        }
+      }
+  });
   return m;
 }
 
@@ -107,7 +128,7 @@ cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
   LUMISLAB_CHECK(signal.type() == CV_32FC4 || signal.type() == CV_32FC3,
                  "Rectify: expects a CV_32FC3/4 image");
   cv::Mat samples, texels;
-  cv::remap(signal, samples, map.map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+  cv::remap(signal, samples, map.map_xy, map.map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));
   if (map.samples_per_texel == 1) return samples;
   cv::resize(samples, texels, cv::Size(map.res_x, map.res_y), 0, 0, cv::INTER_AREA);

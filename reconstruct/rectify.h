@@ -23,7 +23,9 @@ struct RectifyMap {
   // extra ~(F px)^2 / 4 second moment, ~1/3 of the texel box's own (texel^2 / 12): a bias of
   // ~texel^2/72 Laplacian(E), negligible for smooth light (measured in the tests).
   int downsample = 1;
-  cv::Mat map;  // CV_32FC2, (res_y K) x (res_x K): averaged-photo pixel of each sample
+  // Averaged-photo pixel of each sample, (res_y K) x (res_x K), in OpenCV's fixed-point remap
+  // format: CV_16SC2 integer pixel + CV_16UC1 1/32-pixel fraction index.
+  cv::Mat map_xy, map_frac;
   // Per texel: all its corners (hence all samples) inside the photo, and the texel on the
   // physical screen.
   std::vector<unsigned char> inside;

@@ -199,6 +199,43 @@ TEST(Reconstruct, ExposureBracketsRecoverClippedHighlights) {
   EXPECT_LE(Measure(s, 1, 0, p, layout).vs_fit, kAutoTolerance);
 }
 
+// White noise of sigma per photo value: a texel averages N = (px per texel)^2 pixels of both
+// slides, E = gain (P - N) doubles the variance, and the deconvolution multiplies the standard
+// deviation by a / (a^2 - 4 b^2)^1.5 ~ 1.531 (a = 5/6, b = 1/12). The measured noise must stay
+// within 1.5x of that floor (and not be suspiciously below half of it).
+TEST(Reconstruct, NoiseWithinThePredictedFloor) {
+  SyntheticOptions o;
+  const SyntheticDataset clean = MakeSyntheticDataset(FreshTestDir("noise_clean"), o);
+  o.noise_sigma = 0.004;
+  const SyntheticDataset noisy = MakeSyntheticDataset(FreshTestDir("noise_noisy"), o);
+  const SlabLayout layout = clean.dataset.Layout(kRes);
+  const double gain = clean.dataset.filter.peak * *clean.dataset.radiometric_scale;
+  const double px_per_texel = o.px_per_mm * layout.TexelW();
+  const double a = 5.0 / 6, b = 1.0 / 12;
+  const double predicted =
+      gain * std::sqrt(2.0) * o.noise_sigma / px_per_texel * a / std::pow(a * a - 4 * b * b, 1.5);
+  for (const ReconstructOptions& options : {ReconstructOptions(), ExactPath()}) {
+    PositionReport r;
+    const SlabPosition c = Reconstruct(clean, 0, 0, nullptr, options);
+    const SlabPosition n = Reconstruct(noisy, 0, 0, &r, options);
+    double sum2 = 0;
+    int count = 0;
+    for (size_t k = 0; k < c.mask.data.size(); ++k) {
+      if (c.mask.data[k] < 0.5f || n.mask.data[k] < 0.5f) continue;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double d = n.irradiance.data[k * 3 + ch] - c.irradiance.data[k * 3 + ch];
+        sum2 += d * d;
+        ++count;
+      }
+    }
+    const double rms = std::sqrt(sum2 / count);
+    std::printf("noise: F=%d K=%d rms %.3e, predicted floor %.3e (ratio %.2f)\n", r.downsample,
+                r.samples_per_texel, rms, predicted, rms / predicted);
+    EXPECT_LE(rms, 1.5 * predicted);
+    EXPECT_GE(rms, 0.5 * predicted);
+  }
+}
+
 Error CaughtError(const std::function<void()>& f) {
   try {
     f();

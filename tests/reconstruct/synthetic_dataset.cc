@@ -2,9 +2,11 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 
 #include "core/atomic_file.h"
 #include "core/basis.h"
@@ -68,6 +70,8 @@ double SyntheticDataset::Truth(int i, int j, int c, double s, double t) const {
 
 void SyntheticDataset::WritePhotos(int i, int j) {
   const int n = options.image_px;
+  std::mt19937 rng(options.noise_seed + 7919u * unsigned(dataset.grid.Index(i, j)));
+  std::normal_distribution<double> noise(0.0, options.noise_sigma > 0 ? options.noise_sigma : 1.0);
   for (const auto& e : dataset.PhotosOf(i, j)) {
     cv::Mat img(n, n, options.ext == ".png" ? CV_16UC3 : CV_32FC3);
     ImageF exr(n, n, 3);
@@ -75,7 +79,9 @@ void SyntheticDataset::WritePhotos(int i, int j) {
       for (int x = 0; x < n; ++x) {
         const Eigen::Vector2d lab = calibration.ScreenFromImage(Eigen::Vector2d(x, y));
         for (int c = 0; c < 3; ++c) {
-          const double v = std::min(1.0, e.exposure * Photo(i, j, e.positive, c, lab.x(), lab.y()));
+          double v = e.exposure * Photo(i, j, e.positive, c, lab.x(), lab.y());
+          if (options.noise_sigma > 0) v += noise(rng);
+          v = std::clamp(v, 0.0, 1.0);
           if (options.ext == ".png")
             img.at<cv::Vec<uint16_t, 3>>(y, x)[2 - c] = uint16_t(std::lround(v * 65535));
           else

@@ -24,6 +24,8 @@ struct SyntheticOptions {
   std::vector<double> exposures = {1.0};
   double amplitude = 0.6;  // peak of the T+ photo at exposure 1 (>= 1 saturates)
   bool write_calibration = true;
+  double noise_sigma = 0;  // white Gaussian noise on every photo value (normalised units)
+  unsigned noise_seed = 1;
 };
 
 struct SyntheticDataset {

@@ -24,6 +24,22 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void OnStopSignal(int) { g_stop = true; }
 
+// SIGINT/SIGTERM set g_stop while a run is in progress; the previous handlers come back after.
+class StopSignalScope {
+ public:
+  StopSignalScope()
+      : old_int_(std::signal(SIGINT, OnStopSignal)),
+        old_term_(std::signal(SIGTERM, OnStopSignal)) {}
+  ~StopSignalScope() {
+    std::signal(SIGINT, old_int_);
+    std::signal(SIGTERM, old_term_);
+  }
+
+ private:
+  using Handler = void (*)(int);
+  Handler old_int_, old_term_;
+};
+
 struct RunConfig {
   std::string dataset_dir;
   ReconstructOptions options;
@@ -258,8 +274,7 @@ int RunReconstruct(int argc, char** argv) {
          << " threads=" << config.threads;
   LogInfo("parameters: ", params.str());
   g_stop = false;
-  std::signal(SIGINT, OnStopSignal);
-  std::signal(SIGTERM, OnStopSignal);
+  const StopSignalScope signals;
   return config.watch ? RunWatch(config) : RunBatch(config);
 }
 

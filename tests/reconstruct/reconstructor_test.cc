@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <thread>
 
@@ -321,6 +322,37 @@ TEST(RunReconstruct, WatchProcessesPositionsAsTheyArrive) {
     for (int i = 0; i < 2; ++i)
       EXPECT_LE(Measure(s, i, j, ReadSlabPosition(s.dir + "/slab", info, i, j), info.layout).vs_fit,
                 kAutoTolerance);
+}
+
+// SIGTERM while watching: the watcher finishes what is in flight and leaves a valid partial slab.
+TEST(RunReconstruct, WatchStopsCleanlyOnSigterm) {
+  SyntheticOptions o;
+  o.nu = 3;
+  o.nv = 1;
+  SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("watch_sigterm"), o, false);
+  s.WritePhotos(0, 0);
+  s.WritePhotos(1, 0);  // position (2, 0) never arrives
+  int code = -1;
+  std::thread watcher([&] {
+    code = RunCli({"--dataset", s.dir, "--resolution", "40", "--watch", "--poll", "0.02",
+                   "--idle-timeout", "30"});
+  });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (fs::exists(s.dir + "/slab/slab.json") &&
+        SlabInfo::Load(s.dir + "/slab").present.size() == 2)
+      break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::raise(SIGTERM);  // the watcher's handler is installed: it is past its first position
+  watcher.join();
+  EXPECT_EQ(code, 1);  // stopped before the grid was complete
+  const SlabInfo info = SlabInfo::Load(s.dir + "/slab");
+  EXPECT_EQ(info.present.size(), 2u);
+  EXPECT_FALSE(info.Complete());
+  EXPECT_FALSE(fs::exists(SlabPositionPath(s.dir + "/slab", 2, 0)));
+  for (const auto& entry : fs::recursive_directory_iterator(s.dir))
+    EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
 }
 
 }  // namespace

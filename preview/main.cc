@@ -1,0 +1,6 @@
+#include "core/error.h"
+#include "preview/run_preview.h"
+
+int main(int argc, char** argv) {
+  return lumislab::RunMain("preview", [&] { return lumislab::RunPreview(argc, argv); });
+}

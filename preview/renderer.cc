@@ -1,0 +1,615 @@
+#include "preview/renderer.h"
+
+#include <glad/gl.h>
+
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/srgbe.h"
+
+namespace lumislab {
+namespace {
+
+constexpr double kShadowNear = 10.0;  // mm: occluders nearer to c_ij than this are ignored
+constexpr double kShadowFar = 100000.0;
+
+const char* kSceneVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec3 a_albedo;
+uniform mat4 u_view_projection;
+uniform mat4 u_scene_to_luminaire;
+out vec3 v_lum_position;
+out vec3 v_lum_normal;
+out vec3 v_albedo;
+invariant gl_Position;
+void main() {
+  gl_Position = u_view_projection * vec4(a_position, 1.0);
+  v_lum_position = (u_scene_to_luminaire * vec4(a_position, 1.0)).xyz;
+  v_lum_normal = mat3(u_scene_to_luminaire) * a_normal;
+  v_albedo = a_albedo;
+}
+)";
+
+const char* kEmptyFragment = R"(#version 450 core
+void main() {}
+)";
+
+// Clip coordinates of luminaire-frame point x seen from c (z = 0): xy of NDC = slab texture
+// coordinates 2u-1, 2v-1 (u from -W/2, v from +H/2), so shadow maps share the slab texel layout.
+const char* kLightClip = R"(
+uniform float u_d;
+uniform vec2 u_window;  // W, H (mm)
+uniform vec2 u_depth;   // A, B of the depth mapping
+vec4 LightClip(vec3 x, vec2 c) {
+  vec3 rel = x - vec3(c, 0.0);
+  return vec4(2.0 * u_d / u_window.x * rel.x + 2.0 * c.x / u_window.x * rel.z,
+              -2.0 * u_d / u_window.y * rel.y - 2.0 * c.y / u_window.y * rel.z,
+              u_depth.x * rel.z + u_depth.y, rel.z);
+}
+)";
+
+const std::string kShadowVertex = std::string(R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_scene_to_luminaire;
+uniform vec2 u_centre;
+)") + kLightClip + R"(
+void main() {
+  gl_Position = LightClip((u_scene_to_luminaire * vec4(a_position, 1.0)).xyz, u_centre);
+}
+)";
+
+const char* kSrgbeCode = R"(
+uint EncodeChannel(float x, int e) {
+  uint m = uint(min(floor(ldexp(abs(x), -e) * 128.0 + 0.5), 127.0));
+  return (x < 0.0 && m > 0u) ? (m | 0x80u) : m;
+}
+uint EncodeSrgbe(vec3 c) {
+  c = clamp(c, vec3(-1.7e38), vec3(1.7e38));
+  float m = max(max(abs(c.r), abs(c.g)), abs(c.b));
+  if (!(m > 0.0)) return 0u;
+  int e;
+  frexp(m, e);
+  e = max(e, -128);
+  if (floor(ldexp(m, -e) * 128.0 + 0.5) > 127.0) e += 1;
+  e = min(e, 127);
+  uint word = EncodeChannel(c.r, e) | (EncodeChannel(c.g, e) << 8) |
+                (EncodeChannel(c.b, e) << 16) | (uint(e + 128) << 24);
+  return (word & 0x007f7f7fu) == 0u ? 0u : word;
+}
+vec3 DecodeSrgbe(uint p) {
+  int e = int(p >> 24) - 128;
+  vec3 rgb;
+  for (int k = 0; k < 3; ++k) {
+    uint b = (p >> (8 * k)) & 0xffu;
+    float v = ldexp(float(b & 0x7fu) / 128.0, e);
+    rgb[k] = (b & 0x80u) != 0u ? -v : v;
+  }
+  return rgb;
+}
+)";
+
+const std::string kLightFragment = std::string(R"(#version 450 core
+in vec3 v_lum_position;
+in vec3 v_lum_normal;
+in vec3 v_albedo;
+uniform sampler2DArray u_intensity;
+uniform sampler2DArrayShadow u_shadow;
+uniform int u_count;
+uniform vec2 u_centres[16];
+uniform int u_layers[16];
+uniform bool u_shadows;
+uniform float u_offset_scale;  // normal offset per mm of distance (one shadow texel)
+uniform float u_radiance_scale;
+uniform bool u_srgbe;
+uniform usampler2D u_previous;
+layout(location = 0) out vec4 o_float;
+layout(location = 1) out uint o_packed;
+)") + kLightClip + kSrgbeCode + R"(
+void main() {
+  vec3 x = v_lum_position;
+  vec3 n = normalize(v_lum_normal);
+  vec3 sum = vec3(0.0);
+  for (int k = 0; k < u_count; ++k) {
+    vec3 rel = x - vec3(u_centres[k], 0.0);
+    if (rel.z <= 0.0) continue;
+    float delta = length(rel);
+    float cos_emit = rel.z / delta;
+    float cos_recv = -dot(n, rel) / delta;
+    if (cos_recv <= 0.0) continue;
+    vec2 st = u_centres[k] + rel.xy * (u_d / rel.z);
+    if (abs(st.x) > 0.5 * u_window.x || abs(st.y) > 0.5 * u_window.y) continue;
+    vec2 uv = vec2(st.x / u_window.x + 0.5, 0.5 - st.y / u_window.y);
+    float visible = 1.0;
+    if (u_shadows) {
+      vec4 clip = LightClip(x + n * (u_offset_scale * delta), u_centres[k]);
+      vec3 ndc = clip.xyz / clip.w;
+      visible = texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_layers[k]),
+                                       0.5 * ndc.z + 0.5));
+    }
+    vec3 intensity = texture(u_intensity, vec3(uv, float(u_layers[k]))).rgb;
+    sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
+  }
+  vec3 radiance = sum * v_albedo * u_radiance_scale;
+  o_float = vec4(radiance, 1.0);
+  if (u_srgbe) {
+    vec3 previous = DecodeSrgbe(texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r);
+    o_packed = EncodeSrgbe(previous + radiance);
+  } else {
+    o_packed = 0u;
+  }
+}
+)";
+
+const char* kQuadVertex = R"(#version 450 core
+out vec2 v_uv;
+void main() {
+  vec2 p = vec2((gl_VertexID & 1) * 4.0 - 1.0, (gl_VertexID & 2) * 2.0 - 1.0);
+  v_uv = 0.5 * p + 0.5;
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+const std::string kDisplayFragment = std::string(R"(#version 450 core
+in vec2 v_uv;
+uniform sampler2D u_float;
+uniform usampler2D u_packed;
+uniform bool u_srgbe;
+uniform float u_exposure;
+out vec4 o_colour;
+)") + kSrgbeCode + R"(
+void main() {
+  vec3 c = u_srgbe ? DecodeSrgbe(texture(u_packed, v_uv).r) : texture(u_float, v_uv).rgb;
+  c = clamp(c * u_exposure, 0.0, 1.0);
+  c = mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+  o_colour = vec4(c, 1.0);
+}
+)";
+
+GLuint Compile(GLenum type, const std::string& source) {
+  const GLuint shader = glCreateShader(type);
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    throw Failure(std::string("GLSL compile error: ") + log);
+  }
+  return shader;
+}
+
+GLuint Link(const std::string& vertex, const std::string& fragment) {
+  const GLuint program = glCreateProgram();
+  const GLuint vs = Compile(GL_VERTEX_SHADER, vertex);
+  const GLuint fs = Compile(GL_FRAGMENT_SHADER, fragment);
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    throw Failure(std::string("GLSL link error: ") + log);
+  }
+  return program;
+}
+
+GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+
+}  // namespace
+
+struct Renderer::Gl {
+  GLuint vao = 0, vbo = 0, quad_vao = 0;
+  GLuint scene_program = 0, depth_program = 0, shadow_program = 0, display_program = 0;
+  GLuint intensity = 0, shadow = 0, shadow_fbo = 0;
+  GLuint colour = 0, packed[2] = {0, 0}, depth = 0, fbo[2] = {0, 0};
+};
+
+Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options)
+    : info_(info), width_(width), height_(height), options_(options), gl_(new Gl) {
+  const int lights = info_.grid.count();
+  present_.assign(lights, false);
+  shadow_valid_.assign(lights, false);
+  accumulated_.assign(lights, false);
+  gl_->scene_program = Link(kSceneVertex, kLightFragment);
+  gl_->depth_program = Link(kSceneVertex, kEmptyFragment);
+  gl_->shadow_program = Link(kShadowVertex, kEmptyFragment);
+  gl_->display_program = Link(kQuadVertex, kDisplayFragment);
+  glGenVertexArrays(1, &gl_->vao);
+  glGenVertexArrays(1, &gl_->quad_vao);
+  glGenBuffers(1, &gl_->vbo);
+
+  glGenTextures(1, &gl_->intensity);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
+  glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGB32F, info_.layout.res_x, info_.layout.res_y,
+                 lights);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+
+  glGenTextures(1, &gl_->shadow);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->shadow);
+  glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_DEPTH_COMPONENT32F, options_.shadow_size,
+                 options_.shadow_size, lights);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  glGenFramebuffers(1, &gl_->shadow_fbo);
+  AllocateTargets();
+  if (glGetError() != GL_NO_ERROR) throw Failure("GL error while creating the renderer");
+}
+
+Renderer::~Renderer() {
+  glDeleteFramebuffers(2, gl_->fbo);
+  glDeleteFramebuffers(1, &gl_->shadow_fbo);
+  GLuint textures[] = {gl_->intensity, gl_->shadow, gl_->colour, gl_->packed[0], gl_->packed[1],
+                       gl_->depth};
+  glDeleteTextures(6, textures);
+  glDeleteBuffers(1, &gl_->vbo);
+  glDeleteVertexArrays(1, &gl_->vao);
+  glDeleteVertexArrays(1, &gl_->quad_vao);
+  for (GLuint p : {gl_->scene_program, gl_->depth_program, gl_->shadow_program,
+                   gl_->display_program}) {
+    glDeleteProgram(p);
+  }
+  delete gl_;
+}
+
+void Renderer::AllocateTargets() {
+  if (gl_->fbo[0]) {
+    glDeleteFramebuffers(2, gl_->fbo);
+    GLuint textures[] = {gl_->colour, gl_->packed[0], gl_->packed[1], gl_->depth};
+    glDeleteTextures(4, textures);
+  }
+  auto make = [&](GLenum format) {
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexStorage2D(GL_TEXTURE_2D, 1, format, width_, height_);
+    const GLint filter = (format == GL_R32UI) ? GL_NEAREST : GL_LINEAR;
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    return t;
+  };
+  gl_->colour = make(GL_RGBA32F);
+  gl_->packed[0] = make(GL_R32UI);
+  gl_->packed[1] = make(GL_R32UI);
+  gl_->depth = make(GL_DEPTH_COMPONENT32F);
+  glGenFramebuffers(2, gl_->fbo);
+  for (int k = 0; k < 2; ++k) {
+    glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[k]);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, gl_->colour, 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, gl_->packed[k], 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->depth, 0);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw Failure("accumulation framebuffer incomplete");
+    }
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  view_valid_ = false;
+}
+
+void Renderer::SetScene(const Mesh& mesh) {
+  std::vector<float> data;
+  data.reserve(mesh.positions.size() * 9);
+  for (size_t k = 0; k < mesh.positions.size(); ++k) {
+    for (const Eigen::Vector3f* v : {&mesh.positions[k], &mesh.normals[k], &mesh.albedo[k]}) {
+      data.insert(data.end(), {v->x(), v->y(), v->z()});
+    }
+  }
+  vertex_count_ = int(mesh.positions.size());
+  glBindVertexArray(gl_->vao);
+  glBindBuffer(GL_ARRAY_BUFFER, gl_->vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
+               GL_STATIC_DRAW);
+  for (int a = 0; a < 3; ++a) {
+    glEnableVertexAttribArray(a);
+    glVertexAttribPointer(a, 3, GL_FLOAT, GL_FALSE, 9 * sizeof(float),
+                          reinterpret_cast<void*>(size_t(a) * 3 * sizeof(float)));
+  }
+  glBindVertexArray(0);
+  shadow_valid_.assign(shadow_valid_.size(), false);
+  view_valid_ = false;
+}
+
+void Renderer::SetPose(const Eigen::Isometry3d& luminaire_to_scene) {
+  pose_ = luminaire_to_scene;
+  shadow_valid_.assign(shadow_valid_.size(), false);
+  view_valid_ = false;
+}
+
+void Renderer::SetCamera(const Eigen::Matrix4f& view_projection) {
+  if (view_projection == view_projection_ && view_valid_) return;
+  view_projection_ = view_projection;
+  view_valid_ = false;
+}
+
+void Renderer::SetOptions(const RenderOptions& options) {
+  if (options.shadow_size != options_.shadow_size) {
+    throw BadInput("the shadow-map size is fixed when the renderer is created");
+  }
+  options_ = options;
+  view_valid_ = false;
+}
+
+void Renderer::Resize(int width, int height) {
+  if (width == width_ && height == height_) return;
+  width_ = width;
+  height_ = height;
+  AllocateTargets();
+}
+
+void Renderer::SetPosition(int i, int j, const ImageF& intensity) {
+  if (intensity.width != info_.layout.res_x || intensity.height != info_.layout.res_y ||
+      intensity.channels != 3) {
+    throw BadInput("slab position texture does not match the slab layout");
+  }
+  const int layer = info_.grid.Index(i, j);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, intensity.width, intensity.height, 1,
+                  GL_RGB, GL_FLOAT, intensity.data.data());
+  if (accumulated_[layer]) view_valid_ = false;  // replaced: the sum must be redone
+  present_[layer] = true;
+}
+
+bool Renderer::HasPosition(int i, int j) const { return present_[info_.grid.Index(i, j)]; }
+
+int Renderer::PositionCount() const {
+  int n = 0;
+  for (bool p : present_) n += p;
+  return n;
+}
+
+void Renderer::RenderShadowMap(int light) {
+  const int i = light % info_.grid.nu, j = light / info_.grid.nu;
+  const Eigen::Vector2d c = info_.grid.Centre(i, j);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->shadow_fbo);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->shadow, 0, light);
+  glDrawBuffer(GL_NONE);
+  glViewport(0, 0, options_.shadow_size, options_.shadow_size);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.5f, 2.0f);
+  const GLuint p = gl_->shadow_program;
+  glUseProgram(p);
+  const Eigen::Matrix4f to_lum = pose_.inverse().matrix().cast<float>();
+  glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
+  glUniform2f(Loc(p, "u_centre"), float(c.x()), float(c.y()));
+  glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
+  glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm),
+              float(info_.layout.window_h_mm));
+  const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
+  const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
+  glUniform2f(Loc(p, "u_depth"), float(a), float(b));
+  glBindVertexArray(gl_->vao);
+  glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  shadow_valid_[light] = true;
+  ++shadow_renders_;
+}
+
+void Renderer::LightPass(const std::vector<int>& lights) {
+  const GLuint p = gl_->scene_program;
+  const int target = options_.srgbe ? 1 - ping_ : 0;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[target]);
+  glViewport(0, 0, width_, height_);
+  glUseProgram(p);
+  const Eigen::Matrix4f to_lum = pose_.inverse().matrix().cast<float>();
+  glUniformMatrix4fv(Loc(p, "u_view_projection"), 1, GL_FALSE, view_projection_.data());
+  glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
+  glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
+  glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm),
+              float(info_.layout.window_h_mm));
+  const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
+  const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
+  glUniform2f(Loc(p, "u_depth"), float(a), float(b));
+  glUniform1i(Loc(p, "u_shadows"), options_.shadows);
+  glUniform1i(Loc(p, "u_srgbe"), options_.srgbe);
+  glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
+  // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.
+  glUniform1f(Loc(p, "u_offset_scale"),
+              float(1.5 * info_.layout.window_w_mm / info_.distance_mm / options_.shadow_size));
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->shadow);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_2D, gl_->packed[ping_]);
+  glUniform1i(Loc(p, "u_intensity"), 0);
+  glUniform1i(Loc(p, "u_shadow"), 1);
+  glUniform1i(Loc(p, "u_previous"), 2);
+  float centres[2 * kLightsPerPass];
+  int layers[kLightsPerPass];
+  for (size_t k = 0; k < lights.size(); ++k) {
+    const int l = lights[k];
+    const Eigen::Vector2d c = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
+    centres[2 * k] = float(c.x());
+    centres[2 * k + 1] = float(c.y());
+    layers[k] = l;
+  }
+  glUniform1i(Loc(p, "u_count"), int(lights.size()));
+  glUniform2fv(Loc(p, "u_centres"), GLsizei(lights.size()), centres);
+  glUniform1iv(Loc(p, "u_layers"), GLsizei(lights.size()), layers);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_FALSE);
+  if (options_.srgbe) {
+    glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDisable(GL_BLEND);
+  } else {
+    glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glEnablei(GL_BLEND, 0);
+    glBlendFunci(0, GL_ONE, GL_ONE);
+  }
+  glBindVertexArray(gl_->vao);
+  glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+  glDisablei(GL_BLEND, 0);
+  glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  if (options_.srgbe) ping_ = target;
+}
+
+int Renderer::Render() {
+  if (!view_valid_) {
+    // Clear both targets, then the depth pre-pass (light passes shade visible fragments only).
+    for (int k = 0; k < 2; ++k) {
+      glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[k]);
+      const float zero_f[4] = {0, 0, 0, 0};
+      const GLuint zero_u[4] = {0, 0, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, zero_f);
+      glClearBufferuiv(GL_COLOR, 1, zero_u);
+    }
+    ping_ = 0;
+    glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[0]);
+    glViewport(0, 0, width_, height_);
+    glDepthMask(GL_TRUE);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glUseProgram(gl_->depth_program);
+    glUniformMatrix4fv(Loc(gl_->depth_program, "u_view_projection"), 1, GL_FALSE,
+                       view_projection_.data());
+    glBindVertexArray(gl_->vao);
+    glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    accumulated_.assign(accumulated_.size(), false);
+    view_valid_ = true;
+  }
+  std::vector<int> todo;
+  for (size_t l = 0; l < present_.size(); ++l) {
+    if (present_[l] && !accumulated_[l]) todo.push_back(int(l));
+  }
+  if (options_.shadows) {
+    for (int l : todo) {
+      if (!shadow_valid_[l]) RenderShadowMap(l);
+    }
+  }
+  for (size_t start = 0; start < todo.size(); start += kLightsPerPass) {
+    const size_t end = std::min(todo.size(), start + kLightsPerPass);
+    LightPass(std::vector<int>(todo.begin() + start, todo.begin() + end));
+  }
+  for (int l : todo) accumulated_[l] = true;
+  glFinish();
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) throw Failure("GL error " + std::to_string(error) + " while rendering");
+  return int(todo.size());
+}
+
+ImageF Renderer::Read() const {
+  ImageF out(width_, height_, 3);
+  if (options_.srgbe) {
+    std::vector<uint32_t> packed(size_t(width_) * height_);
+    glBindTexture(GL_TEXTURE_2D, gl_->packed[ping_]);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, packed.data());
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        const auto rgb = DecodeSrgbe(packed[size_t(height_ - 1 - y) * width_ + x]);
+        for (int c = 0; c < 3; ++c) out.at(x, y, c) = rgb[c];
+      }
+    }
+    return out;
+  }
+  std::vector<float> rgba(size_t(width_) * height_ * 4);
+  glBindTexture(GL_TEXTURE_2D, gl_->colour);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, rgba.data());
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        out.at(x, y, c) = rgba[(size_t(height_ - 1 - y) * width_ + x) * 4 + c];
+      }
+    }
+  }
+  return out;
+}
+
+void Renderer::Display(double exposure, int viewport_w, int viewport_h) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, viewport_w, viewport_h);
+  glDisable(GL_DEPTH_TEST);
+  const GLuint p = gl_->display_program;
+  glUseProgram(p);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, gl_->colour);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, gl_->packed[ping_]);
+  glUniform1i(Loc(p, "u_float"), 0);
+  glUniform1i(Loc(p, "u_packed"), 1);
+  glUniform1i(Loc(p, "u_srgbe"), options_.srgbe);
+  glUniform1f(Loc(p, "u_exposure"), float(exposure));
+  glBindVertexArray(gl_->quad_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+Eigen::Matrix4f Perspective(double fov_y_deg, double aspect, double near_mm, double far_mm) {
+  const double f = 1.0 / std::tan(0.5 * fov_y_deg * M_PI / 180.0);
+  Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
+  m(0, 0) = float(f / aspect);
+  m(1, 1) = float(f);
+  m(2, 2) = float((far_mm + near_mm) / (near_mm - far_mm));
+  m(2, 3) = float(2 * far_mm * near_mm / (near_mm - far_mm));
+  m(3, 2) = -1;
+  return m;
+}
+
+Eigen::Matrix4f LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                       const Eigen::Vector3d& up) {
+  const Eigen::Vector3d f = (target - eye).normalized();
+  const Eigen::Vector3d s = f.cross(up).normalized();
+  const Eigen::Vector3d u = s.cross(f);
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<1, 3>(0, 0) = s.transpose();
+  m.block<1, 3>(1, 0) = u.transpose();
+  m.block<1, 3>(2, 0) = -f.transpose();
+  m(0, 3) = -s.dot(eye);
+  m(1, 3) = -u.dot(eye);
+  m(2, 3) = f.dot(eye);
+  return m.cast<float>();
+}
+
+Eigen::Matrix4f PlaneView(double plane_z_mm, double extent_mm) {
+  Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
+  m(0, 0) = float(2.0 / extent_mm);
+  m(1, 1) = float(2.0 / extent_mm);
+  // depth = (D - z) / 4D: the plane (z = D) is nearest, anything in front of it is behind it.
+  m(2, 2) = float(-1.0 / (4.0 * plane_z_mm));
+  m(2, 3) = 0.25f;
+  m(3, 3) = 1;
+  return m;
+}
+
+Eigen::Isometry3d PoseFromValues(const std::vector<double>& v) {
+  if (v.size() != 6) throw BadInput("--luminaire-pose needs x,y,z,rx,ry,rz (mm, degrees)");
+  const double k = M_PI / 180.0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(v[5] * k, Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(v[4] * k, Eigen::Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(v[3] * k, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return pose;
+}
+
+}  // namespace lumislab

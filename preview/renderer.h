@@ -1,0 +1,90 @@
+// The preview renderer (DESIGN §4): per grid position a textured spot light at c_ij with the
+// projective texture E'_ij, f = cos(theta) cos(theta') / delta^2 and a shadow map from c_ij; light
+// only towards +z of the luminaire frame and only through the screen window; Lambertian
+// materials; float (RGBA32F, additive blending) or sRGBE-packed accumulation (paper §4.2).
+// Needs a current GL 4.5 core context (OffscreenContext or WindowContext).
+//
+// Caching: shadow maps are kept until the scene or the luminaire pose changes; the accumulated
+// image is kept until the camera, the scene, the pose or an option changes, so a newly arrived
+// position only costs its own light pass. Lights are batched (texture arrays, up to
+// kLightsPerPass per pass).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "core/image.h"
+#include "core/slab.h"
+#include "preview/scenes.h"
+
+namespace lumislab {
+
+struct RenderOptions {
+  bool shadows = true;
+  bool srgbe = false;        // sRGBE-packed accumulation instead of float
+  int shadow_size = 512;     // shadow-map texels per side
+  double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
+};
+
+constexpr int kLightsPerPass = 16;
+
+class Renderer {
+ public:
+  Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  void SetScene(const Mesh& mesh);
+  // Luminaire frame -> scene frame (rigid).
+  void SetPose(const Eigen::Isometry3d& luminaire_to_scene);
+  // Clip-from-scene matrix of the camera.
+  void SetCamera(const Eigen::Matrix4f& view_projection);
+  void SetOptions(const RenderOptions& options);
+  const RenderOptions& options() const { return options_; }
+  void Resize(int width, int height);
+  // Uploads E'_ij (3 channels, slab layout) of position (i, j); it is added at the next Render.
+  void SetPosition(int i, int j, const ImageF& intensity);
+  bool HasPosition(int i, int j) const;
+  int PositionCount() const;
+
+  // Brings the accumulated image up to date; returns how many lights it added. glFinish()ed.
+  int Render();
+  // Shadow maps rendered since construction (to show they are cached).
+  int ShadowMapRenders() const { return shadow_renders_; }
+  // The accumulated image (radiance or irradiance, W/m^2 [/sr]), 3 channels, row 0 on top.
+  ImageF Read() const;
+  // Draws the accumulation tone-mapped (exposure factor, sRGB) into framebuffer 0.
+  void Display(double exposure, int viewport_w, int viewport_h) const;
+
+ private:
+  struct Gl;
+  void RenderShadowMap(int light);
+  void LightPass(const std::vector<int>& lights);
+  void AllocateTargets();
+
+  SlabInfo info_;
+  int width_, height_;
+  RenderOptions options_;
+  Eigen::Matrix4f view_projection_ = Eigen::Matrix4f::Identity();
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+  int vertex_count_ = 0;
+  std::vector<bool> present_, shadow_valid_, accumulated_;
+  bool view_valid_ = false;
+  int shadow_renders_ = 0;
+  int ping_ = 0;  // sRGBE: which of the two targets holds the current sum
+  Gl* gl_;
+};
+
+// Camera helpers (column vectors, GL clip conventions).
+Eigen::Matrix4f Perspective(double fov_y_deg, double aspect, double near_mm, double far_mm);
+Eigen::Matrix4f LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                       const Eigen::Vector3d& up);
+// Orthographic view of the plane z = plane_z (luminaire frame = scene frame), square of side
+// extent: column 0 at -x, row 0 (after Read) at +y; nearer-to-plane surfaces never hide it.
+Eigen::Matrix4f PlaneView(double plane_z_mm, double extent_mm);
+// Pose from "x,y,z,rx,ry,rz" (mm, degrees; R = Rz Ry Rx).
+Eigen::Isometry3d PoseFromValues(const std::vector<double>& values);
+
+}  // namespace lumislab

@@ -11,8 +11,8 @@ std::vector<PointEmitter> DefaultPointEmitters() {
   return {{{1.5, -2.0, -20.0}, 8.0, {1.0, 0.85, 0.6}}, {{-3.0, 1.0, -12.0}, 3.0, {0.4, 0.6, 1.0}}};
 }
 
-Eigen::Vector3d PlaneIrradiance(const std::vector<PointEmitter>& emitters, double x_mm,
-                                double y_mm, double plane_z_mm) {
+Eigen::Vector3d PlaneIrradiance(const std::vector<PointEmitter>& emitters, double x_mm, double y_mm,
+                                double plane_z_mm) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const PointEmitter& e : emitters) {
     const Eigen::Vector3d rel = Eigen::Vector3d(x_mm, y_mm, plane_z_mm) - e.position_mm;

@@ -20,8 +20,8 @@ struct PointEmitter {
 std::vector<PointEmitter> DefaultPointEmitters();
 
 // Analytic irradiance (W/m^2) on the plane z = plane_z_mm (normal towards the luminaire).
-Eigen::Vector3d PlaneIrradiance(const std::vector<PointEmitter>& emitters, double x_mm,
-                                double y_mm, double plane_z_mm);
+Eigen::Vector3d PlaneIrradiance(const std::vector<PointEmitter>& emitters, double x_mm, double y_mm,
+                                double plane_z_mm);
 
 // Slab metadata: d, nu x nv grid of spacing h, window w x w mm at res x res, truncated dual (1).
 SlabInfo MakeSlabInfo(double d_mm, int nu, int nv, double h_mm, double window_mm, int res);

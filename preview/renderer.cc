@@ -229,8 +229,7 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
 
   glGenTextures(1, &gl_->intensity);
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
-  glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGB32F, info_.layout.res_x, info_.layout.res_y,
-                 lights);
+  glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGB32F, info_.layout.res_x, info_.layout.res_y, lights);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -254,14 +253,14 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
 Renderer::~Renderer() {
   glDeleteFramebuffers(2, gl_->fbo);
   glDeleteFramebuffers(1, &gl_->shadow_fbo);
-  GLuint textures[] = {gl_->intensity, gl_->shadow, gl_->colour, gl_->packed[0], gl_->packed[1],
-                       gl_->depth};
+  GLuint textures[] = {gl_->intensity, gl_->shadow,    gl_->colour,
+                       gl_->packed[0], gl_->packed[1], gl_->depth};
   glDeleteTextures(6, textures);
   glDeleteBuffers(1, &gl_->vbo);
   glDeleteVertexArrays(1, &gl_->vao);
   glDeleteVertexArrays(1, &gl_->quad_vao);
-  for (GLuint p : {gl_->scene_program, gl_->depth_program, gl_->shadow_program,
-                   gl_->display_program}) {
+  for (GLuint p :
+       {gl_->scene_program, gl_->depth_program, gl_->shadow_program, gl_->display_program}) {
     glDeleteProgram(p);
   }
   delete gl_;
@@ -361,8 +360,8 @@ void Renderer::SetPosition(int i, int j, const ImageF& intensity) {
   const int layer = info_.grid.Index(i, j);
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, intensity.width, intensity.height, 1,
-                  GL_RGB, GL_FLOAT, intensity.data.data());
+  glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, intensity.width, intensity.height, 1, GL_RGB,
+                  GL_FLOAT, intensity.data.data());
   if (accumulated_[layer]) view_valid_ = false;  // replaced: the sum must be redone
   present_[layer] = true;
 }
@@ -394,8 +393,7 @@ void Renderer::RenderShadowMap(int light) {
   glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
   glUniform2f(Loc(p, "u_centre"), float(c.x()), float(c.y()));
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
-  glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm),
-              float(info_.layout.window_h_mm));
+  glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
   const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
   const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
   glUniform2f(Loc(p, "u_depth"), float(a), float(b));
@@ -416,8 +414,7 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glUniformMatrix4fv(Loc(p, "u_view_projection"), 1, GL_FALSE, view_projection_.data());
   glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
-  glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm),
-              float(info_.layout.window_h_mm));
+  glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
   const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
   const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
   glUniform2f(Loc(p, "u_depth"), float(a), float(b));

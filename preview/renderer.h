@@ -22,8 +22,8 @@ namespace lumislab {
 
 struct RenderOptions {
   bool shadows = true;
-  bool srgbe = false;        // sRGBE-packed accumulation instead of float
-  int shadow_size = 512;     // shadow-map texels per side
+  bool srgbe = false;                              // sRGBE-packed accumulation instead of float
+  int shadow_size = 512;                           // shadow-map texels per side
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
 };
 

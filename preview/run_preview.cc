@@ -112,8 +112,8 @@ int RunHeadless(const PreviewConfig& config) {
     if (added.empty()) continue;
     renderer.Render();
     write();
-    LogInfo("positions ", renderer.PositionCount(), "/", info.grid.count(), " (new: ",
-            added.size(), ")");
+    LogInfo("positions ", renderer.PositionCount(), "/", info.grid.count(), " (new: ", added.size(),
+            ")");
     if (renderer.PositionCount() == info.grid.count()) break;
   }
   return 0;
@@ -154,8 +154,8 @@ SceneSetup MakeSceneSetup(const PreviewConfig& config, const SlabInfo& info) {
     }
     s.camera_target = (0.5f * (lo + hi)).cast<double>();
     s.camera_distance = 1.5 * (hi - lo).norm();
-    s.pose = PoseFromValues({s.camera_target.x(), hi.y() - 0.05 * (hi.y() - lo.y()),
-                             s.camera_target.z(), 90, 0, 0});
+    s.pose = PoseFromValues(
+        {s.camera_target.x(), hi.y() - 0.05 * (hi.y() - lo.y()), s.camera_target.z(), 90, 0, 0});
   }
   if (!config.pose.empty()) s.pose = PoseFromValues(config.pose);
   return s;
@@ -170,8 +170,8 @@ Eigen::Matrix4f OrbitCamera(const SceneSetup& s, double aspect) {
   return Perspective(70, aspect, 20, 100000) * LookAt(eye, s.camera_target, {0, 1, 0});
 }
 
-std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir,
-                                                  const SlabInfo& info, Renderer& renderer) {
+std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
+                                                  Renderer& renderer) {
   std::vector<std::pair<int, int>> added;
   for (const auto& [i, j] : ScanSlabPositions(slab_dir, info.grid)) {
     if (renderer.HasPosition(i, j)) continue;
@@ -267,13 +267,14 @@ int RunPreview(int argc, char** argv) {
   }
   SetLogTool("preview");
   if (verbose) SetLogLevel(LogLevel::kDebug);
-  if (std::sscanf(size.c_str(), "%dx%d", &config.width, &config.height) != 2 ||
-      config.width <= 0 || config.height <= 0 || config.width > 8192 || config.height > 8192) {
+  if (std::sscanf(size.c_str(), "%dx%d", &config.width, &config.height) != 2 || config.width <= 0 ||
+      config.height <= 0 || config.width > 8192 || config.height > 8192) {
     throw InputError("--size", "size", "WxH, e.g. 400x400", size);
   }
   if (threads > 0) setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
   if (config.shadow_size < 16 || config.shadow_size > 4096) {
-    throw InputError("--shadow-size", "shadow-size", "16..4096", std::to_string(config.shadow_size));
+    throw InputError("--shadow-size", "shadow-size", "16..4096",
+                     std::to_string(config.shadow_size));
   }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);

@@ -18,7 +18,7 @@ struct PreviewConfig {
   std::string scene = "crypt";  // crypt | cloister | plane | <file>
   std::vector<double> pose;     // x,y,z,rx,ry,rz; empty: the scene's default
   int width = 400, height = 400;
-  std::string out;              // headless output (.exr linear, .png tone-mapped)
+  std::string out;               // headless output (.exr linear, .png tone-mapped)
   double receiver_plane_mm = 0;  // plane mode: D (0: the slab's d)
   double extent_mm = 0;          // plane mode: W (0: window * D / d)
   double exposure_stops = 0;     // PNG / window exposure; NaN-free: 0 + auto
@@ -54,8 +54,8 @@ Eigen::Matrix4f OrbitCamera(const SceneSetup& setup, double aspect);
 
 // Loads every slab position present on disk that `loaded` (grid index -> bool) lacks into the
 // renderer (E' derived on load); returns the positions loaded.
-std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir,
-                                                  const SlabInfo& info, Renderer& renderer);
+std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
+                                                  Renderer& renderer);
 
 // Tone mapping for PNG/window: factor for `stops` plus auto (99th percentile of max channel
 // -> 0.8) when `automatic`.

@@ -61,14 +61,18 @@ void AddRoom(Mesh& m, const V& lo, const V& hi, const V& floor, const V& wall, c
   const int n = 4;
   for (int a = 0; a < n; ++a) {
     for (int b = 0; b < n; ++b) {
-      const float x0 = lo.x() + (hi.x() - lo.x()) * a / n, x1 = lo.x() + (hi.x() - lo.x()) * (a + 1) / n;
-      const float z0 = lo.z() + (hi.z() - lo.z()) * b / n, z1 = lo.z() + (hi.z() - lo.z()) * (b + 1) / n;
-      const float y0 = lo.y() + (hi.y() - lo.y()) * b / n, y1 = lo.y() + (hi.y() - lo.y()) * (b + 1) / n;
+      const float x0 = lo.x() + (hi.x() - lo.x()) * a / n,
+                  x1 = lo.x() + (hi.x() - lo.x()) * (a + 1) / n;
+      const float z0 = lo.z() + (hi.z() - lo.z()) * b / n,
+                  z1 = lo.z() + (hi.z() - lo.z()) * (b + 1) / n;
+      const float y0 = lo.y() + (hi.y() - lo.y()) * b / n,
+                  y1 = lo.y() + (hi.y() - lo.y()) * (b + 1) / n;
       m.AddQuad({x0, lo.y(), z1}, {x1, lo.y(), z1}, {x1, lo.y(), z0}, {x0, lo.y(), z0}, floor);
       m.AddQuad({x0, hi.y(), z0}, {x1, hi.y(), z0}, {x1, hi.y(), z1}, {x0, hi.y(), z1}, ceiling);
       m.AddQuad({x0, y0, lo.z()}, {x1, y0, lo.z()}, {x1, y1, lo.z()}, {x0, y1, lo.z()}, wall);
       m.AddQuad({x1, y0, hi.z()}, {x0, y0, hi.z()}, {x0, y1, hi.z()}, {x1, y1, hi.z()}, wall);
-      const float w0 = lo.z() + (hi.z() - lo.z()) * a / n, w1 = lo.z() + (hi.z() - lo.z()) * (a + 1) / n;
+      const float w0 = lo.z() + (hi.z() - lo.z()) * a / n,
+                  w1 = lo.z() + (hi.z() - lo.z()) * (a + 1) / n;
       m.AddQuad({lo.x(), y0, w1}, {lo.x(), y0, w0}, {lo.x(), y1, w0}, {lo.x(), y1, w1}, wall);
       m.AddQuad({hi.x(), y0, w0}, {hi.x(), y0, w1}, {hi.x(), y1, w1}, {hi.x(), y1, w0}, wall);
     }

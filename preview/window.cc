@@ -78,15 +78,30 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
     RenderOptions o = s.renderer->options();
     switch (key) {
       case GLFW_KEY_ESCAPE:
-      case GLFW_KEY_Q: s.quit = true; break;
+      case GLFW_KEY_Q:
+        s.quit = true;
+        break;
       case GLFW_KEY_EQUAL:
-      case GLFW_KEY_KP_ADD: s.exposure_stops += 0.5; break;
+      case GLFW_KEY_KP_ADD:
+        s.exposure_stops += 0.5;
+        break;
       case GLFW_KEY_MINUS:
-      case GLFW_KEY_KP_SUBTRACT: s.exposure_stops -= 0.5; break;
-      case GLFW_KEY_S: o.shadows = !o.shadows; s.renderer->SetOptions(o); break;
-      case GLFW_KEY_F: o.srgbe = !o.srgbe; s.renderer->SetOptions(o); break;
-      case GLFW_KEY_P: s.screenshot_requested = true; break;
-      default: break;
+      case GLFW_KEY_KP_SUBTRACT:
+        s.exposure_stops -= 0.5;
+        break;
+      case GLFW_KEY_S:
+        o.shadows = !o.shadows;
+        s.renderer->SetOptions(o);
+        break;
+      case GLFW_KEY_F:
+        o.srgbe = !o.srgbe;
+        s.renderer->SetOptions(o);
+        break;
+      case GLFW_KEY_P:
+        s.screenshot_requested = true;
+        break;
+      default:
+        break;
     }
   });
   glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int button, int action, int) {
@@ -109,8 +124,8 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
     } else if (s.dragging_pan) {
       const double yaw = s.setup->camera_yaw_deg * M_PI / 180;
       const double k = 0.002 * s.setup->camera_distance;
-      s.setup->camera_target += Eigen::Vector3d(-std::cos(yaw) * dx * k, dy * k,
-                                                std::sin(yaw) * dx * k);
+      s.setup->camera_target +=
+          Eigen::Vector3d(-std::cos(yaw) * dx * k, dy * k, std::sin(yaw) * dx * k);
       s.camera_changed = true;
     }
   });
@@ -127,8 +142,9 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
   std::pair<int, int> last = arrived.empty() ? std::pair<int, int>{-1, -1} : arrived.back();
   while (!glfwWindowShouldClose(window) && !state.quit && !PreviewStopRequested()) {
     glfwPollEvents();
-    if (config.watch && std::chrono::duration<double>(std::chrono::steady_clock::now() - last_poll)
-                                .count() >= config.poll_s) {
+    if (config.watch &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_poll).count() >=
+            config.poll_s) {
       last_poll = std::chrono::steady_clock::now();
       try {
         info = SlabInfo::Load(config.slab_dir);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/geometry.h"
 #include "core/slab.h"
 #include "preview/gl_context.h"
 #include "preview/light_field.h"
@@ -51,14 +52,34 @@ PlaneErrors PlaneAgainstAnalytic(double plane_z, int pixels) {
   renderer.SetScene(MakeReceiverPlane(plane_z, 1.2 * extent));
   renderer.SetCamera(PlaneView(plane_z, extent));
   UploadTruth(info, renderer);
+  const auto emitters = DefaultPointEmitters();
   renderer.Render();
   const ImageF image = renderer.Read();
-  const auto emitters = DefaultPointEmitters();
+  // The slab holds only light that crosses M inside the window: compare where every emitter's
+  // ray and every spot light's ray to the pixel cross M at least one texel inside the window.
+  const Eigen::Vector2d corner = info.grid.Centre(info.grid.nu - 1, info.grid.nv - 1);
+  const double inner = 0.5 * info.layout.window_w_mm - info.layout.TexelW();
+  auto inside = [&](double x, double y) {
+    for (double cx : {-corner.x(), corner.x()}) {
+      for (double cy : {-corner.y(), corner.y()}) {
+        const double k = info.distance_mm / plane_z;
+        if (std::abs(cx + (x - cx) * k) > inner || std::abs(cy + (y - cy) * k) > inner) {
+          return false;
+        }
+      }
+    }
+    for (const PointEmitter& e : emitters) {
+      const Eigen::Vector2d m = IntersectPlaneZ(e.position_mm, {x, y, plane_z}, info.distance_mm);
+      if (m.cwiseAbs().maxCoeff() > inner) return false;
+    }
+    return true;
+  };
   double sum_r = 0, sum_a = 0, diff2 = 0, norm2 = 0;
   for (int row = 0; row < pixels; ++row) {
     for (int col = 0; col < pixels; ++col) {
       const double x = -0.5 * extent + (col + 0.5) * extent / pixels;
       const double y = 0.5 * extent - (row + 0.5) * extent / pixels;
+      if (!inside(x, y)) continue;
       const Eigen::Vector3d a = PlaneIrradiance(emitters, x, y, plane_z);
       for (int c = 0; c < 3; ++c) {
         sum_r += image.at(col, row, c);
@@ -99,7 +120,8 @@ TEST(PreviewPlane, MatchesAnalyticIrradianceAt4D) {
 TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
   Context();
   const SlabInfo info = MakeSlabInfo(750, 3, 3, 20, 1200, 100);
-  const double plane_z = 1000, extent = 1400, occ_z = 500, occ_half = 103;  // shadow edges pass near pixel centres
+  const double plane_z = 1000, extent = 1400, occ_z = 500,
+               occ_half = 103;  // shadow edges pass near pixel centres
   Mesh mesh = MakeReceiverPlane(plane_z, 2 * extent);
   mesh.AddQuad({-float(occ_half), -float(occ_half), float(occ_z)},
                {-float(occ_half), float(occ_half), float(occ_z)},
@@ -158,10 +180,11 @@ TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
     }
   }
   const double l2 = std::sqrt(diff2 / norm2), all_l2 = std::sqrt(all_diff2 / all_norm2);
-  std::printf("GL vs CPU (shadowed scene): relative L2 %.5f %% away from shadow edges, %.3f %% "
-              "over all pixels (%d of %d near an edge)\n",
-              100 * l2, 100 * all_l2, edge_pixels, pixels * pixels);
-  EXPECT_LE(l2, 1e-4);     // float arithmetic and bilinear weights only
+  std::printf(
+      "GL vs CPU (shadowed scene): relative L2 %.5f %% away from shadow edges, %.3f %% "
+      "over all pixels (%d of %d near an edge)\n",
+      100 * l2, 100 * all_l2, edge_pixels, pixels * pixels);
+  EXPECT_LE(l2, 1e-4);      // float arithmetic and bilinear weights only
   EXPECT_LE(all_l2, 0.03);  // the edge pixels: partial visibility from the 2x2 shadow filter
   EXPECT_GT(all_l2, l2);
   EXPECT_EQ(umbra_ref, 0.0);
@@ -237,8 +260,8 @@ TEST_F(PreviewSlabFiles, IncrementalPositionsEqualAFullRenderAndReuseShadowMaps)
   // Arrive in three groups, like --watch; each Render adds only the new lights.
   size_t done = 0;
   for (size_t group_end : {size_t(7), size_t(8), scanned.size()}) {
-    Upload(*live, std::vector<std::pair<int, int>>(scanned.begin() + done,
-                                                   scanned.begin() + group_end));
+    Upload(*live,
+           std::vector<std::pair<int, int>>(scanned.begin() + done, scanned.begin() + group_end));
     EXPECT_EQ(live->Render(), int(group_end - done));
     done = group_end;
   }

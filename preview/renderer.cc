@@ -98,13 +98,14 @@ in vec3 v_albedo;
 uniform sampler2DArray u_intensity;
 uniform sampler2DArrayShadow u_shadow;
 uniform int u_count;
-uniform vec2 u_centres[16];
-uniform int u_layers[16];
+uniform vec2 u_centres[LIGHTS_PER_PASS];
+uniform int u_layers[LIGHTS_PER_PASS];
 uniform bool u_shadows;
 uniform float u_offset_scale;  // normal offset per mm of distance (one shadow texel)
 uniform float u_radiance_scale;
 uniform bool u_srgbe;
 uniform usampler2D u_previous;
+uniform vec2 u_grid_half;  // half extent of the filter centres: the union of all spot cones
 layout(location = 0) out vec4 o_float;
 layout(location = 1) out uint o_packed;
 )") + kLightClip + kSrgbeCode + R"(
@@ -112,6 +113,11 @@ void main() {
   vec3 x = v_lum_position;
   vec3 n = normalize(v_lum_normal);
   vec3 sum = vec3(0.0);
+  // Outside every spot light's cone (behind S, or not through the window from any c_ij): no
+  // light. In float mode the fragment is dropped before the light loop (adds 0 anyway).
+  vec2 reach = 0.5 * u_window + u_grid_half * abs(1.0 - u_d / max(x.z, 1e-6));
+  bool dark = x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
+  if (dark && !u_srgbe) discard;
   for (int k = 0; k < u_count; ++k) {
     vec3 rel = x - vec3(u_centres[k], 0.0);
     if (rel.z <= 0.0) continue;
@@ -219,7 +225,10 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   present_.assign(lights, false);
   shadow_valid_.assign(lights, false);
   accumulated_.assign(lights, false);
-  gl_->scene_program = Link(kSceneVertex, kLightFragment);
+  std::string light_fragment = kLightFragment;
+  light_fragment.insert(light_fragment.find('\n') + 1,
+                        "#define LIGHTS_PER_PASS " + std::to_string(kLightsPerPass) + "\n");
+  gl_->scene_program = Link(kSceneVertex, light_fragment);
   gl_->depth_program = Link(kSceneVertex, kEmptyFragment);
   gl_->shadow_program = Link(kShadowVertex, kEmptyFragment);
   gl_->display_program = Link(kQuadVertex, kDisplayFragment);
@@ -229,7 +238,8 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
 
   glGenTextures(1, &gl_->intensity);
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
-  glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGB32F, info_.layout.res_x, info_.layout.res_y, lights);
+  glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, info_.layout.res_x, info_.layout.res_y,
+                 lights);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -421,6 +431,8 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glUniform1i(Loc(p, "u_shadows"), options_.shadows);
   glUniform1i(Loc(p, "u_srgbe"), options_.srgbe);
   glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
+  const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);
+  glUniform2f(Loc(p, "u_grid_half"), float(corner.x()), float(corner.y()));
   // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.
   glUniform1f(Loc(p, "u_offset_scale"),
               float(1.5 * info_.layout.window_w_mm / info_.distance_mm / options_.shadow_size));

@@ -27,7 +27,7 @@ struct RenderOptions {
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
 };
 
-constexpr int kLightsPerPass = 16;
+constexpr int kLightsPerPass = 64;
 
 class Renderer {
  public:

@@ -1,0 +1,182 @@
+// The paper's Table 1 (Granier et al. 2003) redone on this machine through OSMesa at 400x400:
+// crypt and cloister; 5x5, 7x7 and 9x7 slabs at 300x300; with and without shadows. Reports the
+// median fps of frames with a moving camera (shadow maps cached: what the window does while
+// orbiting) and of full frames that also re-render every shadow map (what the paper did each
+// frame), next to the paper's figures; plus the time to add one new position in live mode.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "preview/gl_context.h"
+#include "preview/light_field.h"
+#include "preview/point_emitters.h"
+#include "preview/renderer.h"
+#include "preview/run_preview.h"
+
+namespace lumislab {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+struct Slab {
+  SlabInfo info;
+  std::vector<ImageF> intensity;  // grid index order
+};
+
+Slab MakeSlab(int nu, int nv) {
+  Slab slab{MakeSlabInfo(750, nu, nv, 5, 1200, 300), {}};
+  const auto emitters = DefaultPointEmitters();
+  for (int j = 0; j < nv; ++j) {
+    for (int i = 0; i < nu; ++i) {
+      slab.intensity.push_back(IntensityFromIrradiance(
+          slab.info, i, j, TruthPosition(emitters, slab.info, i, j).irradiance));
+    }
+  }
+  return slab;
+}
+
+void UploadAll(const Slab& slab, Renderer& r) {
+  for (int j = 0; j < slab.info.grid.nv; ++j) {
+    for (int i = 0; i < slab.info.grid.nu; ++i) {
+      r.SetPosition(i, j, slab.intensity[slab.info.grid.Index(i, j)]);
+    }
+  }
+}
+
+int Run(int argc, char** argv) {
+  int frames = 7, size = 400, shadow_size = 512;
+  std::string csv = "preview_table1.csv";
+  bool quick = false;
+  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (DESIGN §8)"};
+  app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
+  app.add_option("--size", size, "image side")->capture_default_str();
+  app.add_option("--shadow-size", shadow_size, "shadow-map side")->capture_default_str();
+  app.add_option("--csv", csv, "CSV output")->capture_default_str();
+  app.add_flag("--quick", quick, "only crypt 5x5 and cloister 9x7 with shadows, no live");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
+  }
+  SetLogTool("preview_table1");
+  OffscreenContext context(16, 16);
+  std::printf("renderer: %s, %dx%d, shadow maps %d^2, median of %d frames\n",
+              context.Renderer().c_str(), size, size, shadow_size, frames);
+  struct Paper {
+    int nu, nv;
+    double crypt, crypt_ns, cloister, cloister_ns;
+  };
+  const Paper paper[] = {
+      {5, 5, 2.7, 3.2, 1.3, 1.6}, {7, 7, 1.5, 1.7, 0.7, 0.85}, {9, 7, 1.2, 1.4, 0.55, 0.7}};
+  std::ofstream out(csv);
+  out << "scene,triangles,grid,shadows,fps_cached,fps_full,paper_fps,ratio_cached,ratio_full\n";
+  std::printf("%-9s %5s %-5s %-7s %10s %10s %8s %8s %8s\n", "scene", "tris", "grid", "shadows",
+              "fps(cache)", "fps(full)", "paper", "ratio", "ratio");
+  std::printf("%-9s %5s %-5s %-7s %10s %10s %8s %8s %8s\n", "", "", "", "", "", "", "", "cache",
+              "full");
+  for (const std::string scene : {"crypt", "cloister"}) {
+    PreviewConfig config;
+    config.scene = scene;
+    for (const Paper& p : paper) {
+      const Slab slab = MakeSlab(p.nu, p.nv);
+      SceneSetup setup = MakeSceneSetup(config, slab.info);
+      if (quick &&
+          !((scene == "crypt" && p.nu == 5) || (scene == "cloister" && p.nv == 7 && p.nu == 9))) {
+        continue;
+      }
+      for (bool shadows : {true, false}) {
+        if (quick && !shadows) continue;
+        RenderOptions options;
+        options.shadows = shadows;
+        options.shadow_size = shadow_size;
+        Renderer r(slab.info, size, size, options);
+        r.SetScene(setup.mesh);
+        r.SetPose(setup.pose);
+        UploadAll(slab, r);
+        r.SetCamera(OrbitCamera(setup, 1.0));
+        r.Render();  // warm-up: shaders, shadow maps
+        std::vector<double> cached, full;
+        SceneSetup moving = setup;
+        for (int f = 0; f < frames; ++f) {
+          moving.camera_yaw_deg += 2;
+          r.SetCamera(OrbitCamera(moving, 1.0));
+          auto start = Clock::now();
+          r.Render();
+          cached.push_back(Seconds(start));
+          moving.camera_yaw_deg += 2;
+          r.SetCamera(OrbitCamera(moving, 1.0));
+          r.SetPose(setup.pose);  // invalidates every shadow map, as a pose change does
+          start = Clock::now();
+          r.Render();
+          full.push_back(Seconds(start));
+        }
+        const double fps_cached = 1 / Median(cached), fps_full = 1 / Median(full);
+        const double paper_fps = scene == "crypt" ? (shadows ? p.crypt : p.crypt_ns)
+                                                  : (shadows ? p.cloister : p.cloister_ns);
+        char grid[16];
+        std::snprintf(grid, sizeof(grid), "%dx%d", p.nu, p.nv);
+        std::printf("%-9s %5zu %-5s %-7s %10.2f %10.2f %8.2f %8.1f %8.1f\n", scene.c_str(),
+                    setup.mesh.triangles(), grid, shadows ? "yes" : "no", fps_cached, fps_full,
+                    paper_fps, fps_cached / paper_fps, fps_full / paper_fps);
+        std::fflush(stdout);
+        out << scene << ',' << setup.mesh.triangles() << ',' << grid << ','
+            << (shadows ? "yes" : "no") << ',' << fps_cached << ',' << fps_full << ',' << paper_fps
+            << ',' << fps_cached / paper_fps << ',' << fps_full / paper_fps << '\n';
+      }
+    }
+  }
+  // Live mode: positions arrive one at a time (crypt, 9x7, shadows); each Render adds exactly the
+  // new light (its shadow map and one light pass) to the accumulated image.
+  if (!quick) {
+    PreviewConfig config;
+    const Slab slab = MakeSlab(9, 7);
+    const SceneSetup setup = MakeSceneSetup(config, slab.info);
+    RenderOptions options;
+    options.shadow_size = shadow_size;
+    Renderer r(slab.info, size, size, options);
+    r.SetScene(setup.mesh);
+    r.SetPose(setup.pose);
+    r.SetCamera(OrbitCamera(setup, 1.0));
+    r.Render();
+    std::vector<double> upload, add;
+    for (int j = 0; j < 7; ++j) {
+      for (int i = 0; i < 9; ++i) {
+        const auto emitters = DefaultPointEmitters();
+        const SlabPosition pos = TruthPosition(emitters, slab.info, i, j);
+        auto start = Clock::now();
+        r.SetPosition(i, j, IntensityFromIrradiance(slab.info, i, j, pos.irradiance));
+        upload.push_back(Seconds(start));
+        start = Clock::now();
+        if (r.Render() != 1) throw Failure("live mode added more than the new position");
+        add.push_back(Seconds(start));
+      }
+    }
+    std::printf(
+        "live (crypt, 9x7, shadows): add one position: E' + upload %.1f ms, shadow map + light "
+        "pass %.1f ms (median of 63)\n",
+        1000 * Median(upload), 1000 * Median(add));
+    out << "live_add_one_position_ms," << 1000 * (Median(upload) + Median(add)) << '\n';
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace lumislab
+
+int main(int argc, char** argv) {
+  return lumislab::RunMain("preview_table1", [&] { return lumislab::Run(argc, argv); });
+}

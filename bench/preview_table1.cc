@@ -103,6 +103,7 @@ int Run(int argc, char** argv) {
         RenderOptions options;
         options.shadows = shadows;
         options.shadow_size = shadow_size;
+        options.cull_back_faces = setup.closed_room;
         Renderer r(slab.info, size, size, options);
         r.SetScene(setup.mesh);
         r.SetPose(setup.pose);

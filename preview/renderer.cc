@@ -470,8 +470,10 @@ void Renderer::LightPass(const std::vector<int>& lights) {
     glEnablei(GL_BLEND, 0);
     glBlendFunci(0, GL_ONE, GL_ONE);
   }
+  if (options_.cull_back_faces) glEnable(GL_CULL_FACE);
   glBindVertexArray(gl_->vao);
   glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+  glDisable(GL_CULL_FACE);
   glDisablei(GL_BLEND, 0);
   glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -497,12 +499,14 @@ int Renderer::Render() {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    if (options_.cull_back_faces) glEnable(GL_CULL_FACE);
     glUseProgram(gl_->depth_program);
     glUniformMatrix4fv(Loc(gl_->depth_program, "u_view_projection"), 1, GL_FALSE,
                        view_projection_.data());
     glBindVertexArray(gl_->vao);
     glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDisable(GL_CULL_FACE);
     accumulated_.assign(accumulated_.size(), false);
     view_valid_ = true;
   }

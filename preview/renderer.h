@@ -25,6 +25,7 @@ struct RenderOptions {
   bool srgbe = false;                              // sRGBE-packed accumulation instead of float
   int shadow_size = 512;                           // shadow-map texels per side
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
+  bool cull_back_faces = false;  // camera passes only: see into a closed room from outside
 };
 
 constexpr int kLightsPerPass = 64;

@@ -46,6 +46,7 @@ struct SceneSetup {
   Eigen::Vector3d camera_target{0, 0, 0};
   double camera_distance = 3000, camera_yaw_deg = 30, camera_pitch_deg = 20;
   bool plane = false;
+  bool closed_room = false;  // built-in rooms: cull back faces so the camera sees in
   double plane_z = 0, extent = 0;
 };
 SceneSetup MakeSceneSetup(const PreviewConfig& config, const SlabInfo& info);

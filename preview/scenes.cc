@@ -31,22 +31,23 @@ void AddPillar(Mesh& m, float x, float z, float r, float y0, float y1, int sides
   }
 }
 
-// An arch between (x0, z) and (x1, z) (pillar tops at height y), thickness along z, `segments`
-// pieces of a half circle, with the spandrel filled up to y + rise + band.
+// An arch between pillar tops a and b (at height y), `thickness` across, `segments` pieces of a
+// half ellipse (rise 0.3 span), the spandrels filled up to a band 0.1 span above the crown.
 void AddArch(Mesh& m, const V& a, const V& b, float y, float thickness, int segments,
              const V& colour) {
   const V axis = (b - a);
   const float span = axis.norm();
   const V dir = axis / span;
   const V side = V(0, 1, 0).cross(dir).normalized() * (0.5f * thickness);
-  const float radius = 0.5f * span;
-  const float top = y + radius + 0.15f * span;
+  const float half = 0.5f * span;
+  const float rise = 0.3f * span;  // elliptical arch, flatter than a half circle
+  const float top = y + rise + 0.1f * span;
   const V centre = 0.5f * (a + b) + V(0, y, 0);
   for (int k = 0; k < segments; ++k) {
     const float t0 = kPi * k / segments;
     const float t1 = kPi * (k + 1) / segments;
-    const V q0 = centre - dir * (radius * std::cos(t0)) + V(0, radius * std::sin(t0), 0);
-    const V q1 = centre - dir * (radius * std::cos(t1)) + V(0, radius * std::sin(t1), 0);
+    const V q0 = centre - dir * (half * std::cos(t0)) + V(0, rise * std::sin(t0), 0);
+    const V q1 = centre - dir * (half * std::cos(t1)) + V(0, rise * std::sin(t1), 0);
     // Intrados (underside of the arch), facing down/in.
     m.AddQuad(q0 - side, q1 - side, q1 + side, q0 + side, colour);
     // Spandrel faces on both sides: from the curve up to the top band.

@@ -61,6 +61,7 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
   options.srgbe = config.srgbe;
   options.shadow_size = config.shadow_size;
   if (setup.plane) options.radiance_scale = 1.0;
+  options.cull_back_faces = setup.closed_room;
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(context.window(), &fb_w, &fb_h);
   Renderer renderer(info, fb_w, fb_h, options);

@@ -110,7 +110,7 @@ int RunHeadless(const PreviewConfig& config) {
     LogInfo("bench: ", config.bench_frames, " frames (camera moving, shadow maps cached), median ",
             median * 1000, " ms = ", 1.0 / median, " fps");
   }
-  while (config.watch && !info.Complete() && !g_stop) {
+  while (config.watch && renderer.PositionCount() < info.grid.count() && !g_stop) {
     std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
     try {
       info = SlabInfo::Load(config.slab_dir);

@@ -123,10 +123,11 @@ TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
   const double plane_z = 1000, extent = 1400, occ_z = 500,
                occ_half = 103;  // shadow edges pass near pixel centres
   Mesh mesh = MakeReceiverPlane(plane_z, 2 * extent);
-  mesh.AddQuad({-float(occ_half), -float(occ_half), float(occ_z)},
-               {-float(occ_half), float(occ_half), float(occ_z)},
-               {float(occ_half), float(occ_half), float(occ_z)},
-               {float(occ_half), -float(occ_half), float(occ_z)}, {1, 1, 1});
+  // Off-centre (+x, +y) so that a flipped image axis shows: the umbra is around 2 * occ_centre.
+  const Eigen::Vector2d occ_centre(150, 70);
+  const float ox = float(occ_centre.x()), oy = float(occ_centre.y()), oh = float(occ_half);
+  mesh.AddQuad({ox - oh, oy - oh, float(occ_z)}, {ox - oh, oy + oh, float(occ_z)},
+               {ox + oh, oy + oh, float(occ_z)}, {ox + oh, oy - oh, float(occ_z)}, {1, 1, 1});
   RenderOptions options;
   options.radiance_scale = 1.0;
   options.shadow_size = 1024;
@@ -158,7 +159,8 @@ TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
       for (int j = 0; j < 3; ++j) {
         for (int i = 0; i < 3; ++i) {
           const Eigen::Vector2d c = info.grid.Centre(i, j);
-          const Eigen::Vector2d hit = c + (x.head<2>() - c) * (occ_z / plane_z);
+          const Eigen::Vector2d hit =
+              c + (x.head<2>() - c) * (occ_z / plane_z) - occ_centre;  // occluder frame
           near_edge |= std::abs(hit.cwiseAbs().maxCoeff() - occ_half) < 2.0;
           if (std::abs(hit.x()) < occ_half && std::abs(hit.y()) < occ_half) continue;
           ref += SpotIrradiance(info, i, j, intensity[j * 3 + i], x, {0, 0, -1});
@@ -173,7 +175,7 @@ TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
         diff2 += e2;
         norm2 += ref[ch] * ref[ch];
       }
-      if (x.head<2>().norm() < 150) {  // deep umbra: the occluder's shadow is ~2x its size
+      if ((x.head<2>() - 2 * occ_centre).norm() < 150) {  // deep umbra (shadow ~2x the size)
         umbra += image.at(col, row, 0);
         umbra_ref += ref[0];
       }
@@ -185,7 +187,7 @@ TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
       "over all pixels (%d of %d near an edge)\n",
       100 * l2, 100 * all_l2, edge_pixels, pixels * pixels);
   EXPECT_LE(l2, 1e-4);      // float arithmetic and bilinear weights only
-  EXPECT_LE(all_l2, 0.03);  // the edge pixels: partial visibility from the 2x2 shadow filter
+  EXPECT_LE(all_l2, 0.10);  // edge pixels (~3 %): partial visibility of a light (1/9 of the sum)
   EXPECT_GT(all_l2, l2);
   EXPECT_EQ(umbra_ref, 0.0);
   EXPECT_LE(umbra, 1e-6 * norm2);  // the shadow is dark in GL too

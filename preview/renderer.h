@@ -22,8 +22,9 @@ namespace lumislab {
 
 struct RenderOptions {
   bool shadows = true;
-  bool srgbe = false;                              // sRGBE-packed accumulation instead of float
-  int shadow_size = 512;                           // shadow-map texels per side
+  bool srgbe = false;       // sRGBE-packed accumulation instead of float
+  int shadow_size = 512;    // shadow-map texels per side
+  bool shadow_pcf = false;  // 2x2 filtered depth compare (softer edges, ~15 % slower)
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
   bool cull_back_faces = false;  // camera passes only: see into a closed room from outside
 };

@@ -47,6 +47,7 @@ int RunHeadless(const PreviewConfig& config) {
   options.shadows = config.shadows;
   options.srgbe = config.srgbe;
   options.shadow_size = config.shadow_size;
+  options.shadow_pcf = config.shadow_pcf;
   if (setup.plane) options.radiance_scale = 1.0;
   options.cull_back_faces = setup.closed_room;
   const int width = setup.plane ? config.width : config.width;
@@ -261,6 +262,7 @@ int RunPreview(int argc, char** argv) {
   app.add_flag("--srgbe-error", config.report_srgbe_error,
                "also render with the other accumulation format and report the difference");
   app.add_option("--shadow-size", config.shadow_size, "shadow-map size")->capture_default_str();
+  app.add_flag("--shadow-pcf", config.shadow_pcf, "2x2 filtered shadow-map lookups");
   app.add_flag("--watch", config.watch, "poll the slab folder and add positions as they arrive");
   app.add_option("--poll", config.poll_s, "--watch polling interval (s)")->capture_default_str();
   app.add_flag("--window", config.window, "interactive GLFW window (needs a display)");

@@ -26,6 +26,7 @@ struct PreviewConfig {
   bool shadows = true;
   bool srgbe = false;
   int shadow_size = 512;
+  bool shadow_pcf = false;
   bool watch = false;
   double poll_s = 0.5;
   bool window = false;

@@ -60,6 +60,7 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
   options.shadows = config.shadows;
   options.srgbe = config.srgbe;
   options.shadow_size = config.shadow_size;
+  options.shadow_pcf = config.shadow_pcf;
   if (setup.plane) options.radiance_scale = 1.0;
   options.cull_back_faces = setup.closed_room;
   int fb_w = 0, fb_h = 0;

@@ -1,0 +1,178 @@
+#include "acquire/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/json.h"
+
+namespace lumislab {
+namespace {
+
+const char* kDefaultSceneJson = R"({
+  "schema_version": 1,
+  "setup": { "distance_mm": 750, "grid": {"nu": 9, "nv": 7, "spacing_mm": 5},
+             "screen_mm": [1200, 1200] },
+  "filter": { "k_max": 1 },
+  "luminaire": { "emitters": [
+    {"position_mm": [1.5, -2, -20], "intensity_w_sr": [1.0, 0.9, 0.8], "lobe_exponent": 8},
+    {"position_mm": [-3, 1, -12], "intensity_w_sr": [0.5, 0.6, 0.9], "lobe_exponent": 3} ] },
+  "camera": { "size_px": [1600, 1200], "focal_px": 1300, "position_mm": [0, -400, 2400],
+              "look_at_mm": [0, 0, 750] },
+  "effects": []
+}
+)";
+
+double NonNegative(const JsonView& v) {
+  if (!v.raw().is_number() || !std::isfinite(v.raw().get<double>()) ||
+      !(v.raw().get<double>() >= 0))
+    v.Fail("number >= 0");
+  return v.raw().get<double>();
+}
+
+Eigen::Vector3d Vec3(const JsonView& v) {
+  const std::vector<double> a = v.Numbers(3);
+  return {a[0], a[1], a[2]};
+}
+
+void ParseSetup(const JsonView& root, SynthScene* scene) {
+  const JsonView setup = root["setup"];
+  scene->distance_mm = setup["distance_mm"].Positive();
+  scene->grid.nu = setup["grid"]["nu"].IntIn(1, 1000);
+  scene->grid.nv = setup["grid"]["nv"].IntIn(1, 1000);
+  scene->grid.spacing_mm = setup["grid"]["spacing_mm"].Positive();
+  const std::vector<double> screen = setup["screen_mm"].Numbers(2);
+  if (!(screen[0] > 0 && screen[1] > 0)) setup["screen_mm"].Fail("two lengths > 0 (w, h in mm)");
+  scene->screen_w_mm = screen[0];
+  scene->screen_h_mm = screen[1];
+  if (root.Has("filter"))
+    scene->k_max = root["filter"].Has("k_max") ? root["filter"]["k_max"].IntIn(1, 8) : 1;
+}
+
+void ParseLuminaire(const JsonView& root, SynthScene* scene) {
+  const JsonView emitters = root["luminaire"]["emitters"];
+  if (emitters.Size() == 0) emitters.Fail("a non-empty array of emitters");
+  for (size_t k = 0; k < emitters.Size(); ++k) {
+    const JsonView e = emitters[k];
+    Emitter emitter;
+    emitter.position_mm = Vec3(e["position_mm"]);
+    if (!(emitter.position_mm.z() < 0))
+      e["position_mm"].Fail("a point behind the filter plane S (z < 0 mm)");
+    const JsonView intensity = e["intensity_w_sr"];
+    emitter.intensity_w_sr = Vec3(intensity);
+    for (size_t c = 0; c < 3; ++c) NonNegative(intensity[c]);
+    emitter.lobe_exponent = NonNegative(e["lobe_exponent"]);
+    scene->luminaire.emitters.push_back(emitter);
+  }
+}
+
+void ParseCamera(const JsonView& root, SynthScene* scene) {
+  const JsonView cam = root["camera"];
+  CameraSpec& c = scene->camera;
+  c.width = cam["size_px"][0].IntIn(16, 20000);
+  c.height = cam["size_px"][1].IntIn(16, 20000);
+  if (cam["size_px"].Size() != 2) cam["size_px"].Fail("[width, height] in pixels");
+  c.focal_px = cam["focal_px"].Positive();
+  c.position_mm = Vec3(cam["position_mm"]);
+  c.look_at_mm = Vec3(cam["look_at_mm"]);
+  if ((c.look_at_mm - c.position_mm).norm() < 1e-6)
+    cam["look_at_mm"].Fail("a point different from camera.position_mm");
+  if (std::abs(c.position_mm.z() - scene->distance_mm) < 1e-6)
+    cam["position_mm"].Fail(
+        "a point off the screen plane z = " + std::to_string(scene->distance_mm) + " mm");
+  c.exposure = cam.Has("exposure") ? cam["exposure"].Positive() : 1.0;
+  c.radiometric_scale_w_m2 =
+      cam.Has("radiometric_scale_w_m2") ? cam["radiometric_scale_w_m2"].Positive() : 0.0;
+}
+
+// A checkerboard centred on the screen: 14 x 11 squares of 60 mm, smaller on small screens.
+void ParseCalibration(const JsonView& root, SynthScene* scene) {
+  CalibrationTarget& t = scene->calibration;
+  t.photo = "photos/calib_0.png";
+  t.squares_x = 14;
+  t.squares_y = 11;
+  t.square_mm = std::min(60.0, 0.8 * std::min(scene->screen_w_mm / 14, scene->screen_h_mm / 11));
+  if (root.Has("calibration")) {
+    const JsonView c = root["calibration"];
+    if (c.Has("squares")) {
+      t.squares_x = c["squares"][0].IntIn(3, 200);
+      t.squares_y = c["squares"][1].IntIn(3, 200);
+    }
+    if (c.Has("square_mm")) t.square_mm = c["square_mm"].Positive();
+    if (t.squares_x * t.square_mm > scene->screen_w_mm ||
+        t.squares_y * t.square_mm > scene->screen_h_mm)
+      c.Fail("a checkerboard that fits on the screen");
+  }
+  t.origin_mm = {-0.5 * t.squares_x * t.square_mm, -0.5 * t.squares_y * t.square_mm};
+}
+
+}  // namespace
+
+bool SynthScene::Quantized() const {
+  return std::any_of(effects.begin(), effects.end(), [](const auto& e) { return e->Quantizes(); });
+}
+
+SynthScene ParseScene(const std::string& json_text, const std::string& name) {
+  const JsonDocument doc = JsonDocument::Parse(json_text, name);
+  doc.CheckSchemaVersion(kSceneSchemaVersion);
+  const JsonView root = doc.root();
+  SynthScene scene;
+  scene.source = name;
+  ParseSetup(root, &scene);
+  ParseLuminaire(root, &scene);
+  ParseCamera(root, &scene);
+  ParseCalibration(root, &scene);
+  if (root.Has("effects")) {
+    const JsonView effects = root["effects"];
+    for (size_t k = 0; k < effects.Size(); ++k) scene.effects.push_back(MakeEffect(effects[k]));
+  }
+  return scene;
+}
+
+SynthScene LoadScene(const std::string& path_or_default) {
+  if (path_or_default == "default") return DefaultScene();
+  const JsonDocument doc = JsonDocument::Load(path_or_default);  // bad input if missing
+  return ParseScene(doc.raw().dump(), path_or_default);
+}
+
+SynthScene DefaultScene() {
+  SynthScene scene = ParseScene(kDefaultSceneJson, "default scene");
+  scene.source = "default";
+  return scene;
+}
+
+std::string DefaultSceneJson() { return kDefaultSceneJson; }
+
+Dataset DatasetSkeleton(const SynthScene& scene) {
+  Dataset ds;
+  ds.distance_mm = scene.distance_mm;
+  ds.grid = scene.grid;
+  ds.screen_w_mm = scene.screen_w_mm;
+  ds.screen_h_mm = scene.screen_h_mm;
+  const DualFilter filter = scene.Filter();
+  ds.filter.basis = "bell";
+  ds.filter.spacing_mm = scene.grid.spacing_mm;
+  ds.filter.dual_coefficients = filter.coefficients();
+  ds.filter.peak = filter.Peak2D();
+  ds.saturation_level = 1.0;
+  ds.calibration = scene.calibration;
+  ds.synthetic = true;
+  return ds;
+}
+
+std::vector<PhotoEntry> PhotoList(const SynthScene& scene) {
+  std::vector<PhotoEntry> list;
+  const std::string ext = scene.PhotoExtension();
+  for (int j = 0; j < scene.grid.nv; ++j)
+    for (int i = 0; i < scene.grid.nu; ++i)
+      for (bool positive : {true, false})
+        list.push_back({i, j, positive, "photos/" + PhotoFileName(i, j, positive, ext),
+                        scene.camera.exposure});
+  return list;
+}
+
+int PhotoIndex(const SynthScene& scene, int i, int j, bool positive) {
+  return 2 * scene.grid.Index(i, j) + (positive ? 0 : 1);
+}
+
+}  // namespace lumislab

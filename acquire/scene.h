@@ -1,0 +1,52 @@
+// The synthetic scene: setup, luminaire, camera, calibration target and effects (DESIGN §8).
+// Read from a JSON scene file (validated through core/json.h) or the built-in "default".
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "acquire/camera.h"
+#include "acquire/effects.h"
+#include "acquire/luminaire.h"
+#include "core/dataset.h"
+#include "core/grid.h"
+
+namespace lumislab {
+
+constexpr int kSceneSchemaVersion = 1;
+
+struct SynthScene {
+  std::string source;      // scene file name, or "default"
+  double distance_mm = 0;  // d, luminaire frame
+  SamplingGrid grid;
+  double screen_w_mm = 0;  // physical screen, lab frame, centred on the optical axis
+  double screen_h_mm = 0;
+  int k_max = 1;  // filter truncation (DESIGN §2)
+  Luminaire luminaire;
+  CameraSpec camera;
+  CalibrationTarget calibration;                       // photo = photos/calib_0.png
+  std::vector<std::shared_ptr<const Effect>> effects;  // in the order listed
+
+  DualFilter Filter() const { return DualFilter::Truncated(k_max); }
+  bool Quantized() const;             // photos are 16-bit PNG (else float EXR)
+  std::string PhotoExtension() const  // "png" or "exr"
+  {
+    return Quantized() ? "png" : "exr";
+  }
+};
+
+// "default" or a scene file; errors name the file and the field (exit 2).
+SynthScene LoadScene(const std::string& path_or_default);
+SynthScene ParseScene(const std::string& json_text, const std::string& name);
+SynthScene DefaultScene();
+std::string DefaultSceneJson();  // the built-in scene as a scene file
+
+// dataset.json without photos or radiometric scale: setup, filter, calibration, synthetic.
+Dataset DatasetSkeleton(const SynthScene& scene);
+// The full photo list (for every position j-major, i, then slides p, n); photo k of the list
+// is the k passed to the effects.
+std::vector<PhotoEntry> PhotoList(const SynthScene& scene);
+int PhotoIndex(const SynthScene& scene, int i, int j, bool positive);
+
+}  // namespace lumislab

@@ -1,0 +1,47 @@
+// lumislab-acquire synth: the synthetic capture of a scene into a dataset folder (DESIGN §5, §8).
+#pragma once
+
+#include <string>
+
+#include "acquire/render.h"
+#include "acquire/scene.h"
+#include "core/image.h"
+
+namespace lumislab {
+
+struct SynthOptions {
+  std::string scene = "default";  // scene file or "default"
+  std::string out_dir;
+  double interval_s = -1;  // >= 0: live acquisition, positions one by one with this pause
+  bool force = false;      // redo a complete dataset
+  int threads = 0;         // 0: all cores
+  int truth_resolution = 300;
+  bool compress_exr = false;  // PIZ for the float photos (smaller, slower)
+
+  void Check() const;  // BadInput naming the option
+};
+
+struct SynthReport {
+  bool skipped = false;  // the folder already held a complete dataset
+  double radiometric_scale = 0;
+  int photos_written = 0;
+};
+
+// Runs the whole capture; callable from tests without a process.
+SynthReport RunSynth(const SynthOptions& options);
+SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options);
+
+// Radiometric scale (W/m^2 per unit value at exposure 1) that puts the brightest pixel of all
+// photos at about 0.85, or the scene camera's explicit one.
+double ChooseRadiometricScale(const SynthScene& scene, int threads);
+
+// Applies the scene's effects, in list order, to photo `photo_index` (see PhotoIndex).
+void ApplyEffects(const SynthScene& scene, int photo_index, ImageF* photo);
+// The finished photo of one slide as stored: render + effects. Exposed for tests.
+ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale, int i, int j,
+                  bool positive);
+
+// True when `dir` holds a dataset.json whose photos, calibration photo and truth all exist.
+bool DatasetComplete(const std::string& dir);
+
+}  // namespace lumislab

@@ -1,0 +1,81 @@
+#include "acquire/truth.h"
+
+#include <atomic>
+#include <nlohmann/json.hpp>
+#include <thread>
+#include <vector>
+
+#include "acquire/camera.h"
+#include "core/json.h"
+
+namespace lumislab {
+
+SlabPosition TruthPosition(const SynthScene& scene, const SlabInfo& info, int i, int j) {
+  SlabPosition p;
+  p.i = i;
+  p.j = j;
+  p.irradiance = ImageF(info.layout.res_x, info.layout.res_y, 3);
+  p.mask = ImageF(info.layout.res_x, info.layout.res_y, 1, 1.f);
+  const DualFilter filter = info.filter.Filter();
+  const Eigen::Vector2d c = info.grid.Centre(i, j);
+  for (int row = 0; row < info.layout.res_y; ++row)
+    for (int col = 0; col < info.layout.res_x; ++col) {
+      const Eigen::Vector2d st = info.layout.TexelCentre(col, row);
+      const Eigen::Vector3d e = scene.luminaire.FilteredIrradiance(
+          filter, info.grid.spacing_mm, c, info.distance_mm, st.x(), st.y());
+      for (int ch = 0; ch < 3; ++ch) p.irradiance.at(col, row, ch) = float(e[ch]);
+    }
+  return p;
+}
+
+void WriteTruthSlab(const SynthScene& scene, const Dataset& dataset, const std::string& truth_dir,
+                    int resolution, int threads) {
+  SlabInfo info = SlabInfo::FromDataset(dataset, resolution);
+  std::atomic<int> next{0};
+  auto work = [&] {
+    for (int q = next++; q < scene.grid.count(); q = next++) {
+      const int i = q % scene.grid.nu, j = q / scene.grid.nu;
+      WriteSlabPosition(truth_dir, info, TruthPosition(scene, info, i, j));
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
+  for (int j = 0; j < scene.grid.nv; ++j)
+    for (int i = 0; i < scene.grid.nu; ++i) info.MarkPresent(i, j);
+  info.Save(truth_dir);
+}
+
+namespace {
+nlohmann::json RowMajor(const Eigen::Matrix3d& m) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) a.push_back(m(r, c));
+  return a;
+}
+nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+}  // namespace
+
+void WriteTruthCamera(const SynthScene& scene, const std::string& path) {
+  const PinholeCamera camera(scene.camera);
+  const Eigen::Matrix3d k = camera.K();
+  nlohmann::json j;
+  j["schema_version"] = 1;
+  j["size_px"] = {scene.camera.width, scene.camera.height};
+  j["focal_px"] = scene.camera.focal_px;
+  j["principal_point_px"] = {k(0, 2), k(1, 2)};
+  j["K"] = RowMajor(k);
+  j["distortion"] = {{"k1", 0.0}, {"k2", 0.0}};
+  j["position_mm"] = Vec(scene.camera.position_mm);
+  j["look_at_mm"] = Vec(scene.camera.look_at_mm);
+  // Columns are the camera axes (x right, y down, z forward) in the lab frame.
+  j["lab_from_camera"] = RowMajor(camera.lab_from_camera());
+  j["screen_plane_z_mm"] = scene.distance_mm;
+  j["screen_from_image"] = RowMajor(camera.ScreenFromImage(scene.distance_mm));
+  j["image_from_screen"] = RowMajor(camera.ImageFromScreen(scene.distance_mm));
+  j["exposure"] = scene.camera.exposure;
+  WriteJsonAtomically(path, j);
+}
+
+}  // namespace lumislab

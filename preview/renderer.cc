@@ -91,7 +91,10 @@ vec3 DecodeSrgbe(uint p) {
 }
 )";
 
+// Early depth tests even with discard (depth writes are off in light passes): only the visible
+// fragment of each pixel is shaded.
 const std::string kLightFragment = std::string(R"(#version 450 core
+layout(early_fragment_tests) in;
 in vec3 v_lum_position;
 in vec3 v_lum_normal;
 in vec3 v_albedo;

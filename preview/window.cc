@@ -51,6 +51,24 @@ void SaveScreenshot(const std::string& path, int w, int h) {
   LogInfo("screenshot -> ", path);
 }
 
+// Overlay in the top-left corner: one small square per grid position (i to the right, j up),
+// bright when the position has arrived, dark when not. Drawn with scissored clears.
+void DrawArrivalOverlay(const SlabInfo& info, const Renderer& renderer, int fb_h) {
+  const int cell = 8, gap = 2, margin = 8;
+  glEnable(GL_SCISSOR_TEST);
+  for (int j = 0; j < info.grid.nv; ++j) {
+    for (int i = 0; i < info.grid.nu; ++i) {
+      const bool here = renderer.HasPosition(i, j);
+      glScissor(margin + i * (cell + gap),
+                fb_h - margin - info.grid.nv * (cell + gap) + j * (cell + gap), cell, cell);
+      glClearColor(here ? 0.2f : 0.15f, here ? 0.9f : 0.15f, here ? 0.3f : 0.15f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+    }
+  }
+  glDisable(GL_SCISSOR_TEST);
+  glClearColor(0, 0, 0, 0);
+}
+
 }  // namespace
 
 int RunWindow(const PreviewConfig& config, SlabInfo info) {
@@ -169,6 +187,7 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
       exposure_factor = ExposureFactor(renderer.Read(), 0, config.auto_exposure);
     }
     renderer.Display(exposure_factor * std::pow(2.0, state.exposure_stops), fb_w, fb_h);
+    DrawArrivalOverlay(info, renderer, fb_h);
     std::ostringstream title;
     title << "lumislab-preview  " << renderer.PositionCount() << "/" << info.grid.count()
           << " positions";

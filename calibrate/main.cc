@@ -1,0 +1,6 @@
+#include "calibrate/screen_calibrator.h"
+#include "core/error.h"
+
+int main(int argc, char** argv) {
+  return lumislab::RunMain("calibrate", [&] { return lumislab::RunCalibrate(argc, argv); });
+}

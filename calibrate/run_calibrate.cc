@@ -1,0 +1,104 @@
+// lumislab-calibrate: command-line parsing around CalibrateScreen.
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <sstream>
+#include <thread>
+
+#include "calibrate/screen_calibrator.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/log.h"
+
+namespace lumislab {
+
+namespace {
+
+struct ScreenCommand {
+  std::string dataset_dir;
+  bool force = false;
+  ScreenCalibratorOptions options;
+};
+
+int RunScreen(const ScreenCommand& command, int threads) {
+  std::ostringstream params;
+  params << "dataset=" << command.dataset_dir << " force=" << (command.force ? "yes" : "no")
+         << " threads=" << threads << " huber_px=" << command.options.refiner.huber_px
+         << " distortion_terms=" << command.options.refiner.distortion_terms
+         << " max_rms_px=" << command.options.max_rms_px
+         << " max_detection_px=" << command.options.detection.max_detection_px;
+  LogInfo("parameters: ", params.str());
+  const Dataset dataset = Dataset::Load(command.dataset_dir);
+  const std::string out = dataset.Path("calib/screen.json");
+  if (std::filesystem::exists(out) && !command.force) {
+    LogInfo(out, " exists, skipping (use --force to recalibrate)");
+    return 0;
+  }
+  ScreenCalibrationReport report;
+  const ScreenCalibration c = CalibrateScreen(dataset, command.options, &report);
+  MakeDirectories(dataset.Path("calib"));
+  c.Save(out);
+  LogInfo("board: ", c.corners_used, " corners (", report.corners.detector, " detector, grid ",
+          report.corners.orientation, ", squares ", report.corners.square_px, " px, dot contrast ",
+          report.corners.dot_contrast, ")");
+  LogInfo("view: board covers ", 100 * report.board_fraction,
+          " % of the photo, local stretch <= ", report.anisotropy, ", condition ",
+          report.condition);
+  LogDebug("ceres: ", report.refinement.message);
+  LogInfo("distortion: k1 = ", c.k1, ", k2 = ", c.k2, " (", report.distortion_terms,
+          " term(s), scale ", c.scale_px, " px)");
+  LogInfo("rms: ", c.rms_px, " px (OpenCV homography alone: ", report.initial_rms_px, " px), ",
+          c.rms_mm, " mm -> ", out);
+  return 0;
+}
+
+}  // namespace
+
+int RunCalibrate(int argc, char** argv) {
+  CLI::App app{"lumislab-calibrate: camera and screen calibration (DESIGN §5, calib/)"};
+  app.require_subcommand(1);
+  bool verbose = false;
+  int threads = 0;
+  app.add_flag("--verbose", verbose, "log details");
+  app.add_option("--threads", threads, "worker threads (default: all cores)");
+  ScreenCommand screen;
+  CLI::App* sub = app.add_subcommand(
+      "screen",
+      "photo of the checkerboard on the screen -> calib/screen.json (image -> screen mm, "
+      "homography + radial distortion)");
+  sub->add_option("--dataset", screen.dataset_dir, "dataset folder (with dataset.json)")
+      ->required();
+  sub->add_flag("--force", screen.force, "recalibrate even if calib/screen.json exists");
+  sub->add_flag("--verbose", verbose, "log details");
+  sub->add_option("--threads", threads, "worker threads (default: all cores)");
+  sub->add_option("--huber-px", screen.options.refiner.huber_px,
+                  "scale of the robust (Huber) loss, pixels")
+      ->capture_default_str();
+  sub->add_option("--distortion-terms", screen.options.refiner.distortion_terms,
+                  "radial terms to fit: 0, 1 (k1) or 2 (k1, k2)")
+      ->capture_default_str();
+  sub->add_option("--max-rms-px", screen.options.max_rms_px,
+                  "refuse the calibration when the reprojection RMS exceeds this (pixels)")
+      ->capture_default_str();
+  sub->add_option("--max-detection-px", screen.options.detection.max_detection_px,
+                  "find corners on a copy whose long side is at most this (pixels)")
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
+  }
+  SetLogTool("calibrate");
+  if (verbose) SetLogLevel(LogLevel::kDebug);
+  if (threads < 0) throw BadInput("--threads: expected >= 0, got " + std::to_string(threads));
+  if (threads == 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  cv::setNumThreads(threads);
+  screen.options.refiner.threads = threads;
+  screen.options.Check();
+  while (screen.dataset_dir.size() > 1 && screen.dataset_dir.back() == '/')
+    screen.dataset_dir.pop_back();
+  return RunScreen(screen, threads);
+}
+
+}  // namespace lumislab

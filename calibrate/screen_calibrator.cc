@@ -1,0 +1,235 @@
+#include "calibrate/screen_calibrator.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+
+#include "calibrate/photo_loader.h"
+#include "core/error.h"
+#include "core/log.h"
+
+namespace lumislab {
+
+namespace {
+
+std::string Num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.4g", v);
+  return buffer;
+}
+
+Eigen::Matrix3d ToEigen(const cv::Mat& h) {
+  Eigen::Matrix3d m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m(r, c) = h.at<double>(r, c);
+  return m;
+}
+
+// d dehomogenise(H [p, 1]) / dp, mm per pixel.
+Eigen::Matrix2d LocalJacobian(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
+  const Eigen::Vector3d q = h * p.homogeneous();
+  const Eigen::Vector2d x = q.head<2>() / q.z();
+  return (h.topLeftCorner<2, 2>() - x * h.block<1, 2>(2, 0)) / q.z();
+}
+
+// Checks the starting homography describes a usable view of the board; fills the report.
+void CheckView(const BoardCorners& corners, const Eigen::Matrix3d& h, const cv::Size& size,
+               const CalibrationTarget& target, const std::string& photo,
+               const ScreenCalibratorOptions& options, ScreenCalibrationReport* report) {
+  const int nc = target.squares_x - 1, nr = target.squares_y - 1;
+  const auto& p = corners.pixels;
+  const Eigen::Vector2d quad[4] = {p[0], p[nc - 1], p[nc * nr - 1], p[nc * (nr - 1)]};
+  double area = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d &a = quad[k], &b = quad[(k + 1) % 4];
+    area += a.x() * b.y() - a.y() * b.x();
+  }
+  report->board_fraction = 0.5 * std::abs(area) / (double(size.width) * size.height);
+  if (report->board_fraction < options.min_board_fraction)
+    throw BadInput(photo + ": degenerate view: the board covers only " +
+                   Num(100 * report->board_fraction) +
+                   " % of the photo (need >= " + Num(100 * options.min_board_fraction) + " %)");
+
+  double min_det = HUGE_VAL, max_det = 0, anisotropy = 0;
+  int sign = 0;
+  for (const auto& q : p) {
+    const Eigen::Matrix2d j = LocalJacobian(h, q);
+    const double det = j.determinant();
+    const int s = det > 0 ? 1 : det < 0 ? -1 : 0;
+    if (s == 0 || !std::isfinite(det) || (sign != 0 && s != sign))
+      throw BadInput(photo + ": degenerate view: the image -> screen mapping folds over the board");
+    sign = s;
+    const Eigen::Vector2d sv = Eigen::JacobiSVD<Eigen::Matrix2d>(j).singularValues();
+    anisotropy = std::max(anisotropy, sv(0) / sv(1));
+    min_det = std::min(min_det, std::abs(det));
+    max_det = std::max(max_det, std::abs(det));
+  }
+  report->anisotropy = anisotropy;
+  report->scale_ratio = max_det / min_det;
+  if (anisotropy > options.max_anisotropy || report->scale_ratio > options.max_scale_ratio)
+    throw BadInput(photo + ": degenerate view: grazing angle (local stretch " + Num(anisotropy) +
+                   ", need <= " + Num(options.max_anisotropy) + "; scale ratio over the board " +
+                   Num(report->scale_ratio) + ", need <= " + Num(options.max_scale_ratio) + ")");
+
+  // Condition number in coordinates normalised like the refinement's.
+  Eigen::Vector2d lo = p[0], hi = p[0];
+  for (const auto& q : p) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  const Eigen::Vector2d c = 0.5 * (lo + hi);
+  const double s = std::max(0.5 * (hi - lo).maxCoeff(), 1.0);
+  Eigen::Matrix3d t_image = Eigen::Matrix3d::Identity();
+  t_image.topLeftCorner<2, 2>() /= s;
+  t_image.topRightCorner<2, 1>() = -c / s;
+  const double w = target.squares_x * target.square_mm, ht = target.squares_y * target.square_mm;
+  Eigen::Matrix3d t_screen = Eigen::Matrix3d::Identity();
+  const double ss = 0.5 * std::max(w, ht);
+  t_screen.topLeftCorner<2, 2>() /= ss;
+  t_screen.topRightCorner<2, 1>() = -(target.origin_mm + 0.5 * Eigen::Vector2d(w, ht)) / ss;
+  const Eigen::Vector3d sv =
+      Eigen::JacobiSVD<Eigen::Matrix3d>(t_screen * h * t_image.inverse()).singularValues();
+  report->condition = sv(0) / sv(2);
+  if (!(report->condition <= options.max_condition))
+    throw BadInput(photo + ": degenerate view: homography condition number " +
+                   Num(report->condition) + " (need <= " + Num(options.max_condition) + ")");
+}
+
+// True when p_u(r) = r (1 + k1 r^2 + k2 r^4) increases over [0, r_max].
+bool Monotonic(double k1, double k2, double r_max) {
+  for (int k = 0; k <= 100; ++k) {
+    const double r2 = std::pow(r_max * k / 100.0, 2);
+    if (1 + 3 * k1 * r2 + 5 * k2 * r2 * r2 < 0.2) return false;
+  }
+  return true;
+}
+
+double RmsPx(const ScreenCalibration& c, const BoardCorners& corners) {
+  double sum = 0;
+  for (size_t i = 0; i < corners.pixels.size(); ++i)
+    sum += (c.ImageFromScreen(corners.screen_mm[i]) - corners.pixels[i]).squaredNorm();
+  return std::sqrt(sum / double(corners.pixels.size()));
+}
+
+double RmsMm(const ScreenCalibration& c, const BoardCorners& corners) {
+  double sum = 0;
+  for (size_t i = 0; i < corners.pixels.size(); ++i)
+    sum += (c.ScreenFromImage(corners.pixels[i]) - corners.screen_mm[i]).squaredNorm();
+  return std::sqrt(sum / double(corners.pixels.size()));
+}
+
+}  // namespace
+
+void ScreenCalibratorOptions::Check() const {
+  detection.Check();
+  refiner.Check();
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0 && std::isfinite(v)))
+      throw BadInput(std::string("calibrator options: ") + name + ": expected > 0, got " +
+                     std::to_string(v));
+  };
+  positive(max_rms_px, "max_rms_px");
+  positive(min_board_fraction, "min_board_fraction");
+  positive(max_anisotropy, "max_anisotropy");
+  positive(max_scale_ratio, "max_scale_ratio");
+  positive(max_condition, "max_condition");
+}
+
+void CheckCalibrationTarget(const CalibrationTarget& target, const std::string& file) {
+  const std::string got =
+      std::to_string(target.squares_x) + " x " + std::to_string(target.squares_y);
+  if (target.squares_x < 3 || target.squares_y < 3)
+    throw InputError(file, "calibration.target.squares", "at least 3 x 3 squares", got);
+  if (target.squares_x == target.squares_y)
+    throw InputError(file, "calibration.target.squares",
+                     "squares_x != squares_y (a square board with one dot looks the same "
+                     "mirrored about its diagonal)",
+                     got);
+  if (!(target.square_mm > 0))
+    throw InputError(file, "calibration.target.square_mm", "a length > 0",
+                     std::to_string(target.square_mm));
+}
+
+ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTarget& target,
+                                       const std::string& photo_name,
+                                       const ScreenCalibratorOptions& options,
+                                       ScreenCalibrationReport* report_out) {
+  options.Check();
+  CheckCalibrationTarget(target, photo_name);
+  ScreenCalibrationReport report;
+  double contrast = 0;
+  const cv::Mat gray8 = StretchToGray8(photo, &contrast);
+  if (!(contrast > 0))
+    throw BadInput(photo_name + ": blank calibration photo (no contrast, no checkerboard)");
+  report.corners = DetectBoard(gray8, target, photo_name, options.detection);
+  const BoardCorners& corners = report.corners;
+
+  std::vector<cv::Point2d> image_pts, screen_pts;
+  for (size_t i = 0; i < corners.pixels.size(); ++i) {
+    image_pts.emplace_back(corners.pixels[i].x(), corners.pixels[i].y());
+    screen_pts.emplace_back(corners.screen_mm[i].x(), corners.screen_mm[i].y());
+  }
+  cv::Mat h0;
+  try {
+    h0 = cv::findHomography(image_pts, screen_pts, 0);
+  } catch (const cv::Exception& e) {
+    throw BadInput(photo_name + ": degenerate view (" + e.what() + ")");
+  }
+  if (h0.empty() || !cv::checkRange(h0))
+    throw BadInput(photo_name + ": degenerate view (no finite homography)");
+  const Eigen::Matrix3d initial = ToEigen(h0);
+  CheckView(corners, initial, photo.size(), target, photo_name, options, &report);
+
+  ScreenCalibration result;
+  result.image_width = photo.cols;
+  result.image_height = photo.rows;
+  result.centre_px = {0.5 * (photo.cols - 1), 0.5 * (photo.rows - 1)};
+  result.scale_px = 0.5 * std::hypot(photo.cols, photo.rows);  // half-diagonal: r <= ~1
+  result.photo = photo_name;
+  result.corners_used = int(corners.pixels.size());
+  {
+    ScreenCalibration start = result;
+    start.screen_from_image = initial;
+    report.initial_rms_px = RmsPx(start, corners);
+  }
+  // Fewer distortion terms when the fit bends back inside the photo (board too small for k2).
+  RefinerOptions refiner = options.refiner;
+  for (;; --refiner.distortion_terms) {
+    try {
+      report.refinement = RefineScreenMapping(corners.pixels, corners.screen_mm, initial,
+                                              result.centre_px, result.scale_px, refiner);
+    } catch (const Error& e) {
+      throw BadInput(photo_name + ": degenerate view: " + e.what());
+    }
+    if (Monotonic(report.refinement.k1, report.refinement.k2, 1.0) || refiner.distortion_terms == 0)
+      break;
+    LogWarning("distortion with ", refiner.distortion_terms,
+               " term(s) is not monotonic over the photo (k1 = ", report.refinement.k1,
+               ", k2 = ", report.refinement.k2, "); refitting with fewer");
+  }
+  report.distortion_terms = refiner.distortion_terms;
+  result.screen_from_image = report.refinement.screen_from_image;
+  result.k1 = report.refinement.k1;
+  result.k2 = report.refinement.k2;
+  result.rms_px = RmsPx(result, corners);
+  result.rms_mm = RmsMm(result, corners);
+  if (!(result.rms_px <= options.max_rms_px))
+    throw BadInput(photo_name + ": reprojection RMS " + Num(result.rms_px) + " px exceeds " +
+                   Num(options.max_rms_px) +
+                   " px (blurred photo, grazing view, or the board is not flat)");
+  if (report_out) *report_out = report;
+  return result;
+}
+
+ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
+                                  ScreenCalibrationReport* report) {
+  CheckCalibrationTarget(dataset.calibration, dataset.Path("dataset.json"));
+  if (dataset.calibration.photo.empty())
+    throw InputError(dataset.Path("dataset.json"), "calibration.photo", "a photo file", "\"\"");
+  const std::string path = dataset.Path(dataset.calibration.photo);
+  const cv::Mat photo = LoadGrayPhoto(path);
+  ScreenCalibration c = CalibrateScreenPhoto(photo, dataset.calibration, path, options, report);
+  c.photo = dataset.calibration.photo;  // relative to the dataset folder
+  return c;
+}
+
+}  // namespace lumislab

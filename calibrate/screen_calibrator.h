@@ -1,0 +1,59 @@
+// lumislab-calibrate screen: the calibration photo of a checkerboard on the screen ->
+// calib/screen.json (core/screen_calibration.h). OpenCV finds the corners and a starting
+// homography; Ceres refines the homography and two radial distortion terms (screen_refiner.h).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "calibrate/board_detector.h"
+#include "calibrate/screen_refiner.h"
+#include "core/dataset.h"
+#include "core/screen_calibration.h"
+
+namespace lumislab {
+
+struct ScreenCalibratorOptions {
+  DetectionOptions detection;
+  RefinerOptions refiner;
+  // Degenerate views are refused (BadInput) rather than calibrated badly.
+  double max_rms_px = 1.0;           // reprojection RMS above this: blur, grazing view, bent board
+  double min_board_fraction = 0.01;  // area of the corner grid / area of the photo
+  double max_anisotropy = 8;         // local stretch ratio (~ 1 / cos of the viewing angle)
+  double max_scale_ratio = 25;       // largest / smallest local area scale over the board
+  double max_condition = 1e6;        // of the homography in normalised coordinates
+  void Check() const;                // BadInput naming the bad field
+};
+
+// What the calibration saw and did, for logs and tests.
+struct ScreenCalibrationReport {
+  BoardCorners corners;
+  RefinementResult refinement;
+  int distortion_terms = 0;  // used in the end (fewer when the fit was not monotonic)
+  double board_fraction = 0;
+  double anisotropy = 0;   // worst over the corners
+  double scale_ratio = 0;  // max / min local area scale
+  double condition = 0;
+  double initial_rms_px = 0;  // OpenCV homography, before refinement
+};
+
+// `photo`: CV_32FC1 (photo_loader.h LoadGrayPhoto), any value range. `photo_name` names the
+// photo in messages and in the result. Throws BadInput for a missing board or dot and for
+// degenerate views.
+ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTarget& target,
+                                       const std::string& photo_name,
+                                       const ScreenCalibratorOptions& options,
+                                       ScreenCalibrationReport* report = nullptr);
+
+// Loads the dataset's calibration photo and calibrates; the result is not written.
+ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
+                                  ScreenCalibrationReport* report = nullptr);
+
+// Throws InputError (naming `file` and calibration.target) when the target cannot be resolved:
+// a square board (squares_x == squares_y) looks the same mirrored about its diagonal.
+void CheckCalibrationTarget(const CalibrationTarget& target, const std::string& file);
+
+// The command line: `lumislab-calibrate screen --dataset <dir> [--force] ...`.
+int RunCalibrate(int argc, char** argv);
+
+}  // namespace lumislab

@@ -124,8 +124,8 @@ TEST(Synth, CalibrationPhotoGeometry) {
   EXPECT_NEAR(value(1.5, 1.5), 13, 2);    // (1,1) black
   EXPECT_NEAR(value(t.squares_x - 0.5, t.squares_y - 0.5),
               (t.squares_x + t.squares_y) % 2 ? 204 : 13, 2);
-  EXPECT_NEAR(value(-0.5, 0.5), 204, 2);  // white screen around the board
-  EXPECT_EQ(img.at<uint8_t>(0, 0), 0);    // outside the screen
+  EXPECT_NEAR(value(-0.25, 0.5), 204, 2);  // white screen around the board
+  EXPECT_EQ(img.at<uint8_t>(0, 0), 0);     // outside the screen
   // A corner is sub-pixel exact: at the inner corner (1,1) the 4x4 supersampled mean of the
   // four pixels around it is half-way between black and white.
   const Eigen::Vector2d corner = pixel_of(1, 1);

@@ -73,7 +73,9 @@ void QuantizationEffect::DoApply(cv::Mat& rgb, const PhotoContext&) const {
     float* p = rgb.ptr<float>(y);
     for (int k = 0; k < rgb.cols * rgb.channels(); ++k) {
       const double v = std::min(1.0, std::max(0.0, double(p[k])));
-      p[k] = float(std::round(v * levels) / levels);
+      // Level k of the bit depth, stored as the 16-bit code of the PNG (k * 65535 / levels,
+      // rounded) so that writing round(v * 65535) gives exactly that code.
+      p[k] = float(std::round(std::round(v * levels) * 65535 / levels) / 65535);
     }
   }
 }

@@ -48,8 +48,8 @@ class SensorNoiseEffect : public Effect {
   unsigned long long seed_;
 };
 
-// Clips to [0, 1] (saturation at full scale) and rounds to 2^bit_depth - 1 levels; the photo is
-// then written as a 16-bit linear PNG.
+// Clips to [0, 1] (saturation at full scale) and rounds to 2^bit_depth - 1 levels, expressed as
+// 16-bit codes / 65535; the photo is then written as a 16-bit linear PNG.
 class QuantizationEffect : public Effect {
  public:
   explicit QuantizationEffect(int bit_depth) : bit_depth_(bit_depth) {}

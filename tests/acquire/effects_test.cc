@@ -128,3 +128,40 @@ TEST(Effects, QuantizedPhotosAre16BitPngOfTheRender) {
 
 }  // namespace
 }  // namespace lumislab
+
+namespace lumislab {
+namespace {
+
+// "exposure" multiplies the values (the radiometric scale stays that of exposure 1) and may
+// saturate on purpose: clipped pixels sit at the saturation level, 65535.
+TEST(Effects, ExposureSaturatesOnPurpose) {
+  const std::string dir = FreshDir("exposure");
+  const std::string effects = R"([{"type": "quantization", "bit_depth": 12}])";
+  const SynthScene normal = acquire_test::SmallScene(effects);
+  const SynthScene bright =
+      ParseScene(acquire_test::SmallSceneJson(effects, R"(, "exposure": 3)"), "bright.json");
+  EXPECT_EQ(ChooseRadiometricScale(bright, 1), ChooseRadiometricScale(normal, 1));
+  SynthOptions options;
+  options.out_dir = dir + "/ds";
+  options.truth_resolution = 20;
+  RunSynth(bright, options);
+  const Dataset ds = Dataset::Load(options.out_dir);
+  EXPECT_DOUBLE_EQ(ds.photos[0].exposure, 3.0);
+  int saturated = 0, off_grid = 0;
+  for (const auto& p : ds.photos) {
+    const cv::Mat png = cv::imread(ds.Path(p.file), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(png.type(), CV_16UC3);
+    for (auto it = png.begin<cv::Vec3w>(); it != png.end<cv::Vec3w>(); ++it)
+      for (int c = 0; c < 3; ++c) {
+        saturated += (*it)[c] == 65535;
+        // 12-bit levels k / 4095 stored as round(k / 4095 * 65535).
+        const double k = (*it)[c] / 65535.0 * 4095;
+        off_grid += std::abs((*it)[c] - std::lround(std::round(k) / 4095 * 65535)) > 0;
+      }
+  }
+  EXPECT_GT(saturated, 100);
+  EXPECT_EQ(off_grid, 0);
+}
+
+}  // namespace
+}  // namespace lumislab

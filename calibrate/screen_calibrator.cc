@@ -132,6 +132,10 @@ void ScreenCalibratorOptions::Check() const {
   positive(max_anisotropy, "max_anisotropy");
   positive(max_scale_ratio, "max_scale_ratio");
   positive(max_condition, "max_condition");
+  if (!(min_radius_k1 >= 0 && min_radius_k2 >= min_radius_k1))
+    throw BadInput(
+        "calibrator options: min_radius_k1, min_radius_k2: expected 0 <= k1 <= k2, got " +
+        std::to_string(min_radius_k1) + ", " + std::to_string(min_radius_k2));
 }
 
 void CheckCalibrationTarget(const CalibrationTarget& target, const std::string& file) {
@@ -193,6 +197,18 @@ ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTa
   }
   // Fewer distortion terms when the fit bends back inside the photo (board too small for k2).
   RefinerOptions refiner = options.refiner;
+  for (const auto& p : corners.pixels)
+    report.board_radius = std::max(report.board_radius, (p - result.centre_px).norm());
+  report.board_radius /= result.scale_px;
+  const int supported = report.board_radius >= options.min_radius_k2   ? 2
+                        : report.board_radius >= options.min_radius_k1 ? 1
+                                                                       : 0;
+  if (supported < refiner.distortion_terms) {
+    LogInfo("the board reaches ", report.board_radius,
+            " half-diagonals from the photo centre: fitting ", supported,
+            " distortion term(s) instead of ", refiner.distortion_terms);
+    refiner.distortion_terms = supported;
+  }
   for (;; --refiner.distortion_terms) {
     try {
       report.refinement = RefineScreenMapping(corners.pixels, corners.screen_mm, initial,

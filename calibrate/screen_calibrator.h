@@ -22,14 +22,20 @@ struct ScreenCalibratorOptions {
   double max_anisotropy = 8;         // local stretch ratio (~ 1 / cos of the viewing angle)
   double max_scale_ratio = 25;       // largest / smallest local area scale over the board
   double max_condition = 1e6;        // of the homography in normalised coordinates
-  void Check() const;                // BadInput naming the bad field
+  // Distortion terms are only fitted when the corners reach far enough from the photo centre
+  // (radius in units of the half-diagonal); otherwise they are unconstrained and extrapolate
+  // wildly beyond the board (a 16 px-square board in the middle gave k2 = 0.8).
+  double min_radius_k1 = 0.25;
+  double min_radius_k2 = 0.5;
+  void Check() const;  // BadInput naming the bad field
 };
 
 // What the calibration saw and did, for logs and tests.
 struct ScreenCalibrationReport {
   BoardCorners corners;
   RefinementResult refinement;
-  int distortion_terms = 0;  // used in the end (fewer when the fit was not monotonic)
+  int distortion_terms = 0;  // used in the end (fewer for small boards or a non-monotonic fit)
+  double board_radius = 0;   // farthest corner from the photo centre, in half-diagonals
   double board_fraction = 0;
   double anisotropy = 0;   // worst over the corners
   double scale_ratio = 0;  // max / min local area scale

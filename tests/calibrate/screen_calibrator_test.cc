@@ -115,6 +115,29 @@ TEST(ScreenCalibrator, NoisyObliquePhoto) {
   EXPECT_NEAR(o.result.k1, truth.k1, 0.02);
 }
 
+// Corners found on a downscaled copy (as for large photos), refined at full resolution.
+TEST(ScreenCalibrator, DetectionOnADownscaledCopy) {
+  const auto truth = TrueCalibration(kWidth, kHeight, kFocal, {20, -30, 500}, {0, 0, 0}, -0.03);
+  ScreenCalibratorOptions options;
+  options.detection.max_detection_px = 400;
+  const Outcome o = Calibrate(truth, 0, options);
+  EXPECT_LT(o.max_error_mm, kToleranceMm);
+  EXPECT_EQ(o.report.corners.saddle_refined, o.result.corners_used);
+}
+
+// Small squares (~16 px): the saddle fit shrinks its blur and window with them.
+TEST(ScreenCalibrator, SmallSquares) {
+  const auto truth = TrueCalibration(kWidth, kHeight, kFocal, {-40, 30, 1300}, {0, 0, 0});
+  const Outcome o = Calibrate(truth);
+  EXPECT_LT(o.report.corners.square_px, 17);
+  EXPECT_LT(o.max_error_mm, kToleranceMm);  // at 1.9 mm per pixel
+  EXPECT_LT(o.result.rms_px, 0.1);
+  // The board reaches only ~0.25 half-diagonals: distortion is left out, not extrapolated.
+  EXPECT_LT(o.report.board_radius, 0.5);
+  EXPECT_LT(o.report.distortion_terms, 2);
+  EXPECT_LT(std::abs(o.result.k1) + std::abs(o.result.k2), 0.02);
+}
+
 template <typename F>
 void ExpectBadInput(F&& f, const std::vector<std::string>& mentions) {
   try {

@@ -1,6 +1,6 @@
 // Sub-pixel checkerboard corners as saddle points of the blurred photo. An X-junction of two
 // straight edges is point-symmetric about the corner, so after any isotropic blur the corner is
-// a saddle point; a quadratic fitted on a window centred at the current estimate moves it there.
+// a saddle point; a quadratic fitted with weights centred at the current estimate moves it there.
 // cv::cornerSubPix locks onto pixel centres on sharp edges (errors up to ~0.1 px here); this
 // stays within ~0.01 px on rendered boards.
 #pragma once

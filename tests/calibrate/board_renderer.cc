@@ -68,19 +68,19 @@ float BoardValue(const CalibrationTarget& t, const Eigen::Vector2d& p, bool dot)
 }  // namespace
 
 cv::Mat RenderBoard(const CalibrationTarget& target, const ScreenCalibration& truth,
-                    int supersample, double noise_sigma, bool dot) {
+                    double noise_sigma, bool dot) {
   cv::Mat image(truth.image_height, truth.image_width, CV_32FC1);
-  const int n = supersample;
   cv::parallel_for_(cv::Range(0, image.rows), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y)
       for (int x = 0; x < image.cols; ++x) {
         double sum = 0;
-        for (int sy = 0; sy < n; ++sy)
-          for (int sx = 0; sx < n; ++sx) {
-            const Eigen::Vector2d p(x - 0.5 + (sx + 0.5) / n, y - 0.5 + (sy + 0.5) / n);
-            sum += BoardValue(target, truth.ScreenFromImage(p), dot);
-          }
-        image.at<float>(y, x) = float(sum / (n * n));
+        for (int k = 0; k < kSamples; ++k) {
+          const double u = (k + 0.5) / kSamples,
+                       v = ((k * kSampleStride) % kSamples + 0.5) / kSamples;
+          sum += BoardValue(target,
+                            truth.ScreenFromImage(Eigen::Vector2d(x - 0.5 + u, y - 0.5 + v)), dot);
+        }
+        image.at<float>(y, x) = float(sum / kSamples);
       }
   });
   if (noise_sigma > 0) {

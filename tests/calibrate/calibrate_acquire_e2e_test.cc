@@ -1,6 +1,7 @@
 // lumislab-acquire synth -> lumislab-calibrate screen, against the true camera the synthetic
 // acquisition writes (truth/camera.json, screen_from_image row-major, lab mm on the screen).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cstdio>
@@ -41,7 +42,8 @@ struct Errors {
 // acquire + calibrate; max / RMS mapping error over the pixels that see the board, and max over
 // the pixels that see the screen window (where distortion is extrapolated beyond the board).
 Errors AcquireAndCalibrate(const std::string& name, const std::string& camera_json) {
-  const std::string dir = fs::path(::testing::TempDir()) / ("lumislab_calibrate_e2e_" + name);
+  const std::string dir = fs::path(::testing::TempDir()) /
+                          ("lumislab_calibrate_e2e_" + std::to_string(::getpid()) + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir + "/scene.json") << Scene(camera_json);

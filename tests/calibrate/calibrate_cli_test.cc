@@ -1,6 +1,7 @@
 // lumislab-calibrate screen, run in-process through RunMain: exit codes, messages naming the
 // file, calib/screen.json written atomically and skipped unless --force.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -40,7 +41,7 @@ class CalibrateCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::path(::testing::TempDir()) /
-           ("lumislab_calibrate_" +
+           ("lumislab_calibrate_" + std::to_string(::getpid()) + "_" +
             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_ + "/photos");

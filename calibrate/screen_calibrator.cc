@@ -117,6 +117,57 @@ double RmsMm(const ScreenCalibration& c, const BoardCorners& corners) {
   return std::sqrt(sum / double(corners.pixels.size()));
 }
 
+// Refines the mapping with 0, 1 and 2 distortion terms (as far as the board's reach allows) and
+// keeps the simplest model that fits nearly as well as the next richer one.
+void FitDistortionModel(const BoardCorners& corners, const Eigen::Matrix3d& initial,
+                        const ScreenCalibratorOptions& options, const std::string& photo_name,
+                        ScreenCalibration* result, ScreenCalibrationReport* report) {
+  for (const auto& p : corners.pixels)
+    report->board_radius = std::max(report->board_radius, (p - result->centre_px).norm());
+  report->board_radius /= result->scale_px;
+  const int supported = report->board_radius >= options.min_radius_k2   ? 2
+                        : report->board_radius >= options.min_radius_k1 ? 1
+                                                                        : 0;
+  const int allowed = std::min(options.refiner.distortion_terms, supported);
+  if (allowed < options.refiner.distortion_terms)
+    LogInfo("the board reaches ", report->board_radius,
+            " half-diagonals from the photo centre: at most ", allowed, " distortion term(s)");
+  // Fit 0..allowed terms; a fit that bends back inside the photo is not a candidate.
+  std::vector<RefinementResult> fits;
+  std::vector<double> rms;
+  for (int terms = 0; terms <= allowed; ++terms) {
+    RefinerOptions refiner = options.refiner;
+    refiner.distortion_terms = terms;
+    try {
+      fits.push_back(RefineScreenMapping(corners.pixels, corners.screen_mm, initial,
+                                         result->centre_px, result->scale_px, refiner));
+    } catch (const Error& e) {
+      throw BadInput(photo_name + ": degenerate view: " + e.what());
+    }
+    ScreenCalibration candidate = *result;
+    candidate.screen_from_image = fits.back().screen_from_image;
+    candidate.k1 = fits.back().k1;
+    candidate.k2 = fits.back().k2;
+    rms.push_back(Monotonic(candidate.k1, candidate.k2, 1.0) ? RmsPx(candidate, corners)
+                                                             : HUGE_VAL);
+    if (rms.back() == HUGE_VAL)
+      LogWarning("distortion with ", terms,
+                 " term(s) is not monotonic over the photo (k1 = ", candidate.k1,
+                 ", k2 = ", candidate.k2, "); not used");
+  }
+  int chosen = allowed;
+  while (chosen > 0 &&
+         (rms[chosen] == HUGE_VAL || rms[chosen - 1] <= options.keep_term_rms_ratio * rms[chosen]))
+    --chosen;
+  report->rms_px_by_terms = rms;
+  report->refinement = fits[chosen];
+  report->distortion_terms = chosen;
+  result->screen_from_image = report->refinement.screen_from_image;
+  result->k1 = report->refinement.k1;
+  result->k2 = report->refinement.k2;
+  result->rms_px = rms[chosen] == HUGE_VAL ? RmsPx(*result, corners) : rms[chosen];
+}
+
 }  // namespace
 
 void ScreenCalibratorOptions::Check() const {
@@ -132,6 +183,7 @@ void ScreenCalibratorOptions::Check() const {
   positive(max_anisotropy, "max_anisotropy");
   positive(max_scale_ratio, "max_scale_ratio");
   positive(max_condition, "max_condition");
+  positive(keep_term_rms_ratio, "keep_term_rms_ratio");
   if (!(min_radius_k1 >= 0 && min_radius_k2 >= min_radius_k1))
     throw BadInput(
         "calibrator options: min_radius_k1, min_radius_k2: expected 0 <= k1 <= k2, got " +
@@ -195,38 +247,7 @@ ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTa
     start.screen_from_image = initial;
     report.initial_rms_px = RmsPx(start, corners);
   }
-  // Fewer distortion terms when the fit bends back inside the photo (board too small for k2).
-  RefinerOptions refiner = options.refiner;
-  for (const auto& p : corners.pixels)
-    report.board_radius = std::max(report.board_radius, (p - result.centre_px).norm());
-  report.board_radius /= result.scale_px;
-  const int supported = report.board_radius >= options.min_radius_k2   ? 2
-                        : report.board_radius >= options.min_radius_k1 ? 1
-                                                                       : 0;
-  if (supported < refiner.distortion_terms) {
-    LogInfo("the board reaches ", report.board_radius,
-            " half-diagonals from the photo centre: fitting ", supported,
-            " distortion term(s) instead of ", refiner.distortion_terms);
-    refiner.distortion_terms = supported;
-  }
-  for (;; --refiner.distortion_terms) {
-    try {
-      report.refinement = RefineScreenMapping(corners.pixels, corners.screen_mm, initial,
-                                              result.centre_px, result.scale_px, refiner);
-    } catch (const Error& e) {
-      throw BadInput(photo_name + ": degenerate view: " + e.what());
-    }
-    if (Monotonic(report.refinement.k1, report.refinement.k2, 1.0) || refiner.distortion_terms == 0)
-      break;
-    LogWarning("distortion with ", refiner.distortion_terms,
-               " term(s) is not monotonic over the photo (k1 = ", report.refinement.k1,
-               ", k2 = ", report.refinement.k2, "); refitting with fewer");
-  }
-  report.distortion_terms = refiner.distortion_terms;
-  result.screen_from_image = report.refinement.screen_from_image;
-  result.k1 = report.refinement.k1;
-  result.k2 = report.refinement.k2;
-  result.rms_px = RmsPx(result, corners);
+  FitDistortionModel(corners, initial, options, photo_name, &result, &report);
   result.rms_mm = RmsMm(result, corners);
   if (!(result.rms_px <= options.max_rms_px))
     throw BadInput(photo_name + ": reprojection RMS " + Num(result.rms_px) + " px exceeds " +

@@ -90,7 +90,7 @@ TEST(CalibrateAcquireEndToEnd, DefaultCamera) {
       "default", R"({"size_px": [1600, 1200], "focal_px": 1300, "position_mm": [0, -400, 2400],
                      "look_at_mm": [0, 0, 750]})");
   EXPECT_LT(e.board_max, 0.2);
-  EXPECT_LT(e.screen_max, 0.5);
+  EXPECT_LT(e.screen_max, 0.2);
 }
 
 // About 50 degrees off the screen normal, from the side and below.
@@ -99,7 +99,7 @@ TEST(CalibrateAcquireEndToEnd, ObliqueCamera) {
       "oblique", R"({"size_px": [1600, 1200], "focal_px": 1100, "position_mm": [1400, -300, 1900],
                      "look_at_mm": [0, 0, 750]})");
   EXPECT_LT(e.board_max, 0.2);
-  EXPECT_LT(e.screen_max, 0.5);
+  EXPECT_LT(e.screen_max, 0.2);
 }
 
 }  // namespace

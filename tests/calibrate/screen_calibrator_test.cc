@@ -59,6 +59,7 @@ TEST(ScreenCalibrator, Frontal) {
   EXPECT_LT(o.max_error_mm, 0.03);  // what the saddle-point corners give on a clean photo
   EXPECT_LT(o.result.rms_px, 0.02);
   EXPECT_NEAR(o.result.k1, 0, 0.002);
+  EXPECT_EQ(o.report.distortion_terms, 0);  // none needed, none fitted
   EXPECT_EQ(o.result.photo, "rendered.png");
   EXPECT_EQ(o.result.image_width, kWidth);
 }
@@ -104,7 +105,18 @@ TEST(ScreenCalibrator, RecoversRadialDistortion) {
   EXPECT_LT(o.max_error_mm, kToleranceMm);
   EXPECT_NEAR(o.result.k1, truth.k1, 0.002);
   EXPECT_LT(o.result.rms_px, 0.02);
+  EXPECT_EQ(o.report.distortion_terms, 1);
   EXPECT_GT(o.report.initial_rms_px, 3 * o.result.rms_px);  // the homography alone misses it
+}
+
+// A board that fills the frame (corners beyond 0.7 half-diagonals) also pins down k2.
+TEST(ScreenCalibrator, FullFrameBoardRecoversK2) {
+  const auto truth = TrueCalibration(kWidth, kHeight, kFocal, {5, -5, 405}, {0, 0, 0}, -0.06, 0.03);
+  const Outcome o = Calibrate(truth);
+  EXPECT_EQ(o.report.distortion_terms, 2);
+  EXPECT_LT(o.max_error_mm, kToleranceMm);
+  EXPECT_NEAR(o.result.k1, truth.k1, 0.003);
+  EXPECT_NEAR(o.result.k2, truth.k2, 0.005);
 }
 
 TEST(ScreenCalibrator, NoisyObliquePhoto) {

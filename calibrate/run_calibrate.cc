@@ -45,8 +45,11 @@ int RunScreen(const ScreenCommand& command, int threads) {
           " % of the photo, local stretch <= ", report.anisotropy, ", condition ",
           report.condition);
   LogDebug("ceres: ", report.refinement.message);
+  std::ostringstream by_terms;
+  for (size_t t = 0; t < report.rms_px_by_terms.size(); ++t)
+    by_terms << (t ? ", " : "") << t << ": " << report.rms_px_by_terms[t] << " px";
   LogInfo("distortion: k1 = ", c.k1, ", k2 = ", c.k2, " (", report.distortion_terms,
-          " term(s), scale ", c.scale_px, " px)");
+          " term(s) chosen; RMS by terms ", by_terms.str(), "; scale ", c.scale_px, " px)");
   LogInfo("rms: ", c.rms_px, " px (OpenCV homography alone: ", report.initial_rms_px, " px), ",
           c.rms_mm, " mm -> ", out);
   return 0;

@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/calib3d.hpp>
 
 #include "calibrate/photo_loader.h"
@@ -27,13 +28,6 @@ Eigen::Matrix3d ToEigen(const cv::Mat& h) {
   return m;
 }
 
-// d dehomogenise(H [p, 1]) / dp, mm per pixel.
-Eigen::Matrix2d LocalJacobian(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
-  const Eigen::Vector3d q = h * p.homogeneous();
-  const Eigen::Vector2d x = q.head<2>() / q.z();
-  return (h.topLeftCorner<2, 2>() - x * h.block<1, 2>(2, 0)) / q.z();
-}
-
 // Checks the starting homography describes a usable view of the board; fills the report.
 void CheckView(const BoardCorners& corners, const Eigen::Matrix3d& h, const cv::Size& size,
                const CalibrationTarget& target, const std::string& photo,
@@ -55,7 +49,7 @@ void CheckView(const BoardCorners& corners, const Eigen::Matrix3d& h, const cv::
   double min_det = HUGE_VAL, max_det = 0, anisotropy = 0;
   int sign = 0;
   for (const auto& q : p) {
-    const Eigen::Matrix2d j = LocalJacobian(h, q);
+    const Eigen::Matrix2d j = HomographyJacobian(h, q);  // mm per pixel
     const double det = j.determinant();
     const int s = det > 0 ? 1 : det < 0 ? -1 : 0;
     if (s == 0 || !std::isfinite(det) || (sign != 0 && s != sign))

@@ -22,14 +22,13 @@ Eigen::Matrix3d Normaliser(const Eigen::Vector2d& centre, double scale) {
   return t;
 }
 
-// d dehomogenise(G [p, 1]) / dp.
-Eigen::Matrix2d LocalJacobian(const Eigen::Matrix3d& g, const Eigen::Vector2d& p) {
-  const Eigen::Vector3d q = g * p.homogeneous();
-  const Eigen::Vector2d x = q.head<2>() / q.z();
-  return (g.topLeftCorner<2, 2>() - x * g.block<1, 2>(2, 0)) / q.z();
-}
-
 }  // namespace
+
+Eigen::Matrix2d HomographyJacobian(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
+  const Eigen::Vector3d q = h * p.homogeneous();
+  const Eigen::Vector2d x = q.head<2>() / q.z();
+  return (h.topLeftCorner<2, 2>() - x * h.block<1, 2>(2, 0)) / q.z();
+}
 
 void RefinerOptions::Check() const {
   if (!(huber_px > 0 && std::isfinite(huber_px)))
@@ -75,7 +74,7 @@ RefinementResult RefineScreenMapping(const std::vector<Eigen::Vector2d>& pixels,
   const Eigen::Matrix3d screen_n_from_image = t_screen * initial_screen_from_image;
   ceres::Problem problem;
   for (size_t i = 0; i < pixels.size(); ++i) {
-    const Eigen::Matrix2d jac = LocalJacobian(screen_n_from_image, pixels[i]);
+    const Eigen::Matrix2d jac = HomographyJacobian(screen_n_from_image, pixels[i]);
     const double det = jac.determinant();
     if (!std::isfinite(det) || std::abs(det) < 1e-18 * jac.squaredNorm() || det == 0)
       throw Failure("singular image -> screen mapping at a board corner (degenerate view)");

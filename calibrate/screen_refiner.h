@@ -29,6 +29,9 @@ struct RefinementResult {
   std::string message;  // Ceres' one-line summary
 };
 
+// d dehomogenise(H [p, 1]) / dp: the local linear map of a homography at p.
+Eigen::Matrix2d HomographyJacobian(const Eigen::Matrix3d& h, const Eigen::Vector2d& p);
+
 // pixels[i] (OpenCV pixel centres) shows screen_mm[i] (lab mm). `initial_screen_from_image`
 // maps distorted pixels to mm (e.g. cv::findHomography); centre_px/scale_px fix the distortion
 // model. Throws Failure when the problem is degenerate (singular local mapping).

@@ -31,9 +31,11 @@ TEST(Live, WatchFollowsAnAcquisitionInProgress) {
                       "[]"));
   const std::string ds = dir + "/ds";
   testing::CommandResult acquire_result;
+  std::atomic<bool> acquire_done{false};
   std::thread acquire([&] {
-    acquire_result = RunTool(
-        "lumislab-acquire", "synth --scene " + dir + "/scene.json --out " + ds + " --interval 0.3");
+    acquire_result = RunTool("lumislab-acquire",
+                             "synth --scene " + dir + "/scene.json --out " + ds + " --interval 1");
+    acquire_done = true;
   });
   // The calibration photo comes first; calibrate as soon as dataset.json and it exist.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);

@@ -1,6 +1,7 @@
 // Bad input on the command line: exit code 2, a message naming the file and the field, and no
 // half-written file under a final name.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -29,7 +30,8 @@ class CliBadInput : public ::testing::Test {
  protected:
   // One small PNG dataset (2x2 grid, 640x480 photos), acquired once and copied per test.
   static void SetUpTestSuite() {
-    const std::string dir = FreshDir("cli_master");
+    // Per process: ctest runs each test in its own process, several at once.
+    const std::string dir = FreshDir("cli_master_" + std::to_string(getpid()));
     WriteFile(dir + "/scene.json",
               SceneJson(2, 2, kSmallCamera, R"([{"type": "quantization", "bit_depth": 16}])"));
     master_ = dir + "/ds";
@@ -37,6 +39,7 @@ class CliBadInput : public ::testing::Test {
         RunTool("lumislab-acquire", "synth --scene " + dir + "/scene.json --out " + master_);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
+  static void TearDownTestSuite() { fs::remove_all(fs::path(master_).parent_path()); }
   void SetUp() override {
     ds_ = FreshDir(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "/ds";
     fs::copy(master_, ds_, fs::copy_options::recursive);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "core/dataset.h"
 #include "core/exr_io.h"
@@ -49,6 +50,13 @@ std::string RunPipeline(const std::string& name, const std::string& scene_json) 
   return ds;
 }
 
+// Datasets are gigabytes: keep them only when a test failed, for inspection.
+void CleanUp(std::initializer_list<std::string> datasets) {
+  if (::testing::Test::HasFailure()) return;
+  for (const auto& ds : datasets)
+    std::filesystem::remove_all(std::filesystem::path(ds).parent_path());
+}
+
 TEST(EndToEnd, DefaultSceneNoiseFreeMatchesTruth) {
   const std::string ds = RunPipeline("e2e_default", "");
   const SlabComparison c = CompareSlabs(ds + "/slab", ds + "/truth");
@@ -58,6 +66,7 @@ TEST(EndToEnd, DefaultSceneNoiseFreeMatchesTruth) {
     EXPECT_LE(p.relative_l2, 0.005) << "position " << p.i << "," << p.j;
     EXPECT_GT(p.lit_texels, 1000) << "position " << p.i << "," << p.j;
   }
+  CleanUp({ds});
 }
 
 // The photo of an oblique camera is resampled much more unevenly; the slab must be as good.
@@ -71,6 +80,7 @@ TEST(EndToEnd, ObliqueViewAsAccurateAsFrontal) {
   EXPECT_LE(o.max_relative_l2, 0.005);
   EXPECT_LE(o.max_relative_l2, std::max(1.5 * f.max_relative_l2, 0.002));
   for (const auto& p : o.positions) EXPECT_GT(p.lit_texels - p.unseen_lit_texels, 1000);
+  CleanUp({frontal, oblique});
 }
 
 // Noise floor predicted from the sensor model: per photo pixel the normalised value v has
@@ -141,6 +151,7 @@ TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
   // The noise must be visible at all (otherwise this test would not test the fit with noise).
   const SlabComparison clean_c = CompareSlabs(clean + "/slab", clean + "/truth");
   EXPECT_GT(c.overall_relative_l2, 1.5 * clean_c.overall_relative_l2);
+  CleanUp({clean, noisy});
 }
 
 }  // namespace

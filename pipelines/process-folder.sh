@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Process one dataset folder: calibrate the screen, reconstruct the slab. Stops at the first
+# Process one dataset folder: calibrate the screen, reconstruct the slab, render previews of it
+# into <dataset>/renders/. Stops at the first
 # failing stage (set -e) and resumes where it stopped (stages skip finished outputs).
 # Usage: pipelines/process-folder.sh <dataset> [--force]
 set -euo pipefail
@@ -14,4 +15,9 @@ bin="${LUMISLAB_BIN:-$(cd "$(dirname "$0")/.." && pwd)/build/bin}"
 
 "$bin/lumislab-calibrate" screen --dataset "$dataset" "$@"
 "$bin/lumislab-reconstruct" --dataset "$dataset" "$@"
+mkdir -p "$dataset/renders"
+"$bin/lumislab-preview" --slab "$dataset/slab" --scene crypt --out "$dataset/renders/crypt.png"
+"$bin/lumislab-preview" --slab "$dataset/slab" --scene plane --receiver-plane 1500 --extent 3000 \
+  --out "$dataset/renders/beam_1500mm.exr"
 echo "slab: $dataset/slab"
+echo "renders: $dataset/renders"

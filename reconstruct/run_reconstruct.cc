@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/slab_compare.h"
 #include "reconstruct/reconstructor.h"
 #include "reconstruct/slab_writer.h"
 
@@ -136,6 +137,8 @@ std::vector<Position> Missing(const Dataset& dataset, const SlabWriter& writer) 
 
 std::string CalibrationPath(const std::string& dir) { return dir + "/calib/screen.json"; }
 
+void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_dir);
+
 int RunBatch(const RunConfig& config) {
   const Dataset dataset = Dataset::Load(config.dataset_dir);
   const std::string calib_path = CalibrationPath(config.dataset_dir);
@@ -162,7 +165,22 @@ int RunBatch(const RunConfig& config) {
   LogInfo("slab: ", writer.dir(), " (", writer.PresentCount(), "/", dataset.grid.count(),
           " positions, ", config.options.resolution, "x", config.options.resolution, ", ",
           writer.info().units, ")");
+  ReportAgainstTruth(config.dataset_dir, writer.dir());
   return 0;
+}
+
+// Synthetic datasets carry their ground truth: say how far the slab is from it.
+void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_dir) {
+  const std::string truth = dataset_dir + "/truth";
+  if (!fs::exists(truth + "/slab.json")) return;
+  const SlabInfo truth_info = SlabInfo::Load(truth);
+  const SlabInfo slab_info = SlabInfo::Load(slab_dir);
+  if (truth_info.layout.res_x != slab_info.layout.res_x) {
+    LogInfo("truth: ", truth, " is at resolution ", truth_info.layout.res_x,
+            "; not compared (reconstruct with --resolution ", truth_info.layout.res_x, ")");
+    return;
+  }
+  LogInfo("error against truth/: ", CompareSlabs(slab_dir, truth).Summary());
 }
 
 // Polls until `path` exists; false when stopped by a signal.
@@ -219,6 +237,7 @@ int RunWatch(const RunConfig& config) {
     return 1;
   }
   LogInfo("slab: ", writer.dir(), " (complete, ", dataset.grid.count(), " positions)");
+  ReportAgainstTruth(config.dataset_dir, writer.dir());
   return 0;
 }
 

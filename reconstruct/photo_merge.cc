@@ -129,6 +129,27 @@ bool FusedDifference(const DecodedPhoto& plus, double gain_p, const DecodedPhoto
   const float gp = float(gain_p / (f * f)), gn = float(gain_n / (f * f));
   const int pr = plus.rgb_order ? 0 : 2, nr = minus.rgb_order ? 0 : 2;
   std::atomic<bool> saturated{false};
+  if (f == 1) {
+    // No block averaging: one pass straight from both photos to the difference.
+    cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+      T max_value = 0;
+      bool finite = true;
+      for (int y = rows.start; y < rows.end; ++y) {
+        const T* a = plus.pixels.template ptr<T>(y);
+        const T* b = minus.pixels.template ptr<T>(y);
+        float* o = out.ptr<float>(y);
+        for (int x = 0; x < w; ++x, a += 3, b += 3, o += 3) {
+          max_value = std::max({max_value, a[0], a[1], a[2], b[0], b[1], b[2]});
+          o[0] = gp * float(a[pr]) - gn * float(b[nr]);
+          o[1] = gp * float(a[1]) - gn * float(b[1]);
+          o[2] = gp * float(a[2 - pr]) - gn * float(b[2 - nr]);
+          finite &= std::isfinite(o[0] + o[1] + o[2]);
+        }
+      }
+      if (!finite || double(max_value) >= saturation_threshold) saturated = true;
+    });
+    return !saturated;
+  }
   cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
     std::vector<Acc> ap(len), an(len);
     T max_value = 0;

@@ -43,14 +43,8 @@ int RunHeadless(const PreviewConfig& config) {
   OffscreenContext context(16, 16);
   LogDebug("GL renderer: ", context.Renderer());
   const SceneSetup setup = MakeSceneSetup(config, info);
-  RenderOptions options;
-  options.shadows = config.shadows;
-  options.srgbe = config.srgbe;
-  options.shadow_size = config.shadow_size;
-  options.shadow_pcf = config.shadow_pcf;
-  if (setup.plane) options.radiance_scale = 1.0;
-  options.cull_back_faces = setup.closed_room;
-  const int width = setup.plane ? config.width : config.width;
+  RenderOptions options = MakeRenderOptions(config, setup);
+  const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
   Renderer renderer(info, width, height, options);
   renderer.SetScene(setup.mesh);
@@ -132,6 +126,17 @@ int RunHeadless(const PreviewConfig& config) {
 }  // namespace
 
 bool PreviewStopRequested() { return g_stop != 0; }
+
+RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
+  RenderOptions options;
+  options.shadows = config.shadows;
+  options.srgbe = config.srgbe;
+  options.shadow_size = config.shadow_size;
+  options.shadow_pcf = config.shadow_pcf;
+  if (setup.plane) options.radiance_scale = 1.0;
+  options.cull_back_faces = setup.closed_room;
+  return options;
+}
 
 SceneSetup MakeSceneSetup(const PreviewConfig& config, const SlabInfo& info) {
   SceneSetup s;

@@ -50,6 +50,8 @@ struct SceneSetup {
   bool closed_room = false;  // built-in rooms: cull back faces so the camera sees in
   double plane_z = 0, extent = 0;
 };
+// Renderer options from the command line, for the scene it sets up (one place for both contexts).
+RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);
 SceneSetup MakeSceneSetup(const PreviewConfig& config, const SlabInfo& info);
 // Orbit camera: clip-from-scene matrix.
 Eigen::Matrix4f OrbitCamera(const SceneSetup& setup, double aspect);

@@ -74,13 +74,7 @@ void DrawArrivalOverlay(const SlabInfo& info, const Renderer& renderer, int fb_h
 int RunWindow(const PreviewConfig& config, SlabInfo info) {
   WindowContext context(config.width, config.height, "lumislab-preview");
   SceneSetup setup = MakeSceneSetup(config, info);
-  RenderOptions options;
-  options.shadows = config.shadows;
-  options.srgbe = config.srgbe;
-  options.shadow_size = config.shadow_size;
-  options.shadow_pcf = config.shadow_pcf;
-  if (setup.plane) options.radiance_scale = 1.0;
-  options.cull_back_faces = setup.closed_room;
+  RenderOptions options = MakeRenderOptions(config, setup);
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(context.window(), &fb_w, &fb_h);
   Renderer renderer(info, fb_w, fb_h, options);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/error.h"
 
@@ -57,8 +58,10 @@ double ExactDual::Amplitude() { return 1.0 / (BellGram(0) + 2.0 * BellGram(1) * 
 double ExactDual::Coefficient(int k) { return Amplitude() * std::pow(Ratio(), std::abs(k)); }
 
 DualFilter DualFilter::Truncated(int k_max) {
-  if (k_max < 0 || k_max > 16) throw BadInput("dual filter: k_max must be in [0, 16]");
-  if (k_max == 0) return DualFilter({1.0});  // phi itself: integral 1, but no deconvolution
+  if (k_max < kMinFilterTruncation || k_max > kMaxFilterTruncation)
+    throw BadInput("dual filter: k_max: expected an integer in [" +
+                   std::to_string(kMinFilterTruncation) + ", " +
+                   std::to_string(kMaxFilterTruncation) + "], got " + std::to_string(k_max));
   // Closest to the exact dual (least squares, each coefficient weighted by how often it occurs)
   // subject to the two conditions a truncation must keep: the integral is 1 (constants are
   // reproduced, so the flux is right) and <phi~, phi> = 1 (biorthogonal to its own centre).

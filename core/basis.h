@@ -1,4 +1,4 @@
-// The 1D bell basis (DESIGN §2), its exact dual and the truncated printed filter.
+// The 1D bell basis (docs/design.md §2), its exact dual and the truncated printed filter.
 // x is in units of the grid spacing h (dimensionless).
 #pragma once
 
@@ -22,11 +22,20 @@ struct ExactDual {
   static double Coefficient(int k);  // a r^|k|
 };
 
+// The truncation K of every printed filter lumislab makes or reads: one range for the scene file,
+// the filter printer, dataset.json and slab.json (at most K + 1 dual coefficients).
+constexpr int kMinFilterTruncation = 1;
+constexpr int kMaxFilterTruncation = 8;
+
 // A dual truncated to support [-(K+1), K+1]: phi~ = c0 phi(x) + sum_{k=1..K} c_k
-// (phi(x-k)+phi(x+k)). Coefficients are the exact dual's, rescaled so that the integral of phi~ is
-// 1 (constants are reproduced). K = 1 is the printed filter of DESIGN §2 (support +-2h).
+// (phi(x-k)+phi(x+k)). The coefficients are those closest to the exact dual's (least squares)
+// that keep two conditions exactly: the integral of phi~ is 1 (constants, hence flux, are
+// reproduced) and <phi~, phi> = 1 (the filter responds 1 to its own basis function); a plain
+// rescale of the exact dual keeps only the first. K = 1 gives c0 = 53/39, c1 = -7/39: the
+// printed filter of docs/design.md §2 (support +-2h).
 class DualFilter {
  public:
+  // K in [kMinFilterTruncation, kMaxFilterTruncation]; BadInput otherwise.
   static DualFilter Truncated(int k_max = 1);
   static DualFilter FromCoefficients(std::vector<double> coefficients);  // as in dataset.json
 

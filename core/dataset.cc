@@ -10,6 +10,71 @@
 
 namespace lumislab {
 
+void CalibrationTarget::Check(const std::string& file, const std::string& field) const {
+  const std::string got = std::to_string(squares_x) + " x " + std::to_string(squares_y);
+  if (squares_x < kMinBoardSquares || squares_y < kMinBoardSquares)
+    throw InputError(file, field + ".squares", "at least 3 x 3 squares", got);
+  if (squares_x == squares_y)
+    throw InputError(file, field + ".squares",
+                     "squares_x != squares_y (a square board with one dot looks the same "
+                     "mirrored about its diagonal)",
+                     got);
+  if (!(square_mm > 0 && std::isfinite(square_mm)))
+    throw InputError(file, field + ".square_mm", "a length > 0", std::to_string(square_mm));
+}
+
+SamplingGrid ParseGrid(const JsonView& grid) {
+  SamplingGrid g;
+  g.nu = grid["nu"].IntIn(1, kMaxGridSide);
+  g.nv = grid["nv"].IntIn(1, kMaxGridSide);
+  g.spacing_mm = grid["spacing_mm"].Positive();
+  return g;
+}
+
+nlohmann::json GridJson(const SamplingGrid& grid) {
+  return {{"nu", grid.nu}, {"nv", grid.nv}, {"spacing_mm", grid.spacing_mm}};
+}
+
+Eigen::Vector2d ParseLengthPair(const JsonView& value) {
+  const std::vector<double> v = value.Numbers(2);
+  if (!(v[0] > 0) || !(v[1] > 0)) value.Fail("two lengths > 0 (width, height in mm)");
+  return {v[0], v[1]};
+}
+
+int ParseFilterTruncation(const JsonView& k_max) {
+  return k_max.IntIn(kMinFilterTruncation, kMaxFilterTruncation);
+}
+
+FilterInfo FilterInfo::Of(const DualFilter& filter, double spacing_mm) {
+  FilterInfo info;
+  info.spacing_mm = spacing_mm;
+  info.dual_coefficients = filter.coefficients();
+  info.peak = filter.Peak2D();
+  return info;
+}
+
+FilterInfo ParseFilterInfo(const JsonView& filter, const SamplingGrid& grid) {
+  FilterInfo f;
+  f.basis = filter["basis"].OneOf({"bell"});
+  f.spacing_mm = filter["spacing_mm"].Positive();
+  if (std::abs(f.spacing_mm - grid.spacing_mm) > 1e-9 * grid.spacing_mm)
+    filter["spacing_mm"].Fail("the grid spacing (" + std::to_string(grid.spacing_mm) + " mm)");
+  f.dual_coefficients = filter["dual_coefficients"].Numbers();
+  if (f.dual_coefficients.size() > size_t(kMaxFilterTruncation) + 1)
+    filter["dual_coefficients"].Fail(
+        "at most " + std::to_string(kMaxFilterTruncation + 1) +
+        " coefficients (truncation K <= " + std::to_string(kMaxFilterTruncation) + ")");
+  f.peak = filter["peak"].Positive();
+  return f;
+}
+
+nlohmann::json FilterInfoJson(const FilterInfo& filter) {
+  return {{"basis", filter.basis},
+          {"spacing_mm", filter.spacing_mm},
+          {"dual_coefficients", filter.dual_coefficients},
+          {"peak", filter.peak}};
+}
+
 std::string PhotoFileName(int i, int j, bool positive, const std::string& ext,
                           const std::string& exposure_tag) {
   std::string name =
@@ -36,24 +101,11 @@ Dataset Dataset::Load(const std::string& dir) {
 
   const JsonView setup = root["setup"];
   ds.distance_mm = setup["distance_mm"].Positive();
-  ds.grid.nu = setup["grid"]["nu"].IntIn(1, 1000);
-  ds.grid.nv = setup["grid"]["nv"].IntIn(1, 1000);
-  ds.grid.spacing_mm = setup["grid"]["spacing_mm"].Positive();
-  const std::vector<double> screen = setup["screen_mm"].Numbers(2);
-  if (!(screen[0] > 0) || !(screen[1] > 0))
-    setup["screen_mm"].Fail("two lengths > 0 (width, height in mm)");
-  ds.screen_w_mm = screen[0];
-  ds.screen_h_mm = screen[1];
-
-  const JsonView filter = root["filter"];
-  ds.filter.basis = filter["basis"].OneOf({"bell"});
-  ds.filter.spacing_mm = filter["spacing_mm"].Positive();
-  if (std::abs(ds.filter.spacing_mm - ds.grid.spacing_mm) > 1e-9 * ds.grid.spacing_mm)
-    filter["spacing_mm"].Fail("the grid spacing (" + std::to_string(ds.grid.spacing_mm) + " mm)");
-  ds.filter.dual_coefficients = filter["dual_coefficients"].Numbers();
-  if (ds.filter.dual_coefficients.size() > 17)
-    filter["dual_coefficients"].Fail("at most 17 coefficients");
-  ds.filter.peak = filter["peak"].Positive();
+  ds.grid = ParseGrid(setup["grid"]);
+  const Eigen::Vector2d screen = ParseLengthPair(setup["screen_mm"]);
+  ds.screen_w_mm = screen.x();
+  ds.screen_h_mm = screen.y();
+  ds.filter = ParseFilterInfo(root["filter"], ds.grid);
 
   const JsonView radiometry = root["radiometry"];
   if (radiometry.Has("scale_w_m2")) ds.radiometric_scale = radiometry["scale_w_m2"].Positive();
@@ -64,11 +116,12 @@ Dataset Dataset::Load(const std::string& dir) {
   ds.calibration.photo = calib["photo"].String();
   const JsonView target = calib["target"];
   target["type"].OneOf({"checkerboard"});
-  ds.calibration.squares_x = target["squares"][0].IntIn(3, 200);
-  ds.calibration.squares_y = target["squares"][1].IntIn(3, 200);
+  ds.calibration.squares_x = target["squares"][0].IntIn(kMinBoardSquares, kMaxBoardSquares);
+  ds.calibration.squares_y = target["squares"][1].IntIn(kMinBoardSquares, kMaxBoardSquares);
   ds.calibration.square_mm = target["square_mm"].Positive();
   const std::vector<double> origin = target["origin_mm"].Numbers(2);
   ds.calibration.origin_mm = {origin[0], origin[1]};
+  ds.calibration.Check(file, "calibration.target");
 
   const JsonView photos = root["photos"];
   std::set<std::tuple<int, int, bool>> slides;
@@ -102,12 +155,9 @@ void Dataset::Save(const std::string& out_dir) const {
   j["schema_version"] = kDatasetSchemaVersion;
   j["synthetic"] = synthetic;
   j["setup"] = {{"distance_mm", distance_mm},
-                {"grid", {{"nu", grid.nu}, {"nv", grid.nv}, {"spacing_mm", grid.spacing_mm}}},
+                {"grid", GridJson(grid)},
                 {"screen_mm", {screen_w_mm, screen_h_mm}}};
-  j["filter"] = {{"basis", filter.basis},
-                 {"spacing_mm", filter.spacing_mm},
-                 {"dual_coefficients", filter.dual_coefficients},
-                 {"peak", filter.peak}};
+  j["filter"] = FilterInfoJson(filter);
   j["radiometry"] = {{"saturation_level", saturation_level}};
   if (radiometric_scale) j["radiometry"]["scale_w_m2"] = *radiometric_scale;
   j["calibration"] = {{"photo", calibration.photo},

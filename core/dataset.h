@@ -1,13 +1,17 @@
-// dataset.json (DESIGN §5): the setup, the printed filter, the radiometric scale and the photos.
+// dataset.json (docs/design.md §5): the setup, the printed filter, the radiometric scale and the
+// photos; and the JSON blocks that several files share (grid, filter, a pair of lengths), each
+// parsed by one function with one set of limits.
 #pragma once
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/basis.h"
 #include "core/grid.h"
+#include "core/json.h"
 
 namespace lumislab {
 
@@ -16,10 +20,15 @@ constexpr int kDatasetSchemaVersion = 1;
 struct FilterInfo {
   std::string basis = "bell";
   double spacing_mm = 0;
-  std::vector<double> dual_coefficients;  // [c0, c1, ...] as in DESIGN §2
+  std::vector<double> dual_coefficients;  // [c0, c1, ...] as in docs/design.md §2
   double peak = 0;                        // max |Phi~| of the 2D filter; slides are Phi~/peak
   DualFilter Filter() const { return DualFilter::FromCoefficients(dual_coefficients); }
+  static FilterInfo Of(const DualFilter& filter, double spacing_mm);
 };
+
+// The "filter" block of dataset.json and slab.json; spacing_mm must equal the grid's.
+FilterInfo ParseFilterInfo(const JsonView& filter, const SamplingGrid& grid);
+nlohmann::json FilterInfoJson(const FilterInfo& filter);
 
 // Checkerboard lying on the screen plane, photographed once for the screen calibration.
 // Board square (a, b) has its lower-left corner at origin + (a, b) * square (lab mm, screen
@@ -30,7 +39,25 @@ struct CalibrationTarget {
   int squares_y = 0;
   double square_mm = 0;
   Eigen::Vector2d origin_mm{0, 0};  // lab frame, screen plane
+
+  // What the screen calibration needs of a board, checked wherever a board is first read (scene
+  // file, dataset.json) so that a capture is never made with a board calibrate would refuse:
+  // at least 3 x 3 squares, not square (a square board with one dot looks the same mirrored
+  // about its diagonal), a square size > 0. InputError naming `file` and `field`.
+  void Check(const std::string& file, const std::string& field) const;
 };
+
+// Limits shared by every file that holds a grid.
+constexpr int kMaxGridSide = 1000;  // positions per axis
+constexpr int kMinBoardSquares = 3, kMaxBoardSquares = 200;
+
+// {"nu": int, "nv": int, "spacing_mm": > 0}.
+SamplingGrid ParseGrid(const JsonView& grid);
+nlohmann::json GridJson(const SamplingGrid& grid);
+// [a, b], both > 0 and finite (screen or window size in mm).
+Eigen::Vector2d ParseLengthPair(const JsonView& value);
+// The truncation K of a filter (scene files, the printer's --k-max).
+int ParseFilterTruncation(const JsonView& k_max);
 
 struct PhotoEntry {
   int i = 0;

@@ -1,4 +1,4 @@
-// Sampling grid on S and the slab texel layout on M (DESIGN §1, §5). All lengths in mm,
+// Sampling grid on S and the slab texel layout on M (docs/design.md §1, §5). All lengths in mm,
 // luminaire frame.
 #pragma once
 

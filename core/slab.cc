@@ -38,21 +38,14 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
   const JsonView root = doc.root();
   SlabInfo info;
   info.distance_mm = root["distance_mm"].Positive();
-  info.grid.nu = root["grid"]["nu"].IntIn(1, 1000);
-  info.grid.nv = root["grid"]["nv"].IntIn(1, 1000);
-  info.grid.spacing_mm = root["grid"]["spacing_mm"].Positive();
-  const std::vector<double> window = root["window_mm"].Numbers(2);
-  if (!(window[0] > 0 && window[1] > 0)) root["window_mm"].Fail("two lengths > 0");
-  info.layout.window_w_mm = window[0];
-  info.layout.window_h_mm = window[1];
+  info.grid = ParseGrid(root["grid"]);
+  const Eigen::Vector2d window = ParseLengthPair(root["window_mm"]);
+  info.layout.window_w_mm = window.x();
+  info.layout.window_h_mm = window.y();
   info.layout.res_x = root["resolution"][0].IntIn(1, 16384);
   info.layout.res_y = root["resolution"][1].IntIn(1, 16384);
   info.units = root["units"].OneOf({"W/m^2", "relative"});
-  const JsonView filter = root["filter"];
-  info.filter.basis = filter["basis"].OneOf({"bell"});
-  info.filter.spacing_mm = filter["spacing_mm"].Positive();
-  info.filter.dual_coefficients = filter["dual_coefficients"].Numbers();
-  info.filter.peak = filter["peak"].Positive();
+  info.filter = ParseFilterInfo(root["filter"], info.grid);
   const JsonView present = root["present"];
   for (size_t k = 0; k < present.Size(); ++k)
     info.MarkPresent(present[k][0].IntIn(0, info.grid.nu - 1),
@@ -64,14 +57,11 @@ void SlabInfo::Save(const std::string& slab_dir) const {
   nlohmann::json j;
   j["schema_version"] = kSlabSchemaVersion;
   j["distance_mm"] = distance_mm;
-  j["grid"] = {{"nu", grid.nu}, {"nv", grid.nv}, {"spacing_mm", grid.spacing_mm}};
+  j["grid"] = GridJson(grid);
   j["window_mm"] = {layout.window_w_mm, layout.window_h_mm};
   j["resolution"] = {layout.res_x, layout.res_y};
   j["units"] = units;
-  j["filter"] = {{"basis", filter.basis},
-                 {"spacing_mm", filter.spacing_mm},
-                 {"dual_coefficients", filter.dual_coefficients},
-                 {"peak", filter.peak}};
+  j["filter"] = FilterInfoJson(filter);
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [i, jj] : present) list.push_back({i, jj});
   j["present"] = list;

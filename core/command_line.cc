@@ -1,0 +1,37 @@
+#include "core/command_line.h"
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/parallel.h"
+
+namespace lumislab {
+
+void AddCommonOptions(CLI::App* app, CommonOptions* options) {
+  app->add_flag("--verbose", options->verbose, "log details");
+  app->add_option("--threads", options->threads,
+                  "worker threads (0: all cores, at most " + std::to_string(kMaxThreads) + ")")
+      ->capture_default_str();
+}
+
+std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
+  }
+  return std::nullopt;
+}
+
+int StartTool(const std::string& tool, const CommonOptions& options) {
+  SetLogTool(tool);
+  if (options.verbose) SetLogLevel(LogLevel::kDebug);
+  return ResolveThreads(options.threads);
+}
+
+std::string TrimTrailingSlashes(std::string path) {
+  while (path.size() > 1 && path.back() == '/') path.pop_back();
+  return path;
+}
+
+}  // namespace lumislab

@@ -1,0 +1,34 @@
+#include "core/stop_signal.h"
+
+#include <atomic>
+
+namespace lumislab {
+namespace {
+
+// Lock-free atomics are async-signal-safe.
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+extern "C" void OnStopSignal(int) { g_stop = true; }
+
+}  // namespace
+
+StopSignalScope::StopSignalScope() {
+  g_stop = false;
+  struct sigaction action {};
+  action.sa_handler = OnStopSignal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: a blocking read or sleep returns early with EINTR
+  sigaction(SIGINT, &action, &old_int_);
+  sigaction(SIGTERM, &action, &old_term_);
+}
+
+StopSignalScope::~StopSignalScope() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+}
+
+bool StopRequested() { return g_stop; }
+void RequestStop() { g_stop = true; }
+
+}  // namespace lumislab

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "core/atomic_file.h"
 #include "core/basis.h"
 #include "core/error.h"
 #include "core/json.h"
+#include "lib/photo/photo_io.h"
 
 namespace lumislab {
 
@@ -16,8 +16,9 @@ void FilterPrintOptions::Check() const {
   if (!(spacing_mm > 0 && spacing_mm <= 1000))
     throw BadInput("--spacing-mm: expected a length in (0, 1000] mm, got " +
                    std::to_string(spacing_mm));
-  if (k_max < 1 || k_max > 8)
-    throw BadInput("--k-max: expected an integer in [1, 8], got " + std::to_string(k_max));
+  if (k_max < kMinFilterTruncation || k_max > kMaxFilterTruncation)
+    throw BadInput("--k-max: expected an integer in [" + std::to_string(kMinFilterTruncation) +
+                   ", " + std::to_string(kMaxFilterTruncation) + "], got " + std::to_string(k_max));
   if (!(dpi >= 10 && dpi <= 20000))
     throw BadInput("--dpi: expected dots per inch in [10, 20000], got " + std::to_string(dpi));
   if (out_dir.empty()) throw BadInput("--out: expected a folder, got nothing");
@@ -51,11 +52,8 @@ FilterPrintReport PrintFilter(const FilterPrintOptions& options) {
   report.plus_png = options.out_dir + "/filter_p.png";
   report.minus_png = options.out_dir + "/filter_n.png";
   report.json = options.out_dir + "/filter.json";
-  for (const auto& [path, img] :
-       {std::make_pair(report.plus_png, &plus), std::make_pair(report.minus_png, &minus)})
-    WriteAtomically(path, [&, p = path, m = img](const std::string& tmp) {
-      if (!cv::imwrite(tmp, *m)) throw IoError(p, "could not encode the slide PNG");
-    });
+  WriteImageFile(report.plus_png, plus);
+  WriteImageFile(report.minus_png, minus);
   nlohmann::json j;
   j["schema_version"] = 1;
   j["basis"] = "bell";

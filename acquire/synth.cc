@@ -1,22 +1,19 @@
 #include "acquire/synth.h"
 
-#include <atomic>
 #include <chrono>
 #include <filesystem>
-#include <mutex>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <thread>
 #include <vector>
 
-#include "acquire/render.h"
-#include "acquire/truth.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/exr_io.h"
 #include "core/log.h"
+#include "core/parallel.h"
 #include "core/progress.h"
 #include "core/slab.h"
+#include "lib/photo/photo_io.h"
+#include "lib/synthetic/render.h"
+#include "lib/synthetic/truth.h"
 
 namespace fs = std::filesystem;
 
@@ -26,27 +23,17 @@ namespace {
 constexpr double kTargetPeakValue = 0.85;
 constexpr int kPrePassStride = 7;  // pixels of the pre-pass: every 7th one that sees the screen
 
-void WritePhoto(const SynthScene& scene, const std::string& path, ImageF& photo,
-                bool compress_exr) {
-  if (scene.Quantized()) {
-    cv::Mat bgr, png;
-    cv::cvtColor(AsMat(photo), bgr, cv::COLOR_RGB2BGR);
-    bgr.convertTo(png, CV_16UC3, 65535.0);  // rounds and clips: code values of the effect
-    WriteAtomically(path, [&](const std::string& tmp) {
-      if (!cv::imwrite(tmp, png)) throw IoError(path, "could not encode the PNG photo");
-    });
-  } else {
-    ExrOptions options;
-    options.compress = compress_exr;
-    WriteExr(path, photo, {"R", "G", "B"}, {}, options);
-  }
+PhotoEncoding SlidePhotoEncoding(const SynthScene& scene, const SynthOptions& options) {
+  if (scene.Quantized()) return PhotoEncoding::kLinear16Png;  // the codes of the effect
+  if (options.photo_format == "float")
+    return options.compress_float ? PhotoEncoding::kFloatExrPiz : PhotoEncoding::kFloatExr;
+  return PhotoEncoding::kHalfExr;
 }
 
-void WriteCalibrationPhoto(const SynthScene& scene, const std::string& path) {
-  const cv::Mat img = RenderCalibration(scene);
-  WriteAtomically(path, [&](const std::string& tmp) {
-    if (!cv::imwrite(tmp, img)) throw IoError(path, "could not encode the calibration photo");
-  });
+// The calibration photo as a camera's 8-bit output: linear reflectance through the sRGB curve
+// (lib/photo's decoder linearises it back).
+void WriteCalibrationPhoto(const SynthScene& scene, const std::string& path, int threads) {
+  WritePhoto(path, RenderCalibration(scene, threads), PhotoEncoding::kSrgb8Png);
 }
 
 }  // namespace
@@ -55,8 +42,9 @@ void SynthOptions::Check() const {
   if (out_dir.empty()) throw BadInput("--out: expected a dataset folder, got nothing");
   if (!(interval_s < 0 || interval_s <= 3600))
     throw BadInput("--interval: expected seconds in [0, 3600], got " + std::to_string(interval_s));
-  if (threads < 0 || threads > 1024)
-    throw BadInput("--threads: expected 0 (all cores) .. 1024, got " + std::to_string(threads));
+  ResolveThreads(threads);  // BadInput naming --threads when out of range
+  if (photo_format != "half" && photo_format != "float")
+    throw BadInput("--photo-format: expected half or float, got " + photo_format);
   if (truth_resolution < 1 || truth_resolution > 16384)
     throw BadInput("--truth-resolution: expected 1 .. 16384, got " +
                    std::to_string(truth_resolution));
@@ -73,8 +61,7 @@ double ChooseRadiometricScale(const SynthScene& scene, int threads) {
 }
 
 void ApplyEffects(const SynthScene& scene, int photo_index, ImageF* photo) {
-  cv::Mat mat = AsMat(*photo);
-  for (const auto& effect : scene.effects) effect->Apply(mat, {photo_index});
+  for (const auto& effect : scene.effects) effect->Apply(*photo, {photo_index});
 }
 
 ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale, int i, int j,
@@ -85,6 +72,37 @@ ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale,
   ApplyEffects(scene, PhotoIndex(scene, i, j, positive), &photo);
   return std::move(photo);
 }
+
+namespace {
+
+// Renders, applies the effects to and writes the photos of every position: in order with a
+// pause for a live acquisition, else on `threads` threads. Returns the number of photos.
+int CapturePositions(const SynthScene& scene, const Dataset& dataset, const SynthOptions& options,
+                     PhotoEncoding encoding, int threads) {
+  const ScreenView view = ScreenView::Of(scene);
+  const double scale = *dataset.radiometric_scale;
+  const int count = scene.grid.count();
+  Progress progress("acquire", count);
+  auto capture = [&](int q) {
+    const int i = q % scene.grid.nu, j = q / scene.grid.nu;
+    if (options.interval_s >= 0 && q > 0)
+      std::this_thread::sleep_for(std::chrono::duration<double>(options.interval_s));
+    ImageF plus, minus;
+    RenderPosition(scene, view, i, j, scale, &plus, &minus);
+    for (bool positive : {true, false}) {
+      ImageF& photo = positive ? plus : minus;
+      const int index = PhotoIndex(scene, i, j, positive);
+      ApplyEffects(scene, index, &photo);
+      WritePhoto(options.out_dir + "/" + dataset.photos[index].file, photo, encoding);
+    }
+    progress.Advance();
+  };
+  ParallelFor(count, options.interval_s >= 0 ? 1 : threads, capture);
+  progress.Finish();
+  return int(dataset.photos.size());
+}
+
+}  // namespace
 
 bool DatasetComplete(const std::string& dir) {
   try {
@@ -113,14 +131,17 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
     report.skipped = true;
     return report;
   }
-  const int threads = options.threads > 0 ? options.threads
-                                          : int(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = ResolveThreads(options.threads);
   Dataset dataset = DatasetSkeleton(scene);
   dataset.photos = PhotoList(scene);
   dataset.radiometric_scale = ChooseRadiometricScale(scene, threads);
   report.radiometric_scale = *dataset.radiometric_scale;
+  const PhotoEncoding encoding = SlidePhotoEncoding(scene, options);
   LogInfo("scene ", scene.source, ": ", scene.grid.nu, "x", scene.grid.nv, " positions, ",
-          scene.camera.width, "x", scene.camera.height, " px photos (", scene.PhotoExtension(),
+          scene.camera.width, "x", scene.camera.height, " px photos (",
+          encoding == PhotoEncoding::kLinear16Png ? "16-bit PNG"
+          : encoding == PhotoEncoding::kHalfExr   ? "half-float EXR"
+                                                  : "float EXR",
           "), radiometric scale ", report.radiometric_scale, " W/m^2 per unit, ",
           scene.effects.size(), " effect(s)");
   MakeDirectories(out + "/photos");
@@ -128,56 +149,11 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
 
   // dataset.json and the calibration photo come first: a live reader can start at once.
   dataset.Save(out);
-  WriteCalibrationPhoto(scene, out + "/" + scene.calibration.photo);
+  WriteCalibrationPhoto(scene, out + "/" + scene.calibration.photo, threads);
   WriteTruthCamera(scene, out + "/truth/camera.json");
-  WriteTruthSlab(scene, dataset, out + "/truth", options.truth_resolution, threads);
-
-  const ScreenView view = ScreenView::Of(scene);
-  const double scale = *dataset.radiometric_scale;
-  auto capture = [&](int q) {
-    const int i = q % scene.grid.nu, j = q / scene.grid.nu;
-    ImageF plus, minus;
-    RenderPosition(scene, view, i, j, scale, &plus, &minus);
-    for (bool positive : {true, false}) {
-      ImageF& photo = positive ? plus : minus;
-      const int index = PhotoIndex(scene, i, j, positive);
-      ApplyEffects(scene, index, &photo);
-      const std::string file = dataset.photos[index].file;
-      WritePhoto(scene, out + "/" + file, photo, options.compress_exr);
-    }
-  };
-
-  Progress progress("acquire", scene.grid.count());
-  if (options.interval_s >= 0) {
-    for (int q = 0; q < scene.grid.count(); ++q) {
-      if (q > 0) std::this_thread::sleep_for(std::chrono::duration<double>(options.interval_s));
-      capture(q);
-      progress.Advance();
-    }
-  } else {
-    std::atomic<int> next{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto work = [&] {
-      for (int q = next++; q < scene.grid.count(); q = next++) {
-        try {
-          capture(q);
-          progress.Advance();
-        } catch (...) {
-          std::lock_guard<std::mutex> lock(error_mutex);
-          if (!error) error = std::current_exception();
-          next = scene.grid.count();
-        }
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-    work();
-    for (auto& th : pool) th.join();
-    if (error) std::rethrow_exception(error);
-  }
-  progress.Finish();
-  report.photos_written = int(dataset.photos.size());
+  WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
+                 out + "/truth", threads);
+  report.photos_written = CapturePositions(scene, dataset, options, encoding, threads);
   return report;
 }
 

@@ -1,11 +1,12 @@
-// lumislab-acquire synth: the synthetic capture of a scene into a dataset folder (DESIGN §5, §8).
+// lumislab-acquire synth: the synthetic capture of a scene into a dataset folder (docs/design.md
+// §5, §8).
 #pragma once
 
 #include <string>
 
-#include "acquire/render.h"
-#include "acquire/scene.h"
 #include "core/image.h"
+#include "lib/synthetic/render.h"
+#include "lib/synthetic/scene.h"
 
 namespace lumislab {
 
@@ -16,7 +17,10 @@ struct SynthOptions {
   bool force = false;      // redo a complete dataset
   int threads = 0;         // 0: all cores
   int truth_resolution = 300;
-  bool compress_exr = false;  // PIZ for the float photos (smaller, slower)
+  // Photos of a scene without a quantization effect (which makes them 16-bit PNG): "half"
+  // (half-float EXR, PIZ: lossless for half, ~1 MB a photo) or "float" (32-bit float EXR).
+  std::string photo_format = "half";
+  bool compress_float = false;  // "float" photos PIZ-compressed (smaller, slower)
 
   void Check() const;  // BadInput naming the option
 };

@@ -60,7 +60,7 @@ int Run(int argc, char** argv) {
   int frames = 7, size = 400, shadow_size = 512;
   std::string csv = "preview_table1.csv";
   bool quick = false;
-  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (DESIGN §8)"};
+  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/design.md §8)"};
   app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
   app.add_option("--size", size, "image side")->capture_default_str();
   app.add_option("--shadow-size", shadow_size, "shadow-map side")->capture_default_str();

@@ -3,10 +3,10 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <sstream>
-#include <thread>
 
 #include "calibrate/screen_calibrator.h"
 #include "core/atomic_file.h"
+#include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -58,12 +58,10 @@ int RunScreen(const ScreenCommand& command, int threads) {
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
-  CLI::App app{"lumislab-calibrate: camera and screen calibration (DESIGN §5, calib/)"};
+  CLI::App app{"lumislab-calibrate: camera and screen calibration (docs/design.md §5, calib/)"};
   app.require_subcommand(1);
-  bool verbose = false;
-  int threads = 0;
-  app.add_flag("--verbose", verbose, "log details");
-  app.add_option("--threads", threads, "worker threads (default: all cores)");
+  CommonOptions common;
+  AddCommonOptions(&app, &common);
   ScreenCommand screen;
   CLI::App* sub = app.add_subcommand(
       "screen",
@@ -72,8 +70,7 @@ int RunCalibrate(int argc, char** argv) {
   sub->add_option("--dataset", screen.dataset_dir, "dataset folder (with dataset.json)")
       ->required();
   sub->add_flag("--force", screen.force, "recalibrate even if calib/screen.json exists");
-  sub->add_flag("--verbose", verbose, "log details");
-  sub->add_option("--threads", threads, "worker threads (default: all cores)");
+  AddCommonOptions(sub, &common);
   sub->add_option("--huber-px", screen.options.refiner.huber_px,
                   "scale of the robust (Huber) loss, pixels")
       ->capture_default_str();
@@ -86,21 +83,12 @@ int RunCalibrate(int argc, char** argv) {
   sub->add_option("--max-detection-px", screen.options.detection.max_detection_px,
                   "find corners on a copy whose long side is at most this (pixels)")
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
-  }
-  SetLogTool("calibrate");
-  if (verbose) SetLogLevel(LogLevel::kDebug);
-  if (threads < 0) throw BadInput("--threads: expected >= 0, got " + std::to_string(threads));
-  if (threads == 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
+  const int threads = StartTool("calibrate", common);
   cv::setNumThreads(threads);
   screen.options.refiner.threads = threads;
   screen.options.Check();
-  while (screen.dataset_dir.size() > 1 && screen.dataset_dir.back() == '/')
-    screen.dataset_dir.pop_back();
+  screen.dataset_dir = TrimTrailingSlashes(screen.dataset_dir);
   return RunScreen(screen, threads);
 }
 

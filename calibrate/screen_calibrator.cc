@@ -7,9 +7,10 @@
 #include <cstdio>
 #include <opencv2/calib3d.hpp>
 
-#include "calibrate/photo_loader.h"
+#include "calibrate/gray_stretch.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "lib/photo/photo_io.h"
 
 namespace lumislab {
 
@@ -184,27 +185,12 @@ void ScreenCalibratorOptions::Check() const {
         std::to_string(min_radius_k1) + ", " + std::to_string(min_radius_k2));
 }
 
-void CheckCalibrationTarget(const CalibrationTarget& target, const std::string& file) {
-  const std::string got =
-      std::to_string(target.squares_x) + " x " + std::to_string(target.squares_y);
-  if (target.squares_x < 3 || target.squares_y < 3)
-    throw InputError(file, "calibration.target.squares", "at least 3 x 3 squares", got);
-  if (target.squares_x == target.squares_y)
-    throw InputError(file, "calibration.target.squares",
-                     "squares_x != squares_y (a square board with one dot looks the same "
-                     "mirrored about its diagonal)",
-                     got);
-  if (!(target.square_mm > 0))
-    throw InputError(file, "calibration.target.square_mm", "a length > 0",
-                     std::to_string(target.square_mm));
-}
-
 ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTarget& target,
                                        const std::string& photo_name,
                                        const ScreenCalibratorOptions& options,
                                        ScreenCalibrationReport* report_out) {
   options.Check();
-  CheckCalibrationTarget(target, photo_name);
+  target.Check(photo_name, "calibration.target");
   ScreenCalibrationReport report;
   double contrast = 0;
   const cv::Mat gray8 = StretchToGray8(photo, &contrast);
@@ -253,11 +239,10 @@ ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTa
 
 ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
                                   ScreenCalibrationReport* report) {
-  CheckCalibrationTarget(dataset.calibration, dataset.Path("dataset.json"));
   if (dataset.calibration.photo.empty())
     throw InputError(dataset.Path("dataset.json"), "calibration.photo", "a photo file", "\"\"");
   const std::string path = dataset.Path(dataset.calibration.photo);
-  const cv::Mat photo = LoadGrayPhoto(path);
+  const cv::Mat photo = LinearGray(DecodePhoto(path, CalibrationPhotoSpec(dataset)));
   ScreenCalibration c = CalibrateScreenPhoto(photo, dataset.calibration, path, options, report);
   c.photo = dataset.calibration.photo;  // relative to the dataset folder
   return c;

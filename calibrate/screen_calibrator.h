@@ -48,7 +48,7 @@ struct ScreenCalibrationReport {
   double initial_rms_px = 0;  // OpenCV homography, before refinement
 };
 
-// `photo`: CV_32FC1 (photo_loader.h LoadGrayPhoto), any value range. `photo_name` names the
+// `photo`: CV_32FC1 (lib/photo LinearGray), any value range. `photo_name` names the
 // photo in messages and in the result. Throws BadInput for a missing board or dot and for
 // degenerate views.
 ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTarget& target,
@@ -59,10 +59,6 @@ ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTa
 // Loads the dataset's calibration photo and calibrates; the result is not written.
 ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
                                   ScreenCalibrationReport* report = nullptr);
-
-// Throws InputError (naming `file` and calibration.target) when the target cannot be resolved:
-// a square board (squares_x == squares_y) looks the same mirrored about its diagonal.
-void CheckCalibrationTarget(const CalibrationTarget& target, const std::string& file);
 
 // The command line: `lumislab-calibrate screen --dataset <dir> [--force] ...`.
 int RunCalibrate(int argc, char** argv);

@@ -111,6 +111,11 @@ Dataset Dataset::Load(const std::string& dir) {
   if (radiometry.Has("scale_w_m2")) ds.radiometric_scale = radiometry["scale_w_m2"].Positive();
   ds.saturation_level =
       radiometry.Has("saturation_level") ? radiometry["saturation_level"].Positive() : 1.0;
+  ds.photo_transfer =
+      radiometry.Has("transfer") ? radiometry["transfer"].OneOf({"auto", "linear", "srgb"}) : "auto";
+  ds.black_level = radiometry.Has("black_level") ? radiometry["black_level"].NumberIn(0, 0.5) : 0;
+  ds.white_level =
+      radiometry.Has("white_level") ? radiometry["white_level"].NumberIn(0.5, 1e6) : 1;
 
   const JsonView calib = root["calibration"];
   ds.calibration.photo = calib["photo"].String();
@@ -158,7 +163,10 @@ void Dataset::Save(const std::string& out_dir) const {
                 {"grid", GridJson(grid)},
                 {"screen_mm", {screen_w_mm, screen_h_mm}}};
   j["filter"] = FilterInfoJson(filter);
-  j["radiometry"] = {{"saturation_level", saturation_level}};
+  j["radiometry"] = {{"saturation_level", saturation_level},
+                     {"transfer", photo_transfer},
+                     {"black_level", black_level},
+                     {"white_level", white_level}};
   if (radiometric_scale) j["radiometry"]["scale_w_m2"] = *radiometric_scale;
   j["calibration"] = {{"photo", calibration.photo},
                       {"target",

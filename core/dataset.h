@@ -77,6 +77,12 @@ struct Dataset {
   // Irradiance on the screen (W m^-2) per unit of normalised linear pixel value at exposure 1.
   std::optional<double> radiometric_scale;
   double saturation_level = 1.0;  // normalised linear value at or above which a pixel is clipped
+  // How photo codes become linear values (lib/photo/photo_io.h): "auto" (8-bit through the sRGB
+  // curve, 16-bit and float linear), "linear" or "srgb"; black and white level in normalised
+  // units (linear = (v - black) / (white - black)).
+  std::string photo_transfer = "auto";
+  double black_level = 0;
+  double white_level = 1;
   CalibrationTarget calibration;
   std::vector<PhotoEntry> photos;
   bool synthetic = false;

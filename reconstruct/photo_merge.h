@@ -1,7 +1,7 @@
 // Photos of one grid position -> one image of E = peak * scale * (E+ - E-) in photo pixel space.
-// Linearisation: 16-bit PNG/TIFF value / 65535, 8-bit through the sRGB curve, EXR as is.
-// Brackets: per slide and channel, sum of values / sum of exposures over the exposures that are
-// not saturated (an exposure-weighted average of value / exposure).
+// Decoding and linearisation are lib/photo's (one decoder for every stage). Brackets: per slide
+// and channel, sum of values / sum of exposures over the exposures that are not saturated (an
+// exposure-weighted average of value / exposure).
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -9,18 +9,17 @@
 #include <vector>
 
 #include "core/dataset.h"
+#include "lib/photo/photo_io.h"
 
 namespace lumislab {
 
 struct DecodedPhoto {
   PhotoEntry entry;
-  std::string path;  // full path, for messages
-  cv::Mat pixels;    // as decoded: 8U/16U (OpenCV BGR or gray) or 32FC3 RGB (EXR)
-  bool rgb_order = false;
+  Photo photo;  // decoded with the dataset's radiometry and the entry's exposure
 };
 
-// Decodes one photo; a missing or undecodable file is bad input naming the photo (exit 2).
-DecodedPhoto DecodePhoto(const Dataset& dataset, const PhotoEntry& entry);
+// Decodes one photo of the dataset; a missing or undecodable file is bad input naming the photo.
+DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry);
 
 // Checks that every photo has the calibration's image size (bad input naming the photo).
 void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,
@@ -36,11 +35,10 @@ struct MergedPosition {
 };
 
 // gain = filter peak * radiometric scale. Needs at least one photo of each slide.
-MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double saturation_level,
-                             double gain, int downsample = 1);
-// The general path (brackets, saturation, 8-bit sRGB), per pixel at full resolution; the
-// signal is CV_32FC4 with A = 1 where saturated.
-MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double saturation_level,
-                                   double gain);
+MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain,
+                             int downsample = 1);
+// The general path (brackets, saturation, 8-bit sRGB, black level), per pixel at full
+// resolution; the signal is CV_32FC4 with A = 1 where saturated.
+MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain);
 
 }  // namespace lumislab

@@ -36,7 +36,7 @@ std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
                      "position " + std::to_string(i) + "," + std::to_string(j) + " lacks " +
                          (has_p ? "n" : "p"));
   std::vector<DecodedPhoto> photos;
-  for (const auto& e : entries) photos.push_back(DecodePhoto(dataset, e));
+  for (const auto& e : entries) photos.push_back(DecodeDatasetPhoto(dataset, e));
   CheckPhotoSizes(photos, calibration.image_width, calibration.image_height,
                   dataset.Path("calib/screen.json"));
   return photos;
@@ -61,8 +61,7 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   auto t1 = std::chrono::steady_clock::now();
   // 2. Linear, merged, E = peak * scale * (E+ - E-) in photo space, saturation flagged.
   const double gain = dataset.filter.peak * dataset.radiometric_scale.value_or(1.0);
-  const MergedPosition merged =
-      MergePosition(photos, dataset.saturation_level, gain, map.downsample);
+  const MergedPosition merged = MergePosition(photos, gain, map.downsample);
   r.saturated_pixels = merged.saturated_pixels;
   r.merge_s = SecondsSince(t1);
   t1 = std::chrono::steady_clock::now();

@@ -1,18 +1,18 @@
 // lumislab-reconstruct: the batch and --watch drivers around ReconstructPosition.
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <chrono>
-#include <csignal>
-#include <exception>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <sstream>
 #include <thread>
 
+#include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/parallel.h"
 #include "core/progress.h"
 #include "core/slab_compare.h"
+#include "core/stop_signal.h"
 #include "reconstruct/reconstructor.h"
 #include "reconstruct/slab_writer.h"
 
@@ -21,25 +21,6 @@ namespace fs = std::filesystem;
 namespace lumislab {
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-extern "C" void OnStopSignal(int) { g_stop = true; }
-
-// SIGINT/SIGTERM set g_stop while a run is in progress; the previous handlers come back after.
-class StopSignalScope {
- public:
-  StopSignalScope()
-      : old_int_(std::signal(SIGINT, OnStopSignal)),
-        old_term_(std::signal(SIGTERM, OnStopSignal)) {}
-  ~StopSignalScope() {
-    std::signal(SIGINT, old_int_);
-    std::signal(SIGTERM, old_term_);
-  }
-
- private:
-  using Handler = void (*)(int);
-  Handler old_int_, old_term_;
-};
 
 struct RunConfig {
   std::string dataset_dir;
@@ -79,6 +60,25 @@ void CheckPhotosExist(const Dataset& dataset, const std::vector<Position>& todo)
   }
 }
 
+// Reconstructs one position and writes it into the slab.
+void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibration,
+                     SlabWriter& writer, const Position& position, const RunConfig& config) {
+  const auto [i, j] = position;
+  PositionReport r;
+  const SlabPosition pos =
+      ReconstructPosition(dataset, calibration, writer.info(), i, j, config.options, &r);
+  const auto t0 = std::chrono::steady_clock::now();
+  writer.Write(pos);
+  r.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (r.saturated_pixels > 0)
+    LogWarning("position ", Name(position), ": ", r.saturated_pixels, " saturated photo pixels; ",
+               r.saturated_texels, " texels left out of the fit (mask 0)");
+  LogDebug("position ", Name(position), ": seen ", r.seen_texels,
+           " texels, K=", r.samples_per_texel, ", fit ", r.fit_iterations, " it (residual ",
+           r.fit_residual, "), decode ", r.decode_s, " s, rectify ", r.rectify_s, " s, fit ",
+           r.fit_s, " s, write ", r.write_s, " s");
+}
+
 // Reconstructs and writes `todo` with up to `threads` positions in flight; the first error is
 // rethrown after the positions in flight have finished. Stops picking new positions on a signal.
 void ProcessPositions(const Dataset& dataset, const ScreenCalibration& calibration,
@@ -87,44 +87,11 @@ void ProcessPositions(const Dataset& dataset, const ScreenCalibration& calibrati
   if (todo.empty()) return;
   const int workers = std::max(1, std::min<int>(config.threads, int(todo.size())));
   cv::setNumThreads(std::max(1, config.threads / workers));
-  std::atomic<size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (;;) {
-      if (failed || g_stop) return;
-      const size_t k = next++;
-      if (k >= todo.size()) return;
-      const auto [i, j] = todo[k];
-      try {
-        PositionReport r;
-        const SlabPosition pos =
-            ReconstructPosition(dataset, calibration, writer.info(), i, j, config.options, &r);
-        const auto t0 = std::chrono::steady_clock::now();
-        writer.Write(pos);
-        r.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (r.saturated_pixels > 0)
-          LogWarning("position ", Name({i, j}), ": ", r.saturated_pixels,
-                     " saturated photo pixels; ", r.saturated_texels,
-                     " texels left out of the fit (mask 0)");
-        LogDebug("position ", Name({i, j}), ": seen ", r.seen_texels,
-                 " texels, K=", r.samples_per_texel, ", fit ", r.fit_iterations, " it (residual ",
-                 r.fit_residual, "), decode ", r.decode_s, " s, rectify ", r.rectify_s, " s, fit ",
-                 r.fit_s, " s, write ", r.write_s, " s");
-        if (progress) progress->Advance(1, "pos " + Name({i, j}));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        failed = true;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  ParallelFor(int(todo.size()), workers, [&](int k) {
+    if (StopRequested()) return;
+    ProcessPosition(dataset, calibration, writer, todo[k], config);
+    if (progress) progress->Advance(1, "pos " + Name(todo[k]));
+  });
 }
 
 std::vector<Position> Missing(const Dataset& dataset, const SlabWriter& writer) {
@@ -157,7 +124,7 @@ int RunBatch(const RunConfig& config) {
   Progress progress("reconstruct", int(todo.size()));
   ProcessPositions(dataset, calibration, writer, todo, config, &progress);
   progress.Finish();
-  if (g_stop) {
+  if (StopRequested()) {
     LogWarning("interrupted: slab is partial (", writer.PresentCount(), "/", dataset.grid.count(),
                " positions); run again to continue");
     return 1;
@@ -187,7 +154,7 @@ void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_
 bool WaitFor(const std::string& path, double poll_s) {
   bool said = false;
   while (!fs::exists(path)) {
-    if (g_stop) return false;
+    if (StopRequested()) return false;
     if (!said) LogInfo("waiting for ", path);
     said = true;
     std::this_thread::sleep_for(std::chrono::duration<double>(poll_s));
@@ -208,7 +175,7 @@ int RunWatch(const RunConfig& config) {
   Progress progress("reconstruct --watch", dataset.grid.count());
   progress.Advance(writer.PresentCount());
   auto last_new = std::chrono::steady_clock::now();
-  while (!writer.Complete() && !g_stop) {
+  while (!writer.Complete() && !StopRequested()) {
     const auto t = fs::last_write_time(dir + "/dataset.json");
     if (t != dataset_time) {  // the acquisition may list photos as it goes
       dataset = Dataset::Load(dir);
@@ -241,14 +208,26 @@ int RunWatch(const RunConfig& config) {
   return 0;
 }
 
+std::string Parameters(const RunConfig& config) {
+  std::ostringstream params;
+  params << "dataset=" << config.dataset_dir << " resolution=" << config.options.resolution
+         << " lambda=" << config.options.lambda << " samples_per_texel="
+         << (config.options.samples_per_texel ? std::to_string(config.options.samples_per_texel)
+                                              : std::string("auto"))
+         << " watch=" << (config.watch ? "yes" : "no") << " force=" << (config.force ? "yes" : "no")
+         << " threads=" << config.threads;
+  return params.str();
+}
+
 }  // namespace
 
 int RunReconstruct(int argc, char** argv) {
   RunConfig config;
-  bool verbose = false;
   CLI::App app{
       "lumislab-reconstruct: photos of each grid position -> fitted E_ij in "
-      "<dataset>/slab (DESIGN §3)"};
+      "<dataset>/slab (docs/design.md §3)"};
+  CommonOptions common;
+  AddCommonOptions(&app, &common);
   app.add_option("--dataset", config.dataset_dir, "dataset folder (with dataset.json)")->required();
   app.add_option("--resolution", config.options.resolution, "slab texels per side")
       ->capture_default_str();
@@ -256,7 +235,6 @@ int RunReconstruct(int argc, char** argv) {
                "follow a live acquisition: process each position as its photos arrive, stop "
                "when the grid is complete");
   app.add_flag("--force", config.force, "redo positions whose slab EXR already exists");
-  app.add_option("--threads", config.threads, "worker threads (default: all cores)");
   app.add_option("--lambda", config.options.lambda,
                  "regularisation of the fit (first differences, relative)")
       ->capture_default_str();
@@ -268,31 +246,16 @@ int RunReconstruct(int argc, char** argv) {
   app.add_option("--idle-timeout", config.idle_timeout_s,
                  "--watch: fail after this many seconds without new photos (0: wait forever)")
       ->capture_default_str();
-  app.add_flag("--verbose", verbose, "log per-position details");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
-  }
-  SetLogTool("reconstruct");
-  if (verbose) SetLogLevel(LogLevel::kDebug);
+  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
+  config.threads = StartTool("reconstruct", common);
   config.options.Check();
-  if (config.threads <= 0) config.threads = std::max(1u, std::thread::hardware_concurrency());
   if (!(config.poll_s > 0 && config.poll_s <= 60))
     throw BadInput("--poll: expected seconds in (0, 60], got " + std::to_string(config.poll_s));
-  while (!config.dataset_dir.empty() && config.dataset_dir.size() > 1 &&
-         config.dataset_dir.back() == '/')
-    config.dataset_dir.pop_back();
-  std::ostringstream params;
-  params << "dataset=" << config.dataset_dir << " resolution=" << config.options.resolution
-         << " lambda=" << config.options.lambda << " samples_per_texel="
-         << (config.options.samples_per_texel ? std::to_string(config.options.samples_per_texel)
-                                              : std::string("auto"))
-         << " watch=" << (config.watch ? "yes" : "no") << " force=" << (config.force ? "yes" : "no")
-         << " threads=" << config.threads;
-  LogInfo("parameters: ", params.str());
-  g_stop = false;
+  if (!(config.idle_timeout_s >= 0 && config.idle_timeout_s <= 1e6))
+    throw BadInput("--idle-timeout: expected seconds in [0, 1e6], got " +
+                   std::to_string(config.idle_timeout_s));
+  config.dataset_dir = TrimTrailingSlashes(config.dataset_dir);
+  LogInfo("parameters: ", Parameters(config));
   const StopSignalScope signals;
   return config.watch ? RunWatch(config) : RunBatch(config);
 }

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "acquire/scene.h"
+#include "lib/synthetic/scene.h"
 
 namespace lumislab::acquire_test {
 

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "acquire/scene.h"
 #include "acquire_test_util.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "lib/synthetic/scene.h"
 
 namespace lumislab {
 namespace {

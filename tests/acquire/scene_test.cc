@@ -1,15 +1,15 @@
 // Scene files: every bad field is reported with the file and the field (exit 2), and the
 // analytic luminaire and camera behave as their formulas say.
-#include "acquire/scene.h"
+#include "lib/synthetic/scene.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <regex>
 
-#include "acquire/camera.h"
-#include "acquire/luminaire.h"
 #include "core/error.h"
+#include "lib/synthetic/camera.h"
+#include "lib/synthetic/luminaire.h"
 
 namespace lumislab {
 namespace {

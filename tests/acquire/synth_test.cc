@@ -8,16 +8,16 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "acquire/camera.h"
 #include "acquire/filter_print.h"
-#include "acquire/render.h"
-#include "acquire/truth.h"
 #include "acquire_test_util.h"
 #include "core/dataset.h"
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/json.h"
 #include "core/slab.h"
+#include "lib/synthetic/camera.h"
+#include "lib/synthetic/render.h"
+#include "lib/synthetic/truth.h"
 
 namespace fs = std::filesystem;
 
@@ -93,8 +93,8 @@ TEST(Synth, CalibrationPhotoGeometry) {
   scene.camera.width = 1600;  // the default camera: squares of ~45 px, the dot ~18 px wide
   scene.camera.height = 1200;
   scene.camera.focal_px = 1300;
-  const cv::Mat img = RenderCalibration(scene);
-  ASSERT_EQ(img.type(), CV_8UC1);
+  const ImageF img = RenderCalibration(scene, 2);  // linear reflectance
+  ASSERT_EQ(img.channels, 1);
   const PinholeCamera camera(scene.camera);
   const CalibrationTarget& t = scene.calibration;
   auto pixel_of = [&](double a, double b) {  // board coordinates in squares -> pixel
@@ -108,7 +108,7 @@ TEST(Synth, CalibrationPhotoGeometry) {
   // radius_px is 0.4 square: the window stays inside square (0, 0).
   for (int y = int(dot.y() - radius_px); y <= int(dot.y() + radius_px); ++y)
     for (int x = int(dot.x() - radius_px); x <= int(dot.x() + radius_px); ++x) {
-      const double w = std::max(0, img.at<uint8_t>(y, x) - 13);
+      const double w = std::max(0.0, img.at(x, y, 0) - 0.05);
       sx += w * x, sy += w * y, sw += w;
     }
   ASSERT_GT(sw, 0);
@@ -116,25 +116,25 @@ TEST(Synth, CalibrationPhotoGeometry) {
   EXPECT_NEAR(sy / sw, dot.y(), 0.1);
   auto value = [&](double a, double b) {
     const Eigen::Vector2d p = pixel_of(a, b);
-    return img.at<uint8_t>(int(std::lround(p.y())), int(std::lround(p.x())));
+    return img.at(int(std::lround(p.x())), int(std::lround(p.y())), 0);
   };
-  EXPECT_NEAR(value(0.5, 0.5), 204, 2);   // dot: white 0.8
-  EXPECT_NEAR(value(0.12, 0.12), 13, 2);  // square (0,0) outside the dot: black 0.05
-  EXPECT_NEAR(value(1.5, 0.5), 204, 2);   // (1,0) white
-  EXPECT_NEAR(value(1.5, 1.5), 13, 2);    // (1,1) black
+  EXPECT_NEAR(value(0.5, 0.5), 0.8, 1e-6);     // dot: white 0.8
+  EXPECT_NEAR(value(0.12, 0.12), 0.05, 1e-6);  // square (0,0) outside the dot: black 0.05
+  EXPECT_NEAR(value(1.5, 0.5), 0.8, 1e-6);     // (1,0) white
+  EXPECT_NEAR(value(1.5, 1.5), 0.05, 1e-6);    // (1,1) black
   EXPECT_NEAR(value(t.squares_x - 0.5, t.squares_y - 0.5),
-              (t.squares_x + t.squares_y) % 2 ? 204 : 13, 2);
-  EXPECT_NEAR(value(-0.25, 0.5), 204, 2);  // white screen around the board
-  EXPECT_EQ(img.at<uint8_t>(0, 0), 0);     // outside the screen
-  // A corner is sub-pixel exact: at the inner corner (1,1) the 4x4 supersampled mean of the
-  // four pixels around it is half-way between black and white.
+              (t.squares_x + t.squares_y) % 2 ? 0.8 : 0.05, 1e-6);
+  EXPECT_NEAR(value(-0.25, 0.5), 0.8, 1e-6);  // white screen around the board
+  EXPECT_EQ(img.at(0, 0, 0), 0.f);            // outside the screen
+  // A corner is sub-pixel exact: around the inner corner (1,1) the area-sampled pixels average
+  // half-way between black and white.
   const Eigen::Vector2d corner = pixel_of(1, 1);
   const int cx = int(std::floor(corner.x())), cy = int(std::floor(corner.y()));
   double mean = 0;
   for (int y = cy - 2; y <= cy + 3; ++y)
-    for (int x = cx - 2; x <= cx + 3; ++x) mean += img.at<uint8_t>(y, x);
+    for (int x = cx - 2; x <= cx + 3; ++x) mean += img.at(x, y, 0);
   mean /= 36;
-  EXPECT_NEAR(mean, 0.5 * (204 + 13), 12);
+  EXPECT_NEAR(mean, 0.5 * (0.8 + 0.05), 0.047);
 }
 
 // The whole capture on disk: dataset.json, photos, truth slab equal to TruthPosition, camera.
@@ -163,7 +163,7 @@ TEST(Synth, WritesACompleteDatasetAndSkipsItAfterwards) {
   EXPECT_TRUE(info.Complete());
   EXPECT_EQ(info.layout.res_x, 40);
   const SlabPosition truth = ReadSlabPosition(options.out_dir + "/truth", info, 2, 0);
-  const SlabPosition expected = TruthPosition(scene, info, 2, 0);
+  const SlabPosition expected = TruthPosition(scene.luminaire, info, 2, 0);
   EXPECT_EQ(truth.irradiance.data, expected.irradiance.data);
   // Texel (col, row) holds E_ij at its centre.
   const Eigen::Vector2d st = info.layout.TexelCentre(13, 27);

@@ -1,8 +1,6 @@
 // Synthetic photos of a calibration checkerboard with a known image -> screen mapping, for the
-// calibrate tests: every pixel is the area average of point samples of the analytic board on a
-// Fibonacci lattice (sharp, anti-aliased corners), seen through core's distortion model. A
-// lattice, not an n x n grid: an n x n grid quantises axis-aligned edges to 1/n pixel, which
-// showed up as corner errors of up to 1/(2n) pixel.
+// calibrate tests: lib/synthetic's board model and renderer (the one the synthetic capture
+// uses), seen through a pinhole camera (lib/synthetic/camera.h) and core's distortion model.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,13 +12,8 @@
 namespace lumislab {
 namespace testing {
 
-// Pinhole camera at `position_mm` looking at `look_at_mm`; the screen is the plane z = 0 (lab
-// x, y in mm). Returns screen_from_image (undistorted pixel -> mm), OpenCV pixel centres.
-Eigen::Matrix3d CameraScreenFromImage(int width, int height, double focal_px,
-                                      const Eigen::Vector3d& position_mm,
-                                      const Eigen::Vector3d& look_at_mm);
-
-// A ScreenCalibration holding the truth: the camera above plus radial distortion k1, k2
+// A ScreenCalibration holding the truth: a pinhole camera at `position_mm` looking at
+// `look_at_mm` with the screen the plane z = 0 (lab x, y in mm), plus radial distortion k1, k2
 // (centre: image centre, scale: half-diagonal, as lumislab-calibrate uses).
 ScreenCalibration TrueCalibration(int width, int height, double focal_px,
                                   const Eigen::Vector3d& position_mm,
@@ -29,8 +22,6 @@ ScreenCalibration TrueCalibration(int width, int height, double focal_px,
 // A board of squares_x x squares_y squares of square_mm centred on the origin.
 CalibrationTarget CentredTarget(int squares_x, int squares_y, double square_mm);
 
-// Fibonacci lattice of kSamples points in the unit square (offsets within a pixel).
-constexpr int kSamples = 34, kSampleStride = 21;
 // Photo (CV_32FC1, values in [0, 1]): black squares 0.05, white 0.9, a white quiet zone of one
 // square around the board, grey screen 0.5 beyond. Optional Gaussian noise (sigma, fixed seed);
 // `dot` false leaves out the orientation dot.

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "acquire/scene.h"
-#include "acquire/truth.h"
+#include "lib/synthetic/scene.h"
+#include "lib/synthetic/truth.h"
 #include "core/geometry.h"
 #include "core/slab.h"
 #include "preview/gl_context.h"
@@ -37,7 +37,7 @@ Errors AgainstAnalytic(double factor) {
   for (int j = 0; j < info.grid.nv; ++j) {
     for (int i = 0; i < info.grid.nu; ++i) {
       renderer.SetPosition(
-          i, j, IntensityFromIrradiance(info, i, j, TruthPosition(scene, info, i, j).irradiance));
+          i, j, IntensityFromIrradiance(info, i, j, TruthPosition(scene.luminaire, info, i, j).irradiance));
     }
   }
   renderer.Render();

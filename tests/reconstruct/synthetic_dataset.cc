@@ -113,7 +113,7 @@ SyntheticDataset MakeSyntheticDataset(const std::string& dir, const SyntheticOpt
   d.radiometric_scale = kGain;
   d.saturation_level = 1.0;
   d.synthetic = true;
-  d.calibration = {"photos/calib_0.png", 8, 8, 10.0, {-40, -40}};
+  d.calibration = {"photos/calib_0.png", 8, 7, 10.0, {-40, -35}};  // not square: checked on load
   for (int j = 0; j < d.grid.nv; ++j)
     for (int i = 0; i < d.grid.nu; ++i)
       for (bool positive : {true, false})

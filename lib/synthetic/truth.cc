@@ -1,16 +1,15 @@
-#include "acquire/truth.h"
+#include "lib/synthetic/truth.h"
 
-#include <atomic>
 #include <nlohmann/json.hpp>
-#include <thread>
-#include <vector>
 
-#include "acquire/camera.h"
+#include "core/atomic_file.h"
 #include "core/json.h"
+#include "core/parallel.h"
+#include "lib/synthetic/camera.h"
 
 namespace lumislab {
 
-SlabPosition TruthPosition(const SynthScene& scene, const SlabInfo& info, int i, int j) {
+SlabPosition TruthPosition(const Luminaire& luminaire, const SlabInfo& info, int i, int j) {
   SlabPosition p;
   p.i = i;
   p.j = j;
@@ -21,30 +20,28 @@ SlabPosition TruthPosition(const SynthScene& scene, const SlabInfo& info, int i,
   for (int row = 0; row < info.layout.res_y; ++row)
     for (int col = 0; col < info.layout.res_x; ++col) {
       const Eigen::Vector2d st = info.layout.TexelCentre(col, row);
-      const Eigen::Vector3d e = scene.luminaire.FilteredIrradiance(
-          filter, info.grid.spacing_mm, c, info.distance_mm, st.x(), st.y());
+      const Eigen::Vector3d e = luminaire.FilteredIrradiance(filter, info.grid.spacing_mm, c,
+                                                             info.distance_mm, st.x(), st.y());
       for (int ch = 0; ch < 3; ++ch) p.irradiance.at(col, row, ch) = float(e[ch]);
     }
   return p;
 }
 
-void WriteTruthSlab(const SynthScene& scene, const Dataset& dataset, const std::string& truth_dir,
-                    int resolution, int threads) {
-  SlabInfo info = SlabInfo::FromDataset(dataset, resolution);
-  std::atomic<int> next{0};
-  auto work = [&] {
-    for (int q = next++; q < scene.grid.count(); q = next++) {
-      const int i = q % scene.grid.nu, j = q / scene.grid.nu;
-      WriteSlabPosition(truth_dir, info, TruthPosition(scene, info, i, j));
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
-  for (int j = 0; j < scene.grid.nv; ++j)
-    for (int i = 0; i < scene.grid.nu; ++i) info.MarkPresent(i, j);
-  info.Save(truth_dir);
+void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir,
+                    int threads) {
+  MakeDirectories(dir);
+  info.present.clear();
+  ParallelFor(info.grid.count(), threads, [&](int q) {
+    const int i = q % info.grid.nu, j = q / info.grid.nu;
+    WriteSlabPosition(dir, info, TruthPosition(luminaire, info, i, j));
+  });
+  for (int j = 0; j < info.grid.nv; ++j)
+    for (int i = 0; i < info.grid.nu; ++i) info.MarkPresent(i, j);
+  info.Save(dir);
+}
+
+SlabInfo TruthSlabInfo(const SynthScene& scene, int resolution) {
+  return SlabInfo::FromDataset(DatasetSkeleton(scene), resolution);
 }
 
 namespace {

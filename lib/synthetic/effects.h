@@ -1,12 +1,12 @@
-// Camera effects of the synthetic capture (DESIGN §8): each is one small step applied to a
+// Camera effects of the synthetic capture (docs/design.md §8): each is one small step applied to a
 // rendered photo, in the order the scene lists them. Only listed effects are computed.
 #pragma once
 
 #include <map>
 #include <memory>
-#include <opencv2/core.hpp>
 #include <string>
 
+#include "core/image.h"
 #include "core/json.h"
 
 namespace lumislab {
@@ -19,17 +19,10 @@ class Effect {
  public:
   virtual ~Effect() = default;
   virtual std::string Type() const = 0;
-  // Changes `rgb` (CV_32FC3, normalised linear values, RGB order) in place.
-  void Apply(cv::Mat& rgb, const PhotoContext& context) const;
+  // Changes `rgb` (3 channels, normalised linear values, RGB order) in place.
+  virtual void Apply(ImageF& rgb, const PhotoContext& context) const = 0;
   // True when the photo holds code values / 65535 afterwards and is stored as a 16-bit PNG.
   virtual bool Quantizes() const { return false; }
-
-  // How many times any effect ran in this process (tests check unlisted effects cost nothing).
-  static long InvocationCount();
-  static void ResetInvocationCount();
-
- protected:
-  virtual void DoApply(cv::Mat& rgb, const PhotoContext& context) const = 0;
 };
 
 // Shot noise (Gaussian with variance = electrons, electrons = v full_well) plus Gaussian read
@@ -39,9 +32,7 @@ class SensorNoiseEffect : public Effect {
   SensorNoiseEffect(double full_well_e, double read_noise_e, unsigned long long seed)
       : full_well_e_(full_well_e), read_noise_e_(read_noise_e), seed_(seed) {}
   std::string Type() const override { return "sensor_noise"; }
-
- protected:
-  void DoApply(cv::Mat& rgb, const PhotoContext& context) const override;
+  void Apply(ImageF& rgb, const PhotoContext& context) const override;
 
  private:
   double full_well_e_, read_noise_e_;
@@ -55,9 +46,7 @@ class QuantizationEffect : public Effect {
   explicit QuantizationEffect(int bit_depth) : bit_depth_(bit_depth) {}
   std::string Type() const override { return "quantization"; }
   bool Quantizes() const override { return true; }
-
- protected:
-  void DoApply(cv::Mat& rgb, const PhotoContext& context) const override;
+  void Apply(ImageF& rgb, const PhotoContext& context) const override;
 
  private:
   int bit_depth_;

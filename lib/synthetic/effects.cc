@@ -1,6 +1,5 @@
-#include "acquire/effects.h"
+#include "lib/synthetic/effects.h"
 
-#include <atomic>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -9,8 +8,6 @@
 
 namespace lumislab {
 namespace {
-
-std::atomic<long> g_invocations{0};
 
 // Rejects parameters the effect does not know (a typo must not silently fall back to a default).
 void CheckKeys(const JsonView& spec, const std::vector<std::string>& allowed) {
@@ -43,40 +40,27 @@ std::shared_ptr<const Effect> MakeQuantization(const JsonView& spec) {
 
 }  // namespace
 
-void Effect::Apply(cv::Mat& rgb, const PhotoContext& context) const {
-  ++g_invocations;
-  DoApply(rgb, context);
-}
-long Effect::InvocationCount() { return g_invocations; }
-void Effect::ResetInvocationCount() { g_invocations = 0; }
-
-void SensorNoiseEffect::DoApply(cv::Mat& rgb, const PhotoContext& context) const {
+void SensorNoiseEffect::Apply(ImageF& rgb, const PhotoContext& context) const {
   // splitmix-style mixing so that neighbouring photo indices get unrelated streams.
   std::seed_seq seq{static_cast<unsigned>(seed_), static_cast<unsigned>(seed_ >> 32),
                     static_cast<unsigned>(context.photo_index), 0x6c756d69u};
   std::mt19937_64 rng(seq);
   std::normal_distribution<double> normal(0.0, 1.0);
   const double read_var = read_noise_e_ * read_noise_e_;
-  for (int y = 0; y < rgb.rows; ++y) {
-    float* p = rgb.ptr<float>(y);
-    for (int k = 0; k < rgb.cols * rgb.channels(); ++k) {
-      const double electrons = std::max(0.0, double(p[k]) * full_well_e_);
-      const double sigma = std::sqrt(electrons + read_var);
-      p[k] = float(p[k] + sigma * normal(rng) / full_well_e_);
-    }
+  for (float& v : rgb.data) {
+    const double electrons = std::max(0.0, double(v) * full_well_e_);
+    const double sigma = std::sqrt(electrons + read_var);
+    v = float(v + sigma * normal(rng) / full_well_e_);
   }
 }
 
-void QuantizationEffect::DoApply(cv::Mat& rgb, const PhotoContext&) const {
+void QuantizationEffect::Apply(ImageF& rgb, const PhotoContext&) const {
   const double levels = double((1 << bit_depth_) - 1);
-  for (int y = 0; y < rgb.rows; ++y) {
-    float* p = rgb.ptr<float>(y);
-    for (int k = 0; k < rgb.cols * rgb.channels(); ++k) {
-      const double v = std::min(1.0, std::max(0.0, double(p[k])));
-      // Level k of the bit depth, stored as the 16-bit code of the PNG (k * 65535 / levels,
-      // rounded) so that writing round(v * 65535) gives exactly that code.
-      p[k] = float(std::round(std::round(v * levels) * 65535 / levels) / 65535);
-    }
+  for (float& value : rgb.data) {
+    const double v = std::min(1.0, std::max(0.0, double(value)));
+    // Level k of the bit depth, stored as the 16-bit code of the PNG (k * 65535 / levels,
+    // rounded) so that writing round(v * 65535) gives exactly that code.
+    value = float(std::round(std::round(v * levels) * 65535 / levels) / 65535);
   }
 }
 

@@ -1,4 +1,4 @@
-#include "acquire/camera.h"
+#include "lib/synthetic/camera.h"
 
 #include <Eigen/Geometry>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "acquire/luminaire.h"
+#include "lib/synthetic/luminaire.h"
 
 #include <cmath>
 

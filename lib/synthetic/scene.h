@@ -1,16 +1,16 @@
-// The synthetic scene: setup, luminaire, camera, calibration target and effects (DESIGN §8).
-// Read from a JSON scene file (validated through core/json.h) or the built-in "default".
+// The synthetic scene: setup, luminaire, camera, calibration target and effects (docs/design.md
+// §8). Read from a JSON scene file (validated through core/json.h) or the built-in "default".
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "acquire/camera.h"
-#include "acquire/effects.h"
-#include "acquire/luminaire.h"
 #include "core/dataset.h"
 #include "core/grid.h"
+#include "lib/synthetic/camera.h"
+#include "lib/synthetic/effects.h"
+#include "lib/synthetic/luminaire.h"
 
 namespace lumislab {
 
@@ -22,7 +22,7 @@ struct SynthScene {
   SamplingGrid grid;
   double screen_w_mm = 0;  // physical screen, lab frame, centred on the optical axis
   double screen_h_mm = 0;
-  int k_max = 1;  // filter truncation (DESIGN §2)
+  int k_max = 1;  // filter truncation (docs/design.md §2)
   Luminaire luminaire;
   CameraSpec camera;
   CalibrationTarget calibration;                       // photo = photos/calib_0.png

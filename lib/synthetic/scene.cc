@@ -1,4 +1,4 @@
-#include "acquire/scene.h"
+#include "lib/synthetic/scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -38,15 +38,12 @@ Eigen::Vector3d Vec3(const JsonView& v) {
 void ParseSetup(const JsonView& root, SynthScene* scene) {
   const JsonView setup = root["setup"];
   scene->distance_mm = setup["distance_mm"].Positive();
-  scene->grid.nu = setup["grid"]["nu"].IntIn(1, 1000);
-  scene->grid.nv = setup["grid"]["nv"].IntIn(1, 1000);
-  scene->grid.spacing_mm = setup["grid"]["spacing_mm"].Positive();
-  const std::vector<double> screen = setup["screen_mm"].Numbers(2);
-  if (!(screen[0] > 0 && screen[1] > 0)) setup["screen_mm"].Fail("two lengths > 0 (w, h in mm)");
-  scene->screen_w_mm = screen[0];
-  scene->screen_h_mm = screen[1];
-  if (root.Has("filter"))
-    scene->k_max = root["filter"].Has("k_max") ? root["filter"]["k_max"].IntIn(1, 8) : 1;
+  scene->grid = ParseGrid(setup["grid"]);
+  const Eigen::Vector2d screen = ParseLengthPair(setup["screen_mm"]);
+  scene->screen_w_mm = screen.x();
+  scene->screen_h_mm = screen.y();
+  if (root.Has("filter") && root["filter"].Has("k_max"))
+    scene->k_max = ParseFilterTruncation(root["filter"]["k_max"]);
 }
 
 void ParseLuminaire(const JsonView& root, SynthScene* scene) {
@@ -89,6 +86,26 @@ void ParseCamera(const JsonView& root, SynthScene* scene) {
 // covering ~93 % x 87 % of a 1.2 m screen with a 40 mm white margin. The screen calibration fits
 // radial distortion to the board corners and extrapolates it to the screen edges; a board of
 // 14 x 11 squares of 60 mm left the default slab 5 % off in its corners (0.3 % with this one).
+// Every corner of the board must be in the photo, or the screen calibration finds no board.
+void CheckBoardInView(const SynthScene& scene) {
+  const CalibrationTarget& t = scene.calibration;
+  const PinholeCamera camera(scene.camera);
+  for (int a = 0; a <= t.squares_x; a += t.squares_x)
+    for (int b = 0; b <= t.squares_y; b += t.squares_y) {
+      const Eigen::Vector2d xy = t.origin_mm + t.square_mm * Eigen::Vector2d(a, b);
+      const Eigen::Vector3d lab(xy.x(), xy.y(), scene.distance_mm);
+      const Eigen::Vector3d in_camera =
+          camera.lab_from_camera().transpose() * (lab - scene.camera.position_mm);
+      const Eigen::Vector2d px = camera.Project(lab);
+      if (!(in_camera.z() > 0) || px.x() < 0 || px.y() < 0 || px.x() > scene.camera.width - 1 ||
+          px.y() > scene.camera.height - 1)
+        throw InputError(scene.source, "camera",
+                         "a view that holds the whole calibration board (corner at " +
+                             std::to_string(xy.x()) + ", " + std::to_string(xy.y()) + " mm)",
+                         "a corner outside the photo");
+    }
+}
+
 void ParseCalibration(const JsonView& root, SynthScene* scene) {
   CalibrationTarget& t = scene->calibration;
   t.photo = "photos/calib_0.png";
@@ -109,6 +126,9 @@ void ParseCalibration(const JsonView& root, SynthScene* scene) {
       c.Fail("a checkerboard that fits on the screen");
   }
   t.origin_mm = {-0.5 * t.squares_x * t.square_mm, -0.5 * t.squares_y * t.square_mm};
+  // What lumislab-calibrate would refuse after the capture is refused before it.
+  t.Check(scene->source, "calibration");
+  CheckBoardInView(*scene);
 }
 
 }  // namespace
@@ -154,11 +174,7 @@ Dataset DatasetSkeleton(const SynthScene& scene) {
   ds.grid = scene.grid;
   ds.screen_w_mm = scene.screen_w_mm;
   ds.screen_h_mm = scene.screen_h_mm;
-  const DualFilter filter = scene.Filter();
-  ds.filter.basis = "bell";
-  ds.filter.spacing_mm = scene.grid.spacing_mm;
-  ds.filter.dual_coefficients = filter.coefficients();
-  ds.filter.peak = filter.Peak2D();
+  ds.filter = FilterInfo::Of(scene.Filter(), scene.grid.spacing_mm);
   ds.saturation_level = 1.0;
   ds.calibration = scene.calibration;
   ds.synthetic = true;

@@ -1,13 +1,12 @@
 // Rendering of the synthetic photos: the slide photos of each grid position and the
-// checkerboard photo for the screen calibration.
+// checkerboard photo for the screen calibration (normalised linear values, before effects).
 #pragma once
 
-#include <opencv2/core.hpp>
 #include <vector>
 
-#include "acquire/camera.h"
-#include "acquire/scene.h"
 #include "core/image.h"
+#include "lib/synthetic/camera.h"
+#include "lib/synthetic/scene.h"
 
 namespace lumislab {
 
@@ -23,22 +22,16 @@ struct ScreenView {
 };
 
 // Photos of position (i, j) through T+ and T- before any effect: normalised linear RGB values
-// v = E / radiometric_scale * exposure (3 channels, RGB order). `stride` > 1 renders only every
-// stride-th visible pixel (for the cheap pre-pass that sets the scale).
+// v = E / radiometric_scale * exposure (3 channels, RGB order).
 void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int j,
                     double radiometric_scale, ImageF* plus, ImageF* minus);
 // Largest slide irradiance (W/m^2, any channel, either slide) over all positions, sampling every
-// `stride`-th screen pixel; divides out to the radiometric scale.
+// `stride`-th screen pixel (a cheap pre-pass); divides out to the radiometric scale.
 double MaxSlideIrradiance(const SynthScene& scene, const ScreenView& view, int stride, int threads);
 
-// The checkerboard of scene.calibration on the screen plane, 8-bit grayscale, 4x4 supersampled:
-// white 0.8, black 0.05, white dot of diameter 0.4 square in square (0, 0); outside the board
-// the white screen (0.8), outside the screen 0.
-cv::Mat RenderCalibration(const SynthScene& scene);
-
-// View an ImageF as a CV_32FC3 (no copy).
-inline cv::Mat AsMat(ImageF& image) {
-  return cv::Mat(image.height, image.width, CV_32FC(image.channels), image.data.data());
-}
+// The checkerboard of scene.calibration on the screen as the scene's camera sees it (1 channel,
+// linear reflectance, lib/synthetic/board.h's default look: white 0.8, black 0.05, the white
+// screen around the board, 0 outside the screen).
+ImageF RenderCalibration(const SynthScene& scene, int threads = 1);
 
 }  // namespace lumislab

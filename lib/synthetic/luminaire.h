@@ -1,5 +1,6 @@
-// The synthetic luminaire: point emitters with cos^n lobes behind the filter plane S (DESIGN §1-3).
-// Everything here is analytic, so it doubles as the ground truth of every synthetic test.
+// The synthetic luminaire: point emitters with cos^n lobes behind the filter plane S
+// (docs/design.md §1-3). Everything here is analytic, so it doubles as the ground truth of every
+// synthetic test.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,0 +1,259 @@
+#include "lib/photo/photo_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/exr_io.h"
+
+namespace lumislab {
+namespace {
+
+float SrgbToLinear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+double LinearToSrgb(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+}
+
+void CheckRegularFile(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw BadInput(path + ": photo missing");
+  if (!std::filesystem::is_regular_file(status))
+    throw BadInput(path + ": not a regular file (a folder, FIFO or device is not a photo)");
+}
+
+cv::Mat DecodeWithOpenCv(const std::string& path) {
+  cv::Mat pixels;
+  try {
+    pixels = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+  } catch (const cv::Exception& e) {
+    throw BadInput(path + ": cannot decode the photo: " + e.what());
+  }
+  if (pixels.empty()) throw BadInput(path + ": cannot decode the photo (corrupt file)");
+  const int depth = pixels.depth(), channels = pixels.channels();
+  if (depth != CV_8U && depth != CV_16U)
+    throw InputError(path, "pixel format", "8 or 16 bits per channel",
+                     std::to_string(pixels.elemSize1() * 8) + "-bit samples");
+  if (channels == 4) {  // alpha carries nothing we measure
+    cv::Mat bgr;
+    cv::cvtColor(pixels, bgr, cv::COLOR_BGRA2BGR);
+    pixels = bgr;
+  } else if (channels != 1 && channels != 3) {
+    throw InputError(path, "channels", "1, 3 or 4", std::to_string(channels));
+  }
+  return pixels;
+}
+
+}  // namespace
+
+void PhotoSpec::Check(const std::string& where) const {
+  auto finite = [&](double v, const char* field, bool positive) {
+    if (!std::isfinite(v) || (positive && !(v > 0)))
+      throw BadInput(where + ": " + field + ": expected a finite number" +
+                     (positive ? " > 0" : "") + ", got " + std::to_string(v));
+  };
+  finite(black_level, "black_level", false);
+  finite(white_level, "white_level", true);
+  finite(saturation_level, "saturation_level", true);
+  finite(exposure, "exposure", true);
+  if (!(white_level > black_level))
+    throw BadInput(where + ": white_level: expected > black_level (" + std::to_string(black_level) +
+                   "), got " + std::to_string(white_level));
+}
+
+PhotoSpec PhotoSpecOf(const Dataset& dataset, const PhotoEntry& entry) {
+  PhotoSpec spec;
+  spec.transfer = dataset.photo_transfer == "linear" ? Transfer::kLinear
+                  : dataset.photo_transfer == "srgb" ? Transfer::kSrgb
+                                                     : Transfer::kAuto;
+  spec.black_level = dataset.black_level;
+  spec.white_level = dataset.white_level;
+  spec.saturation_level = dataset.saturation_level;
+  spec.exposure = entry.exposure;
+  return spec;
+}
+
+PhotoSpec CalibrationPhotoSpec(const Dataset& dataset) {
+  PhotoEntry entry;
+  PhotoSpec spec = PhotoSpecOf(dataset, entry);
+  spec.saturation_level = 1e30;  // the board's contrast is what counts, not clipping
+  return spec;
+}
+
+const char* PhotoFormatName(PhotoFormat format) {
+  switch (format) {
+    case PhotoFormat::kPng:
+      return "PNG";
+    case PhotoFormat::kJpeg:
+      return "JPEG";
+    case PhotoFormat::kTiff:
+      return "TIFF";
+    case PhotoFormat::kExr:
+      return "EXR";
+  }
+  return "?";
+}
+
+PhotoFormat DetectPhotoFormat(const std::string& path) {
+  CheckRegularFile(path);
+  unsigned char magic[8] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(magic), sizeof magic);
+  if (!in && in.gcount() < 4) throw BadInput(path + ": not a photo (file too short)");
+  if (std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0) return PhotoFormat::kPng;
+  if (magic[0] == 0xff && magic[1] == 0xd8 && magic[2] == 0xff) return PhotoFormat::kJpeg;
+  if (std::memcmp(magic, "II*\0", 4) == 0 || std::memcmp(magic, "MM\0*", 4) == 0)
+    return PhotoFormat::kTiff;
+  if (std::memcmp(magic, "\x76\x2f\x31\x01", 4) == 0) return PhotoFormat::kExr;
+  throw BadInput(path + ": not a photo lumislab reads (PNG, JPEG, TIFF or OpenEXR)");
+}
+
+double Photo::CodeMax() const {
+  switch (pixels.depth()) {
+    case CV_8U:
+      return 255.0;
+    case CV_16U:
+      return 65535.0;
+    default:
+      return 1.0;
+  }
+}
+
+double Photo::Gain() const {
+  return 1.0 / (CodeMax() * (spec.white_level - spec.black_level) * spec.exposure);
+}
+
+double Photo::Offset() const {
+  return spec.black_level / ((spec.white_level - spec.black_level) * spec.exposure);
+}
+
+double Photo::SaturationCode() const {
+  if (pixels.depth() == CV_32F) return spec.saturation_level;
+  return std::ceil(spec.saturation_level * CodeMax() - 1e-9);
+}
+
+Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
+  spec.Check(path);
+  Photo photo;
+  photo.path = path;
+  photo.spec = spec;
+  photo.format = DetectPhotoFormat(path);
+  if (photo.format == PhotoFormat::kExr) {
+    const ImageF rgb = ReadExr(path, {"R", "G", "B"});  // BadInput naming file and channel
+    photo.pixels =
+        cv::Mat(rgb.height, rgb.width, CV_32FC3, const_cast<float*>(rgb.data.data())).clone();
+    photo.rgb_order = true;
+  } else {
+    photo.pixels = DecodeWithOpenCv(path);
+  }
+  photo.transfer = spec.transfer != Transfer::kAuto ? spec.transfer
+                   : photo.pixels.depth() == CV_8U  ? Transfer::kSrgb
+                                                    : Transfer::kLinear;
+  return photo;
+}
+
+LinearReader::LinearReader(const Photo& photo) : photo_(photo) {
+  channels_ = photo.pixels.channels();
+  r_ = photo.rgb_order || channels_ == 1 ? 0 : 2;
+  b_ = channels_ == 1 ? 0 : 2 - r_;
+  const bool srgb = photo.transfer == Transfer::kSrgb;
+  for (int v = 0; v < 256; ++v) curve8_[v] = srgb ? SrgbToLinear(v / 255.f) : v / 255.f;
+  inv_max_ = float(1.0 / photo.CodeMax());
+  black_ = float(photo.spec.black_level);
+  inv_range_exposure_ =
+      float(1.0 / ((photo.spec.white_level - photo.spec.black_level) * photo.spec.exposure));
+  saturation_ = float(photo.spec.saturation_level);
+}
+
+float LinearReader::Value(float curve_value) const {
+  return (curve_value - black_) * inv_range_exposure_;
+}
+
+void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
+  const cv::Mat& m = photo_.pixels;
+  const int offsets[3] = {r_, channels_ == 1 ? 0 : 1, b_};
+  const bool srgb = photo_.transfer == Transfer::kSrgb;
+  for (int c = 0; c < 3; ++c) {
+    float v;
+    if (m.depth() == CV_32F) {
+      v = m.ptr<float>(y)[size_t(x) * channels_ + offsets[c]];
+    } else if (m.depth() == CV_16U) {
+      v = m.ptr<uint16_t>(y)[size_t(x) * channels_ + offsets[c]] * inv_max_;
+      if (srgb) v = SrgbToLinear(v);
+    } else {
+      v = curve8_[m.ptr<uint8_t>(y)[size_t(x) * channels_ + offsets[c]]];
+    }
+    clipped[c] = !(v < saturation_);  // NaN counts as clipped
+    rgb[c] = Value(v);
+  }
+}
+
+cv::Mat LinearGray(const Photo& photo) {
+  const LinearReader reader(photo);
+  cv::Mat gray(photo.pixels.rows, photo.pixels.cols, CV_32FC1);
+  for (int y = 0; y < gray.rows; ++y) {
+    float* row = gray.ptr<float>(y);
+    for (int x = 0; x < gray.cols; ++x) {
+      float rgb[3];
+      bool clipped[3];
+      reader.Read(y, x, rgb, clipped);
+      row[x] = 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2];
+      if (!std::isfinite(row[x])) throw BadInput(photo.path + ": photo holds non-finite values");
+    }
+  }
+  return gray;
+}
+
+void WriteImageFile(const std::string& path, const cv::Mat& image) {
+  WriteAtomically(path, [&](const std::string& tmp) {
+    bool ok = false;
+    try {
+      ok = cv::imwrite(tmp, image);
+    } catch (const cv::Exception& e) {
+      throw IoError(path, std::string("cannot encode the image: ") + e.what());
+    }
+    if (!ok) throw IoError(path, "cannot encode the image");
+  });
+}
+
+void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding) {
+  LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "WritePhoto: 1 or 3 channels");
+  if (encoding == PhotoEncoding::kHalfExr || encoding == PhotoEncoding::kFloatExr ||
+      encoding == PhotoEncoding::kFloatExrPiz) {
+    ExrOptions options;
+    options.half = encoding == PhotoEncoding::kHalfExr;
+    options.compress = encoding != PhotoEncoding::kFloatExr;
+    const std::vector<std::string> names = linear.channels == 3
+                                               ? std::vector<std::string>{"R", "G", "B"}
+                                               : std::vector<std::string>{"Y"};
+    WriteExr(path, linear, names, {}, options);
+    return;
+  }
+  const bool srgb = encoding == PhotoEncoding::kSrgb8Png;
+  const int type = srgb ? CV_8UC(linear.channels) : CV_16UC(linear.channels);
+  const double max = srgb ? 255.0 : 65535.0;
+  cv::Mat out(linear.height, linear.width, type);
+  for (int y = 0; y < linear.height; ++y)
+    for (int x = 0; x < linear.width; ++x)
+      for (int c = 0; c < linear.channels; ++c) {
+        const double v = linear.at(x, y, c);
+        const double code = std::round((srgb ? LinearToSrgb(v) : std::clamp(v, 0.0, 1.0)) * max);
+        const int oc = linear.channels == 3 ? 2 - c : 0;  // OpenCV stores BGR
+        if (srgb)
+          out.ptr<uint8_t>(y)[x * linear.channels + oc] = uint8_t(code);
+        else
+          out.ptr<uint16_t>(y)[x * linear.channels + oc] = uint16_t(code);
+      }
+  WriteImageFile(path, out);
+}
+
+}  // namespace lumislab

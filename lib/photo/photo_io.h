@@ -1,0 +1,99 @@
+// The one photo decoder of lumislab: every stage that reads a camera photo reads it here
+// (docs/design.md §5). It owns
+//   - format detection from the file's content (the extension is not trusted),
+//   - the transfer curve: 8-bit photos are camera output and linearised through the sRGB curve
+//     unless told otherwise, 16-bit and float photos are linear,
+//   - black and white level: linear = (curve(code / code_max) - black) / (white - black),
+//   - the saturation mask: a value curve(code / code_max) >= saturation_level is clipped,
+//   - exposure normalisation: values are divided by the photo's relative exposure, so photos of
+//     different exposures are comparable.
+// Writing image files (atomically) is here too, so that every PNG/EXR a tool writes goes
+// through one place.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "core/dataset.h"
+#include "core/image.h"
+
+namespace lumislab {
+
+enum class PhotoFormat { kPng, kJpeg, kTiff, kExr };
+enum class Transfer { kAuto, kLinear, kSrgb };
+
+// How to interpret a photo's codes (dataset.json radiometry and the photo's exposure).
+struct PhotoSpec {
+  Transfer transfer = Transfer::kAuto;  // kAuto: 8-bit -> sRGB, 16-bit and float -> linear
+  double black_level = 0;               // in curve(code / code_max) units
+  double white_level = 1;
+  double saturation_level = 1;  // curve(code / code_max) at or above this is clipped
+  double exposure = 1;          // relative exposure t ISO / N^2 (any consistent unit)
+  void Check(const std::string& where) const;  // BadInput naming `where` and the field
+};
+
+struct Photo {
+  std::string path;
+  PhotoFormat format = PhotoFormat::kPng;
+  // As stored: CV_8U or CV_16U with 1 or 3 channels (BGR order, as OpenCV decodes), or CV_32FC3
+  // in RGB order (EXR channels R, G, B).
+  cv::Mat pixels;
+  bool rgb_order = false;
+  Transfer transfer = Transfer::kLinear;  // resolved: never kAuto
+  PhotoSpec spec;
+
+  double CodeMax() const;  // 255, 65535 or 1 (float)
+  // For a linear transfer: linear value = code * Gain() - Offset(). (Fast paths that work on
+  // the stored codes use these; everything else uses LinearReader.)
+  double Gain() const;
+  double Offset() const;
+  // Smallest stored code that counts as clipped (linear transfer).
+  double SaturationCode() const;
+};
+
+// The spec of a dataset's slide photo (its radiometry and the photo's exposure), and of its
+// calibration photo (exposure 1, nothing clipped).
+PhotoSpec PhotoSpecOf(const Dataset& dataset, const PhotoEntry& entry);
+PhotoSpec CalibrationPhotoSpec(const Dataset& dataset);
+
+// Decodes a photo. A path that is not a regular file, an unknown or corrupt format, or an
+// unsupported pixel layout is BadInput naming the photo (exit 2).
+Photo DecodePhoto(const std::string& path, const PhotoSpec& spec = {});
+// The format from the file's first bytes; BadInput naming the file when it is none of ours.
+PhotoFormat DetectPhotoFormat(const std::string& path);
+const char* PhotoFormatName(PhotoFormat format);
+
+// Linear, exposure-normalised RGB of a pixel, and which channels are clipped.
+class LinearReader {
+ public:
+  explicit LinearReader(const Photo& photo);
+  void Read(int y, int x, float rgb[3], bool clipped[3]) const;
+
+ private:
+  float Value(float curve_value) const;
+  const Photo& photo_;
+  int channels_;
+  int r_, b_;  // offsets of red and blue in a pixel
+  float curve8_[256];
+  float inv_max_, black_, inv_range_exposure_, saturation_;
+};
+
+// The whole photo as linear, exposure-normalised Rec. 709 luminance (CV_32FC1); BadInput when a
+// value is not finite.
+cv::Mat LinearGray(const Photo& photo);
+
+// Writes `image` (8-bit or 16-bit, 1 or 3 channels in OpenCV's BGR order) as PNG (or any format
+// OpenCV writes, by extension) under a temporary name, then renames it into place.
+void WriteImageFile(const std::string& path, const cv::Mat& image);
+
+// How the synthetic camera stores a photo of normalised linear RGB values (ImageF, 3 channels).
+enum class PhotoEncoding {
+  kLinear16Png,  // round(v * 65535), clipped: a 16-bit camera (values already quantised)
+  kSrgb8Png,     // through the sRGB curve, 8 bit: a camera's PNG/JPEG-like output
+  kHalfExr,      // half-float EXR, PIZ (lossless for half; ~3e-4 relative precision)
+  kFloatExr,     // 32-bit float EXR, uncompressed
+  kFloatExrPiz,  // 32-bit float EXR, PIZ
+};
+void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding);
+
+}  // namespace lumislab

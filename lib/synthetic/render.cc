@@ -1,0 +1,81 @@
+#include "lib/synthetic/render.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel.h"
+#include "lib/synthetic/board.h"
+
+namespace lumislab {
+
+ScreenView ScreenView::Of(const SynthScene& scene) {
+  ScreenView view;
+  const PinholeCamera camera(scene.camera);
+  view.width = scene.camera.width;
+  view.height = scene.camera.height;
+  const double half_w = 0.5 * scene.screen_w_mm, half_h = 0.5 * scene.screen_h_mm;
+  Eigen::Vector2d xy;
+  for (int y = 0; y < view.height; ++y)
+    for (int x = 0; x < view.width; ++x)
+      if (camera.PlanePoint(x, y, scene.distance_mm, &xy) && std::abs(xy.x()) <= half_w &&
+          std::abs(xy.y()) <= half_h) {
+        view.pixels.push_back(y * view.width + x);
+        view.lab_mm.push_back(xy);
+      }
+  return view;
+}
+
+void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int j,
+                    double radiometric_scale, ImageF* plus, ImageF* minus) {
+  *plus = ImageF(view.width, view.height, 3);
+  *minus = ImageF(view.width, view.height, 3);
+  const DualFilter filter = scene.Filter();
+  const double peak = filter.Peak2D();
+  const Eigen::Vector2d c = scene.grid.Centre(i, j);
+  const double gain = scene.camera.exposure / radiometric_scale;
+  Eigen::Vector3d e_plus, e_minus;
+  for (size_t k = 0; k < view.pixels.size(); ++k) {
+    // The luminaire was moved by -c: lab (x, y) is (x, y) + c in the luminaire frame.
+    const Eigen::Vector2d st = view.lab_mm[k] + c;
+    scene.luminaire.SlideIrradiance(filter, peak, scene.grid.spacing_mm, c, scene.distance_mm,
+                                    st.x(), st.y(), &e_plus, &e_minus);
+    float* p = &plus->data[size_t(view.pixels[k]) * 3];
+    float* n = &minus->data[size_t(view.pixels[k]) * 3];
+    for (int ch = 0; ch < 3; ++ch) {
+      p[ch] = float(e_plus[ch] * gain);
+      n[ch] = float(e_minus[ch] * gain);
+    }
+  }
+}
+
+double MaxSlideIrradiance(const SynthScene& scene, const ScreenView& view, int stride,
+                          int threads) {
+  const DualFilter filter = scene.Filter();
+  const double peak = filter.Peak2D();
+  std::vector<double> max_of(scene.grid.count(), 0.0);
+  ParallelFor(scene.grid.count(), threads, [&](int q) {
+    Eigen::Vector3d e_plus, e_minus;
+    const Eigen::Vector2d c = scene.grid.Centre(q % scene.grid.nu, q / scene.grid.nu);
+    for (size_t k = 0; k < view.pixels.size(); k += stride) {
+      const Eigen::Vector2d st = view.lab_mm[k] + c;
+      scene.luminaire.SlideIrradiance(filter, peak, scene.grid.spacing_mm, c, scene.distance_mm,
+                                      st.x(), st.y(), &e_plus, &e_minus);
+      max_of[q] = std::max({max_of[q], e_plus.maxCoeff(), e_minus.maxCoeff()});
+    }
+  });
+  return *std::max_element(max_of.begin(), max_of.end());
+}
+
+ImageF RenderCalibration(const SynthScene& scene, int threads) {
+  const PinholeCamera camera(scene.camera);
+  BoardLook look;
+  look.screen_half_mm = {0.5 * scene.screen_w_mm, 0.5 * scene.screen_h_mm};
+  return RenderBoardPhoto(
+      scene.calibration, scene.camera.width, scene.camera.height,
+      [&](const Eigen::Vector2d& px, Eigen::Vector2d* lab) {
+        return camera.PlanePoint(px.x(), px.y(), scene.distance_mm, lab);
+      },
+      look, threads);
+}
+
+}  // namespace lumislab

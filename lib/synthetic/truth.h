@@ -1,0 +1,31 @@
+// Ground truth of a synthetic capture (truth/): the exact E_ij of a luminaire at the slab texel
+// centres, and the true camera (truth/camera.json) for the calibration tests. The capture, the
+// preview's tests and benchmarks and `lumislab-preview --write-test-slab` all take their exact
+// slabs from here.
+#pragma once
+
+#include <string>
+
+#include "core/slab.h"
+#include "lib/synthetic/luminaire.h"
+#include "lib/synthetic/scene.h"
+
+namespace lumislab {
+
+// Exact E_ij(s,t) (W/m^2, luminaire frame) at the texel centres of `info` through its filter,
+// mask 1 everywhere.
+SlabPosition TruthPosition(const Luminaire& luminaire, const SlabInfo& info, int i, int j);
+
+// A complete truth slab in `dir`: every position of info.grid and slab.json, positions computed
+// and written on `threads` threads.
+void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir, int threads);
+
+// The slab layout of a scene's capture at `resolution` texels per side (d, grid, screen window,
+// filter, W/m^2).
+SlabInfo TruthSlabInfo(const SynthScene& scene, int resolution);
+
+// truth/camera.json: intrinsics, pose (lab frame), and the exact homographies of the screen
+// plane (screen_from_image: pixel -> lab mm, row-major, and its inverse).
+void WriteTruthCamera(const SynthScene& scene, const std::string& path);
+
+}  // namespace lumislab

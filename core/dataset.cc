@@ -111,11 +111,11 @@ Dataset Dataset::Load(const std::string& dir) {
   if (radiometry.Has("scale_w_m2")) ds.radiometric_scale = radiometry["scale_w_m2"].Positive();
   ds.saturation_level =
       radiometry.Has("saturation_level") ? radiometry["saturation_level"].Positive() : 1.0;
-  ds.photo_transfer =
-      radiometry.Has("transfer") ? radiometry["transfer"].OneOf({"auto", "linear", "srgb"}) : "auto";
+  ds.photo_transfer = radiometry.Has("transfer")
+                          ? radiometry["transfer"].OneOf({"auto", "linear", "srgb"})
+                          : "auto";
   ds.black_level = radiometry.Has("black_level") ? radiometry["black_level"].NumberIn(0, 0.5) : 0;
-  ds.white_level =
-      radiometry.Has("white_level") ? radiometry["white_level"].NumberIn(0.5, 1e6) : 1;
+  ds.white_level = radiometry.Has("white_level") ? radiometry["white_level"].NumberIn(0.5, 1e6) : 1;
 
   const JsonView calib = root["calibration"];
   ds.calibration.photo = calib["photo"].String();

@@ -1,5 +1,5 @@
 // GL contexts of the preview: OSMesa offscreen (headless renders, tests, benchmarks) and a GLFW
-// window, both loading GL 4.5 core through the same glad loader (DESIGN §6).
+// window, both loading GL 4.5 core through the same glad loader (docs/design.md §6).
 #pragma once
 
 #include <memory>

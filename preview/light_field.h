@@ -1,4 +1,4 @@
-// The slab as the renderer uses it (DESIGN §4): per grid position the texture
+// The slab as the renderer uses it (docs/design.md §4): per grid position the texture
 // E'_ij = E_ij / g_ij in W/sr (g_ij the shift-invariant geometry term, converted to m^-2), and the
 // CPU evaluation of the same textured-spot-light formula (for tests and the exact comparisons).
 #pragma once

@@ -245,7 +245,7 @@ int RunPreview(int argc, char** argv) {
   int threads = 0;
   std::string size = "400x400";
   CLI::App app{
-      "lumislab-preview: the measured luminaire lighting a scene (DESIGN §4); headless "
+      "lumislab-preview: the measured luminaire lighting a scene (docs/design.md §4); headless "
       "(OSMesa, --out) or in a window (--window)"};
   app.add_option("--slab", config.slab_dir, "slab folder (slab.json + pos_<i>_<j>.exr)")
       ->required();

@@ -92,20 +92,21 @@ void DetectionOptions::Check() const {
                    std::to_string(min_dot_contrast));
 }
 
-BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
-                         const std::string& photo, const DetectionOptions& options) {
-  options.Check();
-  CV_Assert(gray8.type() == CV_8UC1);
+namespace {
+
+// OpenCV's corner grid on a copy at most max_detection_px long, then sub-pixel corners on the
+// full photo (cv::cornerSubPix, then the saddle-point fit). Fills detector, square_px and
+// saddle_refined.
+std::vector<cv::Point2f> FindGrid(const cv::Mat& gray8, const CalibrationTarget& target,
+                                  const std::string& photo, const DetectionOptions& options,
+                                  BoardCorners* out) {
   const int nc = target.squares_x - 1, nr = target.squares_y - 1;
-  const cv::Size pattern(nc, nr);
   const double scale =
       std::min(1.0, double(options.max_detection_px) / std::max(gray8.cols, gray8.rows));
   cv::Mat small = gray8;
   if (scale < 1) cv::resize(gray8, small, cv::Size(), scale, scale, cv::INTER_AREA);
-
-  BoardCorners out;
   std::vector<cv::Point2f> corners;
-  if (!FindCorners(small, pattern, options.sb_fallback, &corners, &out.detector) ||
+  if (!FindCorners(small, cv::Size(nc, nr), options.sb_fallback, &corners, &out->detector) ||
       int(corners.size()) != nc * nr)
     throw BadInput(photo + ": no checkerboard with " + SizeText(target) +
                    " inner corners found (blank photo, board not in view, or too small)");
@@ -116,20 +117,24 @@ BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
     for (int c = 0; c + 1 < nc; ++c)
       spacing.push_back(cv::norm(corners[r * nc + c + 1] - corners[r * nc + c]));
   std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-  out.square_px = spacing[spacing.size() / 2];
-  const int win = std::clamp(int(0.4 * out.square_px), 2, 15);
+  out->square_px = spacing[spacing.size() / 2];
+  const int win = std::clamp(int(0.4 * out->square_px), 2, 15);
   try {
     cv::cornerSubPix(gray8, corners, cv::Size(win, win), cv::Size(-1, -1),
                      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 1e-4));
   } catch (const cv::Exception& e) {
     throw Failure(photo + ": corner refinement failed: " + e.what());
   }
-  out.saddle_refined = RefineSaddlePoints(gray8, out.square_px, &corners);
-  if (out.saddle_refined < int(corners.size()))
-    LogDebug(photo, ": ", int(corners.size()) - out.saddle_refined,
+  out->saddle_refined = RefineSaddlePoints(gray8, out->square_px, &corners);
+  if (out->saddle_refined < int(corners.size()))
+    LogDebug(photo, ": ", int(corners.size()) - out->saddle_refined,
              " corner(s) kept cv::cornerSubPix positions (no saddle fit)");
+  return corners;
+}
 
-  // Board-index coordinates (square units) of OpenCV's grid taken as is.
+// Homography from board-index coordinates (square units, OpenCV's grid taken as is) to pixels.
+cv::Matx33d ImageFromIndex(const std::vector<cv::Point2f>& corners, int nc, int nr,
+                           const std::string& photo) {
   std::vector<cv::Point2d> index_pts, image_pts;
   for (int k = 0; k < nc * nr; ++k) {
     index_pts.emplace_back(k % nc + 1, k / nc + 1);
@@ -142,9 +147,13 @@ BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
     throw BadInput(photo + ": degenerate checkerboard view (" + e.what() + ")");
   }
   if (h.empty()) throw BadInput(photo + ": degenerate checkerboard view (no homography)");
-  const cv::Matx33d image_from_index(h);
+  return cv::Matx33d(h);
+}
 
-  // Black/white contrast from the centres of the squares that are not corner squares.
+// Black/white contrast from the centres of the squares that are not corner squares.
+double SquareContrast(const cv::Mat& gray8, const cv::Matx33d& image_from_index,
+                      const CalibrationTarget& target) {
+  const int nc = target.squares_x - 1, nr = target.squares_y - 1;
   double sum[2] = {0, 0};
   int count[2] = {0, 0};
   for (int b = 0; b < target.squares_y; ++b)
@@ -155,12 +164,18 @@ BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
       sum[(a + b) % 2] += v;
       ++count[(a + b) % 2];
     }
-  const double contrast =
-      (count[0] && count[1]) ? std::abs(sum[0] / count[0] - sum[1] / count[1]) : 0.0;
+  return (count[0] && count[1]) ? std::abs(sum[0] / count[0] - sum[1] / count[1]) : 0.0;
+}
 
-  // The dot: bright disk (radius 0.2 square) in a dark square, in one of the four corners.
+// The dot: a bright disk (radius 0.2 square) in a dark square, in one of the four corners.
+// Returns which corner holds it (0 identity, 1 flip_x, 2 flip_y, 3 rotate_180); fills the
+// contrasts; BadInput when there is no clear winner.
+int FindDot(const cv::Mat& gray8, const cv::Matx33d& image_from_index,
+            const CalibrationTarget& target, const std::string& photo,
+            const DetectionOptions& options, BoardCorners* out) {
+  const int nc = target.squares_x - 1, nr = target.squares_y - 1;
+  const double contrast = SquareContrast(gray8, image_from_index, target);
   const std::array<std::pair<int, int>, 4> corner_squares = {{{0, 0}, {nc, 0}, {0, nr}, {nc, nr}}};
-  const std::array<const char*, 4> names = {"identity", "flip_x", "flip_y", "rotate_180"};
   std::array<double, 4> score;
   for (int k = 0; k < 4; ++k) {
     const double cx = corner_squares[k].first + 0.5, cy = corner_squares[k].second + 0.5;
@@ -171,15 +186,29 @@ BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
   }
   std::array<int, 4> order = {0, 1, 2, 3};
   std::sort(order.begin(), order.end(), [&](int x, int y) { return score[x] > score[y]; });
-  out.dot_contrast = score[order[0]];
-  out.runner_up_contrast = score[order[1]];
-  if (!(out.dot_contrast >= options.min_dot_contrast) ||
-      out.runner_up_contrast > 0.5 * out.dot_contrast)
+  out->dot_contrast = score[order[0]];
+  out->runner_up_contrast = score[order[1]];
+  if (!(out->dot_contrast >= options.min_dot_contrast) ||
+      out->runner_up_contrast > 0.5 * out->dot_contrast)
     throw BadInput(photo + ": the orientation dot in board square (0, 0) was not found (best " +
-                   Num(out.dot_contrast) + ", runner-up " + Num(out.runner_up_contrast) +
+                   Num(out->dot_contrast) + ", runner-up " + Num(out->runner_up_contrast) +
                    " of the black/white contrast; need >= " + Num(options.min_dot_contrast) +
                    " and a clear winner)");
-  const int found = order[0];
+  return order[0];
+}
+
+}  // namespace
+
+BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
+                         const std::string& photo, const DetectionOptions& options) {
+  options.Check();
+  CV_Assert(gray8.type() == CV_8UC1);
+  const int nc = target.squares_x - 1, nr = target.squares_y - 1;
+  BoardCorners out;
+  const std::vector<cv::Point2f> corners = FindGrid(gray8, target, photo, options, &out);
+  const cv::Matx33d image_from_index = ImageFromIndex(corners, nc, nr, photo);
+  const int found = FindDot(gray8, image_from_index, target, photo, options, &out);
+  const std::array<const char*, 4> names = {"identity", "flip_x", "flip_y", "rotate_180"};
   out.orientation = names[found];
   const bool flip_x = found == 1 || found == 3, flip_y = found == 2 || found == 3;
   for (int k = 0; k < nc * nr; ++k) {

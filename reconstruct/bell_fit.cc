@@ -140,28 +140,34 @@ class MaskedGrid {
   std::vector<double>&tmp_, &tmp2_;
 };
 
+// Sets ws.b to the data on the seen texels, ws.rhs = B^T b, and the starting point ws.x: the
+// data improved by one Neumann step B^-1 ~ 2I - B (B is within [0.44, 1] of I): c0 = 2b - Bb,
+// whose error (I - B)^2 c is tiny for smooth fields. The other vectors are zeroed.
+template <int CH>
+void WarmStart(const MaskedGrid<CH>& grid, const std::vector<double>& data, Workspace& ws) {
+  const std::vector<int>& act = grid.active();
+  for (auto* v : {&ws.x, &ws.b, &ws.rhs, &ws.r, &ws.z, &ws.p, &ws.ap}) v->assign(grid.Size(), 0.0);
+  for (int k : act)
+    for (int c = 0; c < CH; ++c) ws.b[size_t(k) * CH + c] = data[size_t(k) * CH + c];
+  grid.ApplyB(ws.b, ws.ap);
+  for (int k : act)
+    for (int c = 0; c < CH; ++c) {
+      const size_t i = size_t(k) * CH + c;
+      ws.x[i] = 2 * ws.b[i] - ws.ap[i];
+    }
+  grid.ApplyBt(ws.b, ws.rhs);
+}
+
 template <int CH>
 std::vector<double> Solve(const std::vector<double>& data, const std::vector<unsigned char>& seen,
                           int width, int height, const BellFitOptions& options,
                           BellFitReport* report) {
   const MaskedGrid<CH> grid(seen, width, height);
   const std::vector<int>& act = grid.active();
-  const size_t n = grid.Size();
-  // Warm start from the data b, improved by one Neumann step B^-1 ~ 2I - B (B is within [0.44,
-  // 1] of I): c0 = 2b - Bb, whose error (I - B)^2 c is tiny for smooth fields.
   Workspace& ws = ThreadWorkspace();
-  std::vector<double>&x = ws.x, &b = ws.b, &rhs = ws.rhs, &r = ws.r, &z = ws.z, &p = ws.p,
-  &ap = ws.ap, &inv_diag = ws.inv_diag;
-  for (auto* v : {&x, &b, &rhs, &r, &z, &p, &ap}) v->assign(n, 0.0);
-  for (int k : act)
-    for (int c = 0; c < CH; ++c) b[size_t(k) * CH + c] = data[size_t(k) * CH + c];
-  grid.ApplyB(b, ap);
-  for (int k : act)
-    for (int c = 0; c < CH; ++c) {
-      const size_t i = size_t(k) * CH + c;
-      x[i] = 2 * b[i] - ap[i];
-    }
-  grid.ApplyBt(b, rhs);
+  WarmStart(grid, data, ws);
+  std::vector<double>&x = ws.x, &rhs = ws.rhs, &r = ws.r, &z = ws.z, &p = ws.p, &ap = ws.ap,
+  &inv_diag = ws.inv_diag;
   grid.ApplyNormal(x, options.lambda, ap);
   const std::vector<double> diag = grid.Diagonal(options.lambda);
   inv_diag.resize(diag.size());

@@ -4,111 +4,115 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
 
 namespace lumislab {
 
-RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayout& layout,
-                           const Eigen::Vector2d& centre_mm, double screen_w_mm, double screen_h_mm,
-                           int samples_per_texel) {
-  RectifyMap m;
-  m.res_x = layout.res_x;
-  m.res_y = layout.res_y;
-  const int nx = m.res_x + 1, ny = m.res_y + 1;
-  const Eigen::Matrix3d image_from_screen = calibration.screen_from_image.inverse();
+namespace {
+
+// The texel grid's (res_x + 1) x (res_y + 1) corners: lab point on the screen, and its exact
+// photo pixel (NaN where the camera does not see it). Samples inside a texel interpolate these
+// (the mapping is smooth on the scale of one texel: the error is far below 0.01 px).
+struct TexelCorners {
+  int nx = 0, ny = 0;
+  std::function<Eigen::Vector2d(double, double)> lab_of;  // corner (cx, cy) -> lab mm
+  std::vector<Eigen::Vector2f> pixel;                     // row-major, ny x nx
+  const Eigen::Vector2f& at(int cx, int cy) const { return pixel[size_t(cy) * nx + cx]; }
+};
+
+TexelCorners CornerPixels(const ScreenCalibration& calibration, const SlabLayout& layout,
+                          const Eigen::Vector2d& centre_mm) {
+  TexelCorners c;
+  c.nx = layout.res_x + 1;
+  c.ny = layout.res_y + 1;
   const double tw = layout.TexelW(), th = layout.TexelH();
   // Luminaire-frame corner (cx, cy) of the texel grid -> lab point on the screen.
-  auto lab_of = [&](double cx, double cy) -> Eigen::Vector2d {
+  c.lab_of = [=](double cx, double cy) -> Eigen::Vector2d {
     return Eigen::Vector2d(-0.5 * layout.window_w_mm + cx * tw,
                            0.5 * layout.window_h_mm - cy * th) -
            centre_mm;
   };
-  // Exact photo pixel of every texel corner; samples inside a texel interpolate these (the
-  // mapping is smooth on the scale of one texel: the error is far below 0.01 px).
-  std::vector<Eigen::Vector2f> corner(size_t(nx) * ny);
-  cv::parallel_for_(cv::Range(0, ny), [&](const cv::Range& rows) {
+  const Eigen::Matrix3d image_from_screen = calibration.screen_from_image.inverse();
+  c.pixel.resize(size_t(c.nx) * c.ny);
+  cv::parallel_for_(cv::Range(0, c.ny), [&](const cv::Range& rows) {
     for (int cy = rows.start; cy < rows.end; ++cy)
-      for (int cx = 0; cx < nx; ++cx) {
-        const Eigen::Vector3d hp = image_from_screen * lab_of(cx, cy).homogeneous();
+      for (int cx = 0; cx < c.nx; ++cx) {
+        const Eigen::Vector3d hp = image_from_screen * c.lab_of(cx, cy).homogeneous();
         Eigen::Vector2d px(NAN, NAN);
         if (hp.z() > 0 || hp.z() < 0) px = calibration.Distort(hp.hnormalized());
-        corner[size_t(cy) * nx + cx] = px.cast<float>();
+        c.pixel[size_t(cy) * c.nx + cx] = px.cast<float>();
       }
   });
-  float max_x = float(calibration.image_width - 1), max_y = float(calibration.image_height - 1);
-  auto in_photo = [&](const Eigen::Vector2f& p) {
-    return p.x() >= 0 && p.y() >= 0 && p.x() <= max_x && p.y() <= max_y;  // false for NaN
-  };
-  // Texel extent in pixels, over texels whose corners are in the photo.
+  return c;
+}
+
+// Inside the photo [0, max_x] x [0, max_y]; false for NaN.
+struct PhotoBounds {
+  float max_x, max_y;
+  bool Contains(const Eigen::Vector2f& p) const {
+    return p.x() >= 0 && p.y() >= 0 && p.x() <= max_x && p.y() <= max_y;
+  }
+};
+
+// Texel edge lengths in pixels over the texels in the photo: fills max/min_texel_px, returns
+// the median (1 when no texel is in the photo).
+double MeasureTexels(const TexelCorners& c, const PhotoBounds& photo, RectifyMap* m) {
   std::vector<float> extents;
-  for (int cy = 0; cy + 1 < ny; ++cy)
-    for (int cx = 0; cx + 1 < nx; ++cx) {
-      const Eigen::Vector2f& p00 = corner[size_t(cy) * nx + cx];
-      const Eigen::Vector2f& p10 = corner[size_t(cy) * nx + cx + 1];
-      const Eigen::Vector2f& p01 = corner[size_t(cy + 1) * nx + cx];
-      if (!in_photo(p00) || !in_photo(p10) || !in_photo(p01)) continue;
+  for (int cy = 0; cy + 1 < c.ny; ++cy)
+    for (int cx = 0; cx + 1 < c.nx; ++cx) {
+      const Eigen::Vector2f &p00 = c.at(cx, cy), &p10 = c.at(cx + 1, cy), &p01 = c.at(cx, cy + 1);
+      if (!photo.Contains(p00) || !photo.Contains(p10) || !photo.Contains(p01)) continue;
       extents.push_back((p10 - p00).norm());
       extents.push_back((p01 - p00).norm());
     }
-  double median_px = 1;
-  if (!extents.empty()) {
-    m.max_texel_px = *std::max_element(extents.begin(), extents.end());
-    m.min_texel_px = *std::min_element(extents.begin(), extents.end());
-    std::nth_element(extents.begin(), extents.begin() + extents.size() / 2, extents.end());
-    median_px = extents[extents.size() / 2];
-  }
-  const int f = samples_per_texel > 0 ? 1 : std::max(1, int(std::lround(median_px / 3)));
-  const int k = samples_per_texel > 0
-                    ? samples_per_texel
-                    : std::clamp(int(std::ceil(m.max_texel_px / f)), 2, kMaxSamplesPerTexel);
-  m.samples_per_texel = k;
-  m.downsample = f;
-  // Pixel p of the photo is at (p - (F - 1) / 2) / F in the F x F averaged image, whose size is
-  // floor(size / F).
-  if (f > 1) {
-    const float shift = 0.5f * (f - 1), scale = 1.0f / f;
-    for (auto& p : corner) p = (p.array() - shift) * scale;
-    max_x = float(calibration.image_width / f - 1);
-    max_y = float(calibration.image_height / f - 1);
-  }
-  // Seen geometrically: all four corners inside the photo (the samples interpolate them, so
-  // they are inside too) and the texel's lab rectangle on the physical screen.
-  m.inside.assign(size_t(m.res_x) * m.res_y, 0);
+  if (extents.empty()) return 1;
+  m->max_texel_px = *std::max_element(extents.begin(), extents.end());
+  m->min_texel_px = *std::min_element(extents.begin(), extents.end());
+  std::nth_element(extents.begin(), extents.begin() + extents.size() / 2, extents.end());
+  return extents[extents.size() / 2];
+}
+
+// Seen geometrically: all four corners inside the photo (the samples interpolate them, so they
+// are inside too) and the texel's lab rectangle on the physical screen.
+void MarkInside(const TexelCorners& c, const PhotoBounds& photo, double screen_w_mm,
+                double screen_h_mm, RectifyMap* m) {
+  m->inside.assign(size_t(m->res_x) * m->res_y, 0);
   const double half_w = 0.5 * screen_w_mm + 1e-9, half_h = 0.5 * screen_h_mm + 1e-9;
-  for (int row = 0; row < m.res_y; ++row)
-    for (int col = 0; col < m.res_x; ++col) {
-      const Eigen::Vector2d lo = lab_of(col, row + 1), hi = lab_of(col + 1, row);
+  for (int row = 0; row < m->res_y; ++row)
+    for (int col = 0; col < m->res_x; ++col) {
+      const Eigen::Vector2d lo = c.lab_of(col, row + 1), hi = c.lab_of(col + 1, row);
       const bool on_screen =
           lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h;
-      const bool in = in_photo(corner[size_t(row) * nx + col]) &&
-                      in_photo(corner[size_t(row) * nx + col + 1]) &&
-                      in_photo(corner[size_t(row + 1) * nx + col]) &&
-                      in_photo(corner[size_t(row + 1) * nx + col + 1]);
-      m.inside[size_t(row) * m.res_x + col] = (on_screen && in) ? 1 : 0;
+      const bool in = photo.Contains(c.at(col, row)) && photo.Contains(c.at(col + 1, row)) &&
+                      photo.Contains(c.at(col, row + 1)) && photo.Contains(c.at(col + 1, row + 1));
+      m->inside[size_t(row) * m->res_x + col] = (on_screen && in) ? 1 : 0;
     }
-  // Sample (a, b) of texel (col, row) interpolates the texel's corners bilinearly at
-  // ((a + 0.5) / K, (b + 0.5) / K). Written directly in OpenCV's fixed-point remap format
-  // (integer pixel + 1/32 fraction, what remap converts float maps to anyway).
+}
+
+// Sample (a, b) of texel (col, row) interpolates the texel's corners bilinearly at
+// ((a + 0.5) / K, (b + 0.5) / K). Written directly in OpenCV's fixed-point remap format
+// (integer pixel + 1/32 fraction, what remap converts float maps to anyway).
+void WriteRemapTables(const TexelCorners& c, RectifyMap* m) {
   constexpr int kBits = cv::INTER_BITS, kTab = cv::INTER_TAB_SIZE;
-  m.map_xy.create(m.res_y * k, m.res_x * k, CV_16SC2);
-  m.map_frac.create(m.res_y * k, m.res_x * k, CV_16UC1);
+  const int k = m->samples_per_texel;
+  m->map_xy.create(m->res_y * k, m->res_x * k, CV_16SC2);
+  m->map_frac.create(m->res_y * k, m->res_x * k, CV_16UC1);
   std::vector<float> fr(k);
   for (int a = 0; a < k; ++a) fr[a] = (a + 0.5f) / k;
-  cv::parallel_for_(cv::Range(0, m.res_y), [&](const cv::Range& rows) {
+  cv::parallel_for_(cv::Range(0, m->res_y), [&](const cv::Range& rows) {
     for (int row = rows.start; row < rows.end; ++row)
       for (int b = 0; b < k; ++b) {
         const float fy = fr[b];
-        int16_t* xy = m.map_xy.ptr<int16_t>(row * k + b);
-        uint16_t* frac = m.map_frac.ptr<uint16_t>(row * k + b);
-        for (int col = 0; col < m.res_x; ++col) {
-          const Eigen::Vector2f& p00 = corner[size_t(row) * nx + col];
-          const Eigen::Vector2f& p10 = corner[size_t(row) * nx + col + 1];
-          const Eigen::Vector2f& p01 = corner[size_t(row + 1) * nx + col];
-          const Eigen::Vector2f& p11 = corner[size_t(row + 1) * nx + col + 1];
+        int16_t* xy = m->map_xy.ptr<int16_t>(row * k + b);
+        uint16_t* frac = m->map_frac.ptr<uint16_t>(row * k + b);
+        for (int col = 0; col < m->res_x; ++col) {
+          const Eigen::Vector2f &p00 = c.at(col, row), &p10 = c.at(col + 1, row);
+          const Eigen::Vector2f &p01 = c.at(col, row + 1), &p11 = c.at(col + 1, row + 1);
           const Eigen::Vector2f left = p00 + fy * (p01 - p00), right = p10 + fy * (p11 - p10);
-          const bool ok = m.inside[size_t(row) * m.res_x + col] != 0;
+          const bool ok = m->inside[size_t(row) * m->res_x + col] != 0;
           for (int a = 0; a < k; ++a, xy += 2, ++frac) {
             const Eigen::Vector2f p = left + fr[a] * (right - left);
             // Unseen texels read the constant border; their values are never used.
@@ -121,6 +125,33 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
         }
       }
   });
+}
+
+}  // namespace
+
+RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayout& layout,
+                           const Eigen::Vector2d& centre_mm, double screen_w_mm, double screen_h_mm,
+                           int samples_per_texel) {
+  RectifyMap m;
+  m.res_x = layout.res_x;
+  m.res_y = layout.res_y;
+  TexelCorners corners = CornerPixels(calibration, layout, centre_mm);
+  PhotoBounds photo{float(calibration.image_width - 1), float(calibration.image_height - 1)};
+  const double median_px = MeasureTexels(corners, photo, &m);
+  const int f = samples_per_texel > 0 ? 1 : std::max(1, int(std::lround(median_px / 3)));
+  m.samples_per_texel = samples_per_texel > 0 ? samples_per_texel
+                                              : std::clamp(int(std::ceil(m.max_texel_px / f)), 2,
+                                                           kMaxSamplesPerTexel);
+  m.downsample = f;
+  // Pixel p of the photo is at (p - (F - 1) / 2) / F in the F x F averaged image, whose size is
+  // floor(size / F).
+  if (f > 1) {
+    const float shift = 0.5f * (f - 1), scale = 1.0f / f;
+    for (auto& p : corners.pixel) p = (p.array() - shift) * scale;
+    photo = {float(calibration.image_width / f - 1), float(calibration.image_height / f - 1)};
+  }
+  MarkInside(corners, photo, screen_w_mm, screen_h_mm, &m);
+  WriteRemapTables(corners, &m);
   return m;
 }
 

@@ -17,7 +17,9 @@ struct ExrAttributes {
 
 struct ExrOptions {
   bool half = false;     // store HALF instead of FLOAT
-  bool compress = true;  // PIZ (fast on noisy float data); false: none
+  // PIZ (lossless) or none. On half data PIZ is fast and small; on 32-bit float photos it
+  // measured ~4x smaller but ~10x slower to write than none (1600x1200 RGB: 285 vs 28 ms).
+  bool compress = true;
 };
 
 // Writes image channels named `channel_names` (size == image.channels) atomically.

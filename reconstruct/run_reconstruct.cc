@@ -177,7 +177,9 @@ int RunWatch(const RunConfig& config) {
   auto last_new = std::chrono::steady_clock::now();
   while (!writer.Complete() && !StopRequested()) {
     const auto t = fs::last_write_time(dir + "/dataset.json");
-    if (t != dataset_time) {  // the acquisition may list photos as it goes
+    // dataset.json is rewritten when an acquisition restarts (--force): follow it. (It always
+    // lists every photo, Dataset::Load insists on that; a live acquisition adds the files.)
+    if (t != dataset_time) {
       dataset = Dataset::Load(dir);
       dataset_time = t;
     }

@@ -62,7 +62,10 @@ FilterPrintReport PrintFilter(const FilterPrintOptions& options) {
   j["dual_coefficients"] = filter.coefficients();
   j["integral"] = filter.Integral();
   j["peak"] = report.peak;
-  j["cross_talk"] = {{"k1", filter.CrossTalk(1)}, {"k2", filter.CrossTalk(2)}};
+  // Response to the neighbouring basis functions, k = 1 .. K + 1 (beyond, the supports do not
+  // overlap): the largest is not always at k = 1, 2 (for K = 2 it is at k = 3).
+  for (int k = 1; k <= options.k_max + 1; ++k)
+    j["cross_talk"]["k" + std::to_string(k)] = filter.CrossTalk(k);
   j["size_mm"] = report.size_mm;
   j["dpi"] = options.dpi;
   j["size_px"] = report.size_px;

@@ -21,7 +21,7 @@ struct FilterPrintReport {
 };
 
 // Writes filter_p.png and filter_n.png (16-bit grayscale transmittance of one filter window,
-// row 0 on top = +v) and filter.json (coefficients, peak, cross-talk for k = 1, 2, size).
+// row 0 on top = +v) and filter.json (coefficients, peak, cross-talk for k = 1 .. K + 1, size).
 FilterPrintReport PrintFilter(const FilterPrintOptions& options);
 
 }  // namespace lumislab

@@ -10,6 +10,13 @@
 
 namespace lumislab {
 
+namespace {
+// A path that stays inside the dataset folder: relative, without "..".
+bool IsRelativeInside(const std::string& path) {
+  return !path.empty() && path[0] != '/' && path.find("..") == std::string::npos;
+}
+}  // namespace
+
 void CalibrationTarget::Check(const std::string& file, const std::string& field) const {
   const std::string got = std::to_string(squares_x) + " x " + std::to_string(squares_y);
   if (squares_x < kMinBoardSquares || squares_y < kMinBoardSquares)
@@ -65,6 +72,11 @@ FilterInfo ParseFilterInfo(const JsonView& filter, const SamplingGrid& grid) {
         "at most " + std::to_string(kMaxFilterTruncation + 1) +
         " coefficients (truncation K <= " + std::to_string(kMaxFilterTruncation) + ")");
   f.peak = filter["peak"].Positive();
+  // The slides were printed as Phi~ / peak: a peak that is not that of the coefficients would
+  // scale every E_ij by the ratio.
+  const double expected = f.Filter().Peak2D();
+  if (std::abs(f.peak - expected) > 1e-6 * expected)
+    filter["peak"].Fail("max |Phi~| of dual_coefficients (" + std::to_string(expected) + ")");
   return f;
 }
 
@@ -119,6 +131,8 @@ Dataset Dataset::Load(const std::string& dir) {
 
   const JsonView calib = root["calibration"];
   ds.calibration.photo = calib["photo"].String();
+  if (!IsRelativeInside(ds.calibration.photo))
+    calib["photo"].Fail("a path relative to the dataset folder");
   const JsonView target = calib["target"];
   target["type"].OneOf({"checkerboard"});
   ds.calibration.squares_x = target["squares"][0].IntIn(kMinBoardSquares, kMaxBoardSquares);
@@ -137,8 +151,7 @@ Dataset Dataset::Load(const std::string& dir) {
     e.j = p["j"].IntIn(0, ds.grid.nv - 1);
     e.positive = p["slide"].OneOf({"p", "n"}) == "p";
     e.file = p["file"].String();
-    if (e.file.empty() || e.file[0] == '/' || e.file.find("..") != std::string::npos)
-      p["file"].Fail("a path relative to the dataset folder");
+    if (!IsRelativeInside(e.file)) p["file"].Fail("a path relative to the dataset folder");
     e.exposure = p.Has("exposure") ? p["exposure"].Positive() : 1.0;
     slides.insert({e.i, e.j, e.positive});
     ds.photos.push_back(e);

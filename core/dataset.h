@@ -15,7 +15,9 @@
 
 namespace lumislab {
 
-constexpr int kDatasetSchemaVersion = 1;
+// 2 added radiometry.transfer, black_level and white_level (version 1 files read with their
+// defaults; a version-1 reader refuses version 2 instead of misreading the photos).
+constexpr int kDatasetSchemaVersion = 2;
 
 struct FilterInfo {
   std::string basis = "bell";

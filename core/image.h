@@ -1,6 +1,7 @@
 // A plain float image (row-major, interleaved channels) used by core IO; stages use OpenCV.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 namespace lumislab {

@@ -13,8 +13,10 @@
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/log.h"
+#include "lib/lightfield/camera.h"
+#include "lib/lightfield/light_field.h"
+#include "lib/lightfield/tone_map.h"
 #include "preview/gl_context.h"
-#include "preview/light_field.h"
 #include "preview/point_emitters.h"
 #include "preview/window.h"
 
@@ -42,7 +44,7 @@ int RunHeadless(const PreviewConfig& config) {
   SlabInfo info = LoadInfo(config);
   OffscreenContext context(16, 16);
   LogDebug("GL renderer: ", context.Renderer());
-  const SceneSetup setup = MakeSceneSetup(config, info);
+  const SceneSetup setup = MakeSceneSetup(config.scene, info);
   RenderOptions options = MakeRenderOptions(config, setup);
   const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
@@ -72,23 +74,10 @@ int RunHeadless(const PreviewConfig& config) {
     const ImageF b = renderer.Read();
     renderer.SetOptions(options);
     renderer.Render();
-    double diff = 0, norm = 0, worst = 0;
-    const ImageF& reference = options.srgbe ? b : a;  // the float render
-    const double floor = 1e-3 * *std::max_element(reference.data.begin(), reference.data.end());
-    for (size_t px = 0; px < a.data.size() / 3; ++px) {
-      double peak = 0, error = 0;
-      for (size_t c = 3 * px; c < 3 * px + 3; ++c) {
-        const double e = a.data[c] - b.data[c];
-        diff += e * e;
-        norm += double(reference.data[c]) * reference.data[c];
-        peak = std::max(peak, std::abs(double(reference.data[c])));
-        error = std::max(error, std::abs(e));
-      }
-      if (peak > floor) worst = std::max(worst, error / peak);  // shared exponent: per pixel
-    }
-    LogInfo("sRGBE accumulation vs float: relative L2 error ", std::sqrt(diff / norm),
+    const ImageDifference error = options.srgbe ? CompareImages(a, b) : CompareImages(b, a);
+    LogInfo("sRGBE accumulation vs float: relative L2 error ", error.relative_l2,
             ", max per pixel (relative to its largest channel, pixels above 1e-3 of the peak) ",
-            worst);
+            error.worst_pixel);
   }
   if (config.bench) {
     std::vector<double> seconds;
@@ -138,83 +127,15 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   return options;
 }
 
-SceneSetup MakeSceneSetup(const PreviewConfig& config, const SlabInfo& info) {
-  SceneSetup s;
-  if (config.scene == "plane") {
-    s.plane = true;
-    s.plane_z = config.receiver_plane_mm > 0 ? config.receiver_plane_mm : info.distance_mm;
-    s.extent = config.extent_mm > 0 ? config.extent_mm
-                                    : info.layout.window_w_mm * s.plane_z / info.distance_mm;
-    s.mesh = MakeReceiverPlane(s.plane_z, 1.2 * s.extent);
-  } else if (config.scene == "crypt") {
-    s.mesh = MakeCrypt();
-    s.pose = PoseFromValues({250, 2300, -150, 90, 0, 0});  // hanging, shining down
-    s.camera_target = {0, 500, 0};
-    s.camera_distance = 3900;
-    s.camera_yaw_deg = 35;
-    s.camera_pitch_deg = 38;
-    s.closed_room = true;
-  } else if (config.scene == "cloister") {
-    s.mesh = MakeCloister();
-    s.pose = PoseFromValues({900, 3700, 900, 90, 0, 0});
-    s.camera_target = {0, 500, 0};
-    s.camera_distance = 9000;
-    s.camera_yaw_deg = 35;
-    s.camera_pitch_deg = 38;
-    s.closed_room = true;
-  } else {
-    s.mesh = LoadSceneFile(config.scene);
-    Eigen::Vector3f lo = s.mesh.positions[0], hi = lo;
-    for (const auto& p : s.mesh.positions) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    s.camera_target = (0.5f * (lo + hi)).cast<double>();
-    s.camera_distance = 1.5 * (hi - lo).norm();
-    s.pose = PoseFromValues(
-        {s.camera_target.x(), hi.y() - 0.05 * (hi.y() - lo.y()), s.camera_target.z(), 90, 0, 0});
-  }
-  if (!config.pose.empty()) s.pose = PoseFromValues(config.pose);
-  return s;
-}
-
-Eigen::Matrix4f OrbitCamera(const SceneSetup& s, double aspect) {
-  const double yaw = s.camera_yaw_deg * M_PI / 180, pitch = s.camera_pitch_deg * M_PI / 180;
-  const Eigen::Vector3d eye =
-      s.camera_target + s.camera_distance * Eigen::Vector3d(std::cos(pitch) * std::sin(yaw),
-                                                            std::sin(pitch),
-                                                            std::cos(pitch) * std::cos(yaw));
-  return Perspective(70, aspect, 20, 100000) * LookAt(eye, s.camera_target, {0, 1, 0});
-}
-
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
                                                   Renderer& renderer) {
   std::vector<std::pair<int, int>> added;
   for (const auto& [i, j] : ScanSlabPositions(slab_dir, info.grid)) {
     if (renderer.HasPosition(i, j)) continue;
-    const SlabPosition p = ReadSlabPosition(slab_dir, info, i, j);
-    renderer.SetPosition(i, j, IntensityFromIrradiance(info, i, j, p.irradiance));
+    renderer.SetPosition(i, j, ReadIntensity(slab_dir, info, i, j));
     added.emplace_back(i, j);
   }
   return added;
-}
-
-double ExposureFactor(const ImageF& image, double stops, bool automatic) {
-  double factor = std::pow(2.0, stops);
-  if (automatic) {
-    std::vector<float> values;
-    for (int y = 0; y < image.height; ++y) {
-      for (int x = 0; x < image.width; ++x) {
-        values.push_back(std::max({image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)}));
-      }
-    }
-    if (!values.empty()) {
-      std::nth_element(values.begin(), values.begin() + values.size() * 99 / 100, values.end());
-      const double p99 = values[values.size() * 99 / 100];
-      if (p99 > 0) factor *= 0.8 / p99;
-    }
-  }
-  return factor;
 }
 
 void WriteImage(const std::string& path, const ImageF& image, double exposure_factor) {
@@ -224,13 +145,12 @@ void WriteImage(const std::string& path, const ImageF& image, double exposure_fa
     return;
   }
   if (ext != ".png") throw BadInput(path + ": output must end in .exr or .png");
+  const std::vector<uint8_t> rgb = EncodeSrgb8(image, exposure_factor);
   cv::Mat out(image.height, image.width, CV_8UC3);
   for (int y = 0; y < image.height; ++y) {
     for (int x = 0; x < image.width; ++x) {
       for (int c = 0; c < 3; ++c) {
-        double v = std::clamp(image.at(x, y, c) * exposure_factor, 0.0, 1.0);
-        v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-        out.at<cv::Vec3b>(y, x)[2 - c] = cv::saturate_cast<uchar>(v * 255.0 + 0.5);
+        out.at<cv::Vec3b>(y, x)[2 - c] = rgb[(size_t(y) * image.width + x) * 3 + c];
       }
     }
   }
@@ -249,17 +169,18 @@ int RunPreview(int argc, char** argv) {
       "(OSMesa, --out) or in a window (--window)"};
   app.add_option("--slab", config.slab_dir, "slab folder (slab.json + pos_<i>_<j>.exr)")
       ->required();
-  app.add_option("--scene", config.scene, "crypt | cloister | plane | scene file (Assimp)")
+  app.add_option("--scene", config.scene.name, "crypt | cloister | plane | scene file (Assimp)")
       ->capture_default_str();
-  app.add_option("--luminaire-pose", config.pose,
+  app.add_option("--luminaire-pose", config.scene.pose,
                  "luminaire frame in the scene: x,y,z (mm),rx,ry,rz (degrees, R = Rz Ry Rx)")
       ->delimiter(',')
       ->expected(6);
   app.add_option("--size", size, "image size WxH")->capture_default_str();
   app.add_option("--out", config.out, "headless output: .exr (linear) or .png (tone-mapped)");
-  app.add_option("--receiver-plane", config.receiver_plane_mm,
+  app.add_option("--receiver-plane", config.scene.receiver_plane_mm,
                  "plane mode: D in mm (default: the slab's d)");
-  app.add_option("--extent", config.extent_mm, "plane mode: side W in mm (default: window D/d)");
+  app.add_option("--extent", config.scene.extent_mm,
+                 "plane mode: side W in mm (default: window D/d)");
   app.add_option("--exposure", config.exposure_stops, "exposure in stops (on top of auto)");
   app.add_flag("!--no-auto-exposure", config.auto_exposure, "no automatic exposure");
   app.add_flag("!--no-shadows", config.shadows, "no shadow maps");

@@ -13,6 +13,8 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "lib/lightfield/camera.h"
+#include "lib/lightfield/tone_map.h"
 #include "preview/gl_context.h"
 
 namespace lumislab {
@@ -73,7 +75,7 @@ void DrawArrivalOverlay(const SlabInfo& info, const Renderer& renderer, int fb_h
 
 int RunWindow(const PreviewConfig& config, SlabInfo info) {
   WindowContext context(config.width, config.height, "lumislab-preview");
-  SceneSetup setup = MakeSceneSetup(config, info);
+  SceneSetup setup = MakeSceneSetup(config.scene, info);
   RenderOptions options = MakeRenderOptions(config, setup);
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(context.window(), &fb_w, &fb_h);

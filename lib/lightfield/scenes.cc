@@ -1,4 +1,4 @@
-#include "preview/scenes.h"
+#include "lib/lightfield/scenes.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>

@@ -9,12 +9,14 @@
 
 #include "core/geometry.h"
 #include "core/slab.h"
+#include "lib/lightfield/camera.h"
+#include "lib/lightfield/light_field.h"
+#include "lib/lightfield/scene_setup.h"
+#include "lib/lightfield/scenes.h"
 #include "preview/gl_context.h"
-#include "preview/light_field.h"
 #include "preview/point_emitters.h"
 #include "preview/renderer.h"
 #include "preview/run_preview.h"
-#include "preview/scenes.h"
 
 namespace lumislab {
 namespace {
@@ -116,9 +118,7 @@ class PreviewSlabFiles : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   std::unique_ptr<Renderer> MakeRenderer(const RenderOptions& options = {}) {
-    PreviewConfig config;
-    config.scene = "crypt";
-    const SceneSetup setup = MakeSceneSetup(config, info_);
+    const SceneSetup setup = MakeSceneSetup("crypt", info_);
     auto renderer = std::make_unique<Renderer>(info_, 96, 96, options);
     renderer->SetScene(setup.mesh);
     renderer->SetPose(setup.pose);
@@ -128,8 +128,7 @@ class PreviewSlabFiles : public ::testing::Test {
   // Uploads positions (i, j) from the files.
   void Upload(Renderer& r, const std::vector<std::pair<int, int>>& positions) {
     for (const auto& [i, j] : positions) {
-      const SlabPosition p = ReadSlabPosition(dir_.string(), info_, i, j);
-      r.SetPosition(i, j, IntensityFromIrradiance(info_, i, j, p.irradiance));
+      r.SetPosition(i, j, ReadIntensity(dir_.string(), info_, i, j));
     }
   }
   static double RelativeDifference(const ImageF& a, const ImageF& b) {
@@ -185,8 +184,7 @@ TEST_F(PreviewSlabFiles, IncrementalPositionsEqualAFullRenderAndReuseShadowMaps)
   // Moving the camera re-accumulates all lights but renders no shadow map again.
   const int shadow_renders = full->ShadowMapRenders();
   EXPECT_EQ(shadow_renders, info_.grid.count());
-  PreviewConfig config;
-  SceneSetup moved = MakeSceneSetup(config, info_);
+  SceneSetup moved = MakeSceneSetup("crypt", info_);
   moved.camera_yaw_deg += 20;
   full->SetCamera(OrbitCamera(moved, 1.0));
   EXPECT_EQ(full->Render(), info_.grid.count());

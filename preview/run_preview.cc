@@ -4,15 +4,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
+#include <regex>
 #include <thread>
 
 #include "core/atomic_file.h"
+#include "core/command_line.h"
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/log.h"
+#include "core/stop_signal.h"
 #include "lib/lightfield/camera.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/tone_map.h"
@@ -23,9 +25,6 @@
 namespace lumislab {
 namespace {
 
-volatile std::sig_atomic_t g_stop = 0;
-void OnSignal(int) { g_stop = 1; }
-
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -34,7 +33,7 @@ double Median(std::vector<double> v) {
 // Waits for slab.json (a live reconstruct writes it with its first position).
 SlabInfo LoadInfo(const PreviewConfig& config) {
   const std::string json = config.slab_dir + "/slab.json";
-  while (config.watch && !std::filesystem::exists(json) && !g_stop) {
+  while (config.watch && !std::filesystem::exists(json) && !StopRequested()) {
     std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
   }
   return SlabInfo::Load(config.slab_dir);
@@ -59,7 +58,8 @@ int RunHeadless(const PreviewConfig& config) {
     WriteImage(config.out, image,
                ExposureFactor(image, config.exposure_stops, config.auto_exposure));
   };
-  std::vector<std::pair<int, int>> loaded = LoadNewPositions(config.slab_dir, info, renderer);
+  std::vector<std::pair<int, int>> loaded =
+      LoadNewPositions(config.slab_dir, info, renderer, config.threads);
   renderer.Render();
   write();
   LogInfo("rendered ", renderer.PositionCount(), "/", info.grid.count(), " positions, ",
@@ -94,14 +94,14 @@ int RunHeadless(const PreviewConfig& config) {
     LogInfo("bench: ", config.bench_frames, " frames (camera moving, shadow maps cached), median ",
             median * 1000, " ms = ", 1.0 / median, " fps");
   }
-  while (config.watch && renderer.PositionCount() < info.grid.count() && !g_stop) {
+  while (config.watch && renderer.PositionCount() < info.grid.count() && !StopRequested()) {
     std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
     try {
       info = SlabInfo::Load(config.slab_dir);
     } catch (const Error&) {
       continue;  // slab.json being replaced: try again at the next poll
     }
-    const auto added = LoadNewPositions(config.slab_dir, info, renderer);
+    const auto added = LoadNewPositions(config.slab_dir, info, renderer, config.threads);
     if (added.empty()) continue;
     renderer.Render();
     write();
@@ -113,8 +113,6 @@ int RunHeadless(const PreviewConfig& config) {
 }
 
 }  // namespace
-
-bool PreviewStopRequested() { return g_stop != 0; }
 
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
   RenderOptions options;
@@ -128,14 +126,32 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
 }
 
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
-                                                  Renderer& renderer) {
+                                                  Renderer& renderer, int threads) {
   std::vector<std::pair<int, int>> added;
   for (const auto& [i, j] : ScanSlabPositions(slab_dir, info.grid)) {
-    if (renderer.HasPosition(i, j)) continue;
-    renderer.SetPosition(i, j, ReadIntensity(slab_dir, info, i, j));
-    added.emplace_back(i, j);
+    if (!renderer.HasPosition(i, j)) added.emplace_back(i, j);
+  }
+  // E' of a batch on `threads` threads, then uploaded on this one (the GL context's); batches
+  // bound the memory held for a large slab.
+  const size_t batch = size_t(std::max(16, 2 * threads));
+  for (size_t start = 0; start < added.size(); start += batch) {
+    const std::vector<std::pair<int, int>> part(
+        added.begin() + start, added.begin() + std::min(added.size(), start + batch));
+    const std::vector<ImageF> intensities = ReadIntensities(slab_dir, info, part, threads);
+    for (size_t k = 0; k < part.size(); ++k) {
+      renderer.SetPosition(part[k].first, part[k].second, intensities[k]);
+    }
   }
   return added;
+}
+
+bool ParseSize(const std::string& text, int* width, int* height) {
+  static const std::regex pattern("([0-9]{1,5})x([0-9]{1,5})");
+  std::smatch match;
+  if (!std::regex_match(text, match, pattern)) return false;
+  *width = std::stoi(match[1].str());
+  *height = std::stoi(match[2].str());
+  return *width > 0 && *height > 0 && *width <= 8192 && *height <= 8192;
 }
 
 void WriteImage(const std::string& path, const ImageF& image, double exposure_factor) {
@@ -161,12 +177,16 @@ void WriteImage(const std::string& path, const ImageF& image, double exposure_fa
 
 int RunPreview(int argc, char** argv) {
   PreviewConfig config;
-  bool verbose = false;
-  int threads = 0;
+  CommonOptions common;
   std::string size = "400x400";
   CLI::App app{
       "lumislab-preview: the measured luminaire lighting a scene (DESIGN §4); headless "
       "(OSMesa, --out) or in a window (--window)"};
+  AddCommonOptions(&app, &common);
+  app.footer(
+      "--threads sizes lumislab's own CPU work (deriving E' of the slab positions as they are "
+      "loaded). The renderer's threads are llvmpipe's: set them with the LP_NUM_THREADS "
+      "environment variable (default: all cores).");
   app.add_option("--slab", config.slab_dir, "slab folder (slab.json + pos_<i>_<j>.exr)")
       ->required();
   app.add_option("--scene", config.scene.name, "crypt | cloister | plane | scene file (Assimp)")
@@ -196,25 +216,15 @@ int RunPreview(int argc, char** argv) {
                  "--window: save the window to this PNG once all positions are in, then quit");
   app.add_flag("--bench", config.bench, "time frames with a moving camera");
   app.add_option("--bench-frames", config.bench_frames)->capture_default_str();
-  app.add_option("--threads", threads, "render threads (LP_NUM_THREADS; default: all cores)");
   bool write_test_slab = false;
   app.add_flag("--write-test-slab", write_test_slab,
                "first write the exact slab of the built-in point-emitter luminaire (9x7, h=5, "
                "d=750, window 1200 at 300) into --slab when it has no slab.json (demos, tests)");
-  app.add_flag("--verbose", verbose, "debug log");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
+  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
+  config.threads = StartTool("preview", common);
+  if (!ParseSize(size, &config.width, &config.height)) {
+    throw InputError("--size", "size", "WxH, each 1..8192, e.g. 400x400", size);
   }
-  SetLogTool("preview");
-  if (verbose) SetLogLevel(LogLevel::kDebug);
-  if (std::sscanf(size.c_str(), "%dx%d", &config.width, &config.height) != 2 || config.width <= 0 ||
-      config.height <= 0 || config.width > 8192 || config.height > 8192) {
-    throw InputError("--size", "size", "WxH, e.g. 400x400", size);
-  }
-  if (threads > 0) setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
   if (config.shadow_size < 16 || config.shadow_size > 4096) {
     throw InputError("--shadow-size", "shadow-size", "16..4096",
                      std::to_string(config.shadow_size));
@@ -223,8 +233,7 @@ int RunPreview(int argc, char** argv) {
     WriteTruthSlab(DefaultPointEmitters(), MakeSlabInfo(750, 9, 7, 5, 1200, 300), config.slab_dir);
     LogInfo("wrote the built-in test slab to ", config.slab_dir);
   }
-  std::signal(SIGINT, OnSignal);
-  std::signal(SIGTERM, OnSignal);
+  const StopSignalScope stop_signals;  // Ctrl-C ends the --watch loops cleanly
   if (config.window) {
     SlabInfo info = LoadInfo(config);
     return RunWindow(config, info);

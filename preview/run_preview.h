@@ -31,19 +31,20 @@ struct PreviewConfig {
   int bench_frames = 10;
   std::string screenshot;  // window: save this file after the first complete frame, then quit
   bool report_srgbe_error = false;
+  int threads = 1;  // lumislab's own CPU work (E' of the positions loaded), resolved --threads
 };
 
 int RunPreview(int argc, char** argv);
-// True once SIGINT/SIGTERM arrived (clean shutdown of --watch loops).
-bool PreviewStopRequested();
 
 // Renderer options from the command line, for the scene it sets up (one place for both contexts).
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);
 
-// Loads every slab position present on disk that `loaded` (grid index -> bool) lacks into the
-// renderer (E' derived on load); returns the positions loaded.
+// Loads every slab position present on disk that the renderer lacks into it (E' derived on
+// `threads` threads); returns the positions loaded.
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
-                                                  Renderer& renderer);
+                                                  Renderer& renderer, int threads);
+// Strict "WxH" (digits only, each 1..8192): false for anything else ("400x400junk").
+bool ParseSize(const std::string& text, int* width, int* height);
 
 // Writes .exr (linear RGB) or .png (tone-mapped, sRGB 8-bit) atomically.
 void WriteImage(const std::string& path, const ImageF& image, double exposure_factor);

@@ -13,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/stop_signal.h"
 #include "lib/lightfield/camera.h"
 #include "lib/lightfield/tone_map.h"
 #include "preview/gl_context.h"
@@ -152,11 +153,12 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
   });
 
   auto last_poll = std::chrono::steady_clock::now();
-  std::vector<std::pair<int, int>> arrived = LoadNewPositions(config.slab_dir, info, renderer);
+  std::vector<std::pair<int, int>> arrived =
+      LoadNewPositions(config.slab_dir, info, renderer, config.threads);
   double exposure_factor = 0;
   bool screenshot_done = false;
   std::pair<int, int> last = arrived.empty() ? std::pair<int, int>{-1, -1} : arrived.back();
-  while (!glfwWindowShouldClose(window) && !state.quit && !PreviewStopRequested()) {
+  while (!glfwWindowShouldClose(window) && !state.quit && !StopRequested()) {
     glfwPollEvents();
     if (config.watch &&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - last_poll).count() >=
@@ -164,7 +166,7 @@ int RunWindow(const PreviewConfig& config, SlabInfo info) {
       last_poll = std::chrono::steady_clock::now();
       try {
         info = SlabInfo::Load(config.slab_dir);
-        const auto added = LoadNewPositions(config.slab_dir, info, renderer);
+        const auto added = LoadNewPositions(config.slab_dir, info, renderer, config.threads);
         if (!added.empty()) last = added.back();
       } catch (const Error& e) {
         LogDebug("poll: ", e.what());

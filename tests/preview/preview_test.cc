@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/error.h"
 #include "core/geometry.h"
 #include "core/slab.h"
 #include "lib/lightfield/camera.h"
@@ -178,7 +179,7 @@ TEST_F(PreviewSlabFiles, IncrementalPositionsEqualAFullRenderAndReuseShadowMaps)
   }
   EXPECT_EQ(live->Render(), 0);
   auto full = MakeRenderer();
-  EXPECT_EQ(int(LoadNewPositions(dir_.string(), info_, *full).size()), info_.grid.count());
+  EXPECT_EQ(int(LoadNewPositions(dir_.string(), info_, *full, 3).size()), info_.grid.count());
   full->Render();
   EXPECT_LE(RelativeDifference(live->Read(), full->Read()), 1e-5);
   // Moving the camera re-accumulates all lights but renders no shadow map again.
@@ -209,6 +210,40 @@ TEST_F(PreviewSlabFiles, SrgbeAccumulationStaysCloseToFloat) {
   // Each pass re-encodes the sum (25 lights fit one pass here): ~1/255 relative per pass.
   EXPECT_LE(error, 0.01);
   EXPECT_GT(error, 0.0);  // it is really packed
+}
+
+int RunPreviewWith(std::vector<std::string> args) {
+  args.insert(args.begin(), "lumislab-preview");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
+}
+
+TEST(PreviewCommandLine, SizeIsCheckedStrictly) {
+  int w = 0, h = 0;
+  EXPECT_TRUE(ParseSize("640x480", &w, &h));
+  EXPECT_EQ(w, 640);
+  EXPECT_EQ(h, 480);
+  for (const char* bad : {"400x400junk", "400x", "x400", " 400x400", "400X400", "-4x400", "0x400",
+                          "400x9000", "400x400x3", "+400x400", ""}) {
+    EXPECT_FALSE(ParseSize(bad, &w, &h)) << bad;
+  }
+  testing::internal::CaptureStderr();
+  const int code = RunPreviewWith(
+      {"--slab", "/nonexistent-lumislab-slab", "--size", "400x400junk", "--out", "x.png"});
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("--size"), std::string::npos) << err;
+  EXPECT_NE(err.find("400x400junk"), std::string::npos) << err;
+}
+
+TEST(PreviewCommandLine, HelpNamesLlvmpipeThreads) {
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(RunPreviewWith({"--help"}), 0);
+  const std::string help = testing::internal::GetCapturedStdout();
+  EXPECT_NE(help.find("--threads"), std::string::npos);
+  EXPECT_NE(help.find("LP_NUM_THREADS"), std::string::npos) << help;
+  EXPECT_EQ(RunPreviewWith({"--slab", "x", "--threads", "-1", "--out", "x.png"}), 2);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
-// lumislab-preview: command line, headless (OSMesa) renders, slab loading and --watch polling.
+// lumislab-preview: its configuration and command line, and the steps the headless run and the
+// window share (renderer options, waiting for the slab, loading new positions).
 #pragma once
 
-#include <Eigen/Geometry>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,19 +35,20 @@ struct PreviewConfig {
   int threads = 1;  // lumislab's own CPU work (E' of the positions loaded), resolved --threads
 };
 
+// The whole tool: command line, then the window or the headless run.
 int RunPreview(int argc, char** argv);
 
 // Renderer options from the command line, for the scene it sets up (one place for both contexts).
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);
 
+// slab.json of --slab; with --watch, waits for it to appear (a live reconstruct writes it with
+// its first position); nothing when a stop signal arrives first.
+std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config);
 // Loads every slab position present on disk that the renderer lacks into it (E' derived on
 // `threads` threads); returns the positions loaded.
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
                                                   Renderer& renderer, int threads);
 // Strict "WxH" (digits only, each 1..8192): false for anything else ("400x400junk").
 bool ParseSize(const std::string& text, int* width, int* height);
-
-// Writes .exr (linear RGB) or .png (tone-mapped, sRGB 8-bit) atomically.
-void WriteImage(const std::string& path, const ImageF& image, double exposure_factor);
 
 }  // namespace lumislab

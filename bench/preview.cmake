@@ -5,14 +5,11 @@ if(TARGET lumislab_preview)
   lumislab_warnings(preview_table1)
 endif()
 
-if(TARGET lumislab_glad)
-  find_package(assimp REQUIRED)
+if(TARGET lumislab_preview_renderer)
   # The renderer on a real GPU through EGL vs OSMesa; links neither (both are dlopen()ed), so the
   # binary and a few libraries can be carried to a GPU node.
-  add_executable(preview_gpu_check ${CMAKE_CURRENT_LIST_DIR}/preview_gpu_check.cc
-                 ${PROJECT_SOURCE_DIR}/preview/renderer.cc ${PROJECT_SOURCE_DIR}/preview/light_field.cc
-                 ${PROJECT_SOURCE_DIR}/preview/scenes.cc ${PROJECT_SOURCE_DIR}/preview/point_emitters.cc)
-  target_link_libraries(preview_gpu_check PRIVATE lumislab_core lumislab_glad assimp::assimp
-                        ${CMAKE_DL_LIBS})
+  add_executable(preview_gpu_check ${CMAKE_CURRENT_LIST_DIR}/preview_gpu_check.cc)
+  target_link_libraries(preview_gpu_check PRIVATE lumislab_preview_renderer lumislab_lightfield
+                        lumislab_point_emitters ${CMAKE_DL_LIBS})
   lumislab_warnings(preview_gpu_check)
 endif()

@@ -17,10 +17,10 @@
 
 #include "core/error.h"
 #include "core/exr_io.h"
-#include "preview/light_field.h"
+#include "lib/lightfield/light_field.h"
+#include "lib/lightfield/scene_setup.h"
 #include "preview/point_emitters.h"
 #include "preview/renderer.h"
-#include "preview/scenes.h"
 
 namespace lumislab {
 namespace {
@@ -144,19 +144,19 @@ int Run(int argc, char** argv) {
   const SlabInfo info = MakeSlabInfo(750, 9, 7, 5, 1200, 300);
   const auto emitters = DefaultPointEmitters();
   const int w = 400, h = 400;
+  // The crypt as lumislab-preview sets it up: mesh, luminaire pose, orbit camera, culling.
+  SceneSetup setup = MakeSceneSetup("crypt", info);
   RenderOptions options;
+  options.cull_back_faces = setup.closed_room;
   Renderer renderer(info, w, h, options);
-  renderer.SetScene(MakeCrypt());
-  renderer.SetPose(PoseFromValues({250, 2300, -150, 90, 0, 0}));  // as lumislab-preview's crypt
-  auto camera = [&](double yaw_deg) -> Eigen::Matrix4f {
-    const double yaw = yaw_deg * M_PI / 180, pitch = 38 * M_PI / 180;
-    const Eigen::Vector3d target(0, 500, 0);
-    const Eigen::Vector3d eye =
-        target + 3900 * Eigen::Vector3d(std::cos(pitch) * std::sin(yaw), std::sin(pitch),
-                                        std::cos(pitch) * std::cos(yaw));
-    return Perspective(70, double(w) / h, 20, 100000) * LookAt(eye, target, {0, 1, 0});
+  renderer.SetScene(setup.mesh);
+  renderer.SetPose(setup.pose);
+  const double start_yaw = setup.camera_yaw_deg;
+  auto camera = [&](double yaw_deg) {
+    setup.camera_yaw_deg = yaw_deg;
+    return OrbitCamera(setup, double(w) / h);
   };
-  renderer.SetCamera(camera(35));
+  renderer.SetCamera(camera(start_yaw));
   for (int j = 0; j < info.grid.nv; ++j)
     for (int i = 0; i < info.grid.nu; ++i)
       renderer.SetPosition(
@@ -169,7 +169,7 @@ int Run(int argc, char** argv) {
   const ImageF image = renderer.Read();
   std::vector<double> moving;
   for (int f = 0; f < frames; ++f) {
-    renderer.SetCamera(camera(35 + 2.0 * (f + 1)));
+    renderer.SetCamera(camera(start_yaw + 2.0 * (f + 1)));
     t0 = std::chrono::steady_clock::now();
     renderer.Render();
     moving.push_back(

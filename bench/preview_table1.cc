@@ -11,11 +11,11 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "lib/lightfield/light_field.h"
+#include "lib/lightfield/scene_setup.h"
 #include "preview/gl_context.h"
-#include "preview/light_field.h"
 #include "preview/point_emitters.h"
 #include "preview/renderer.h"
-#include "preview/run_preview.h"
 
 namespace lumislab {
 namespace {
@@ -89,11 +89,11 @@ int Run(int argc, char** argv) {
   std::printf("%-9s %5s %-5s %-7s %10s %10s %8s %8s %8s\n", "", "", "", "", "", "", "", "cache",
               "full");
   for (const std::string scene : {"crypt", "cloister"}) {
-    PreviewConfig config;
-    config.scene = scene;
+    SceneRequest request;
+    request.name = scene;
     for (const Paper& p : paper) {
       const Slab slab = MakeSlab(p.nu, p.nv);
-      SceneSetup setup = MakeSceneSetup(config, slab.info);
+      SceneSetup setup = MakeSceneSetup(request, slab.info);
       if (quick &&
           !((scene == "crypt" && p.nu == 5) || (scene == "cloister" && p.nv == 7 && p.nu == 9))) {
         continue;
@@ -143,9 +143,8 @@ int Run(int argc, char** argv) {
   // Live mode: positions arrive one at a time (crypt, 9x7, shadows); each Render adds exactly the
   // new light (its shadow map and one light pass) to the accumulated image.
   if (!quick) {
-    PreviewConfig config;
     const Slab slab = MakeSlab(9, 7);
-    const SceneSetup setup = MakeSceneSetup(config, slab.info);
+    const SceneSetup setup = MakeSceneSetup("crypt", slab.info);
     RenderOptions options;
     options.shadow_size = shadow_size;
     Renderer r(slab.info, size, size, options);

@@ -16,7 +16,7 @@
 
 #include "core/image.h"
 #include "core/slab.h"
-#include "preview/scenes.h"
+#include "lib/lightfield/scenes.h"
 
 namespace lumislab {
 
@@ -78,15 +78,5 @@ class Renderer {
   int ping_ = 0;  // sRGBE: which of the two targets holds the current sum
   Gl* gl_;
 };
-
-// Camera helpers (column vectors, GL clip conventions).
-Eigen::Matrix4f Perspective(double fov_y_deg, double aspect, double near_mm, double far_mm);
-Eigen::Matrix4f LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-                       const Eigen::Vector3d& up);
-// Orthographic view of the plane z = plane_z (luminaire frame = scene frame), square of side
-// extent: column 0 at -x, row 0 (after Read) at +y; nearer-to-plane surfaces never hide it.
-Eigen::Matrix4f PlaneView(double plane_z_mm, double extent_mm);
-// Pose from "x,y,z,rx,ry,rz" (mm, degrees; R = Rz Ry Rx).
-Eigen::Isometry3d PoseFromValues(const std::vector<double>& values);
 
 }  // namespace lumislab

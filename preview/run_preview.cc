@@ -3,129 +3,101 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <csignal>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
+#include <regex>
 #include <thread>
 
-#include "core/atomic_file.h"
+#include "core/command_line.h"
 #include "core/error.h"
-#include "core/exr_io.h"
 #include "core/log.h"
-#include "preview/gl_context.h"
-#include "preview/light_field.h"
+#include "core/stop_signal.h"
+#include "lib/lightfield/light_field.h"
+#include "preview/headless.h"
 #include "preview/point_emitters.h"
 #include "preview/window.h"
 
 namespace lumislab {
 namespace {
 
-volatile std::sig_atomic_t g_stop = 0;
-void OnSignal(int) { g_stop = 1; }
+// What the command line gives beyond PreviewConfig.
+struct CommandLineExtras {
+  std::string size = "400x400";
+  bool write_test_slab = false;
+};
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
+void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
+  app.add_option("--slab", config.slab_dir, "slab folder (slab.json + pos_<i>_<j>.exr)")
+      ->required();
+  app.add_option("--scene", config.scene.name, "crypt | cloister | plane | scene file (Assimp)")
+      ->capture_default_str();
+  app.add_option("--luminaire-pose", config.scene.pose,
+                 "luminaire frame in the scene: x,y,z (mm),rx,ry,rz (degrees, R = Rz Ry Rx)")
+      ->delimiter(',')
+      ->expected(6);
+  app.add_option("--size", extras.size, "image size WxH")->capture_default_str();
+  app.add_option("--out", config.out, "headless output: .exr (linear) or .png (tone-mapped)");
+  app.add_option("--receiver-plane", config.scene.receiver_plane_mm,
+                 "plane mode: D in mm (default: the slab's d)");
+  app.add_option("--extent", config.scene.extent_mm,
+                 "plane mode: side W in mm (default: window D/d)");
 }
 
-// Waits for slab.json (a live reconstruct writes it with its first position).
-SlabInfo LoadInfo(const PreviewConfig& config) {
-  const std::string json = config.slab_dir + "/slab.json";
-  while (config.watch && !std::filesystem::exists(json) && !g_stop) {
-    std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
-  }
-  return SlabInfo::Load(config.slab_dir);
+void AddRenderOptions(CLI::App& app, PreviewConfig& config) {
+  app.add_option("--exposure", config.exposure_stops, "exposure in stops (on top of auto)");
+  app.add_flag("!--no-auto-exposure", config.auto_exposure, "no automatic exposure");
+  app.add_flag("!--no-shadows", config.shadows, "no shadow maps");
+  app.add_flag("--srgbe", config.srgbe, "sRGBE-packed accumulation (paper §4.2)");
+  app.add_flag("--srgbe-error", config.report_srgbe_error,
+               "also render with the other accumulation format and report the difference");
+  app.add_option("--shadow-size", config.shadow_size, "shadow-map size")->capture_default_str();
+  app.add_flag("--shadow-pcf", config.shadow_pcf, "2x2 filtered shadow-map lookups");
 }
 
-int RunHeadless(const PreviewConfig& config) {
-  SlabInfo info = LoadInfo(config);
-  OffscreenContext context(16, 16);
-  LogDebug("GL renderer: ", context.Renderer());
-  const SceneSetup setup = MakeSceneSetup(config, info);
-  RenderOptions options = MakeRenderOptions(config, setup);
-  const int width = config.width;  // plane mode is square
-  const int height = setup.plane ? config.width : config.height;
-  Renderer renderer(info, width, height, options);
-  renderer.SetScene(setup.mesh);
-  renderer.SetPose(setup.pose);
-  renderer.SetCamera(setup.plane ? PlaneView(setup.plane_z, setup.extent)
-                                 : OrbitCamera(setup, double(width) / height));
-  auto write = [&] {
-    if (config.out.empty()) return;
-    const ImageF image = renderer.Read();
-    WriteImage(config.out, image,
-               ExposureFactor(image, config.exposure_stops, config.auto_exposure));
-  };
-  std::vector<std::pair<int, int>> loaded = LoadNewPositions(config.slab_dir, info, renderer);
-  renderer.Render();
-  write();
-  LogInfo("rendered ", renderer.PositionCount(), "/", info.grid.count(), " positions, ",
-          setup.mesh.triangles(), " triangles, ", width, "x", height,
-          config.out.empty() ? "" : " -> " + config.out);
-  if (config.report_srgbe_error || config.srgbe) {
-    RenderOptions other = options;
-    other.srgbe = !options.srgbe;
-    const ImageF a = renderer.Read();
-    renderer.SetOptions(other);
-    renderer.Render();
-    const ImageF b = renderer.Read();
-    renderer.SetOptions(options);
-    renderer.Render();
-    double diff = 0, norm = 0, worst = 0;
-    const ImageF& reference = options.srgbe ? b : a;  // the float render
-    const double floor = 1e-3 * *std::max_element(reference.data.begin(), reference.data.end());
-    for (size_t px = 0; px < a.data.size() / 3; ++px) {
-      double peak = 0, error = 0;
-      for (size_t c = 3 * px; c < 3 * px + 3; ++c) {
-        const double e = a.data[c] - b.data[c];
-        diff += e * e;
-        norm += double(reference.data[c]) * reference.data[c];
-        peak = std::max(peak, std::abs(double(reference.data[c])));
-        error = std::max(error, std::abs(e));
-      }
-      if (peak > floor) worst = std::max(worst, error / peak);  // shared exponent: per pixel
-    }
-    LogInfo("sRGBE accumulation vs float: relative L2 error ", std::sqrt(diff / norm),
-            ", max per pixel (relative to its largest channel, pixels above 1e-3 of the peak) ",
-            worst);
+void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
+  app.add_flag("--watch", config.watch, "poll the slab folder and add positions as they arrive");
+  app.add_option("--poll", config.poll_s, "--watch polling interval (s)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_flag("--window", config.window, "interactive GLFW window (needs a display)");
+  app.add_option("--screenshot", config.screenshot,
+                 "--window: save the window to this PNG once all positions are in, then quit");
+  app.add_flag("--bench", config.bench, "time frames with a moving camera");
+  app.add_option("--bench-frames", config.bench_frames)->capture_default_str();
+  app.add_flag("--write-test-slab", extras.write_test_slab,
+               "first write the exact slab of the built-in point-emitter luminaire (9x7, h=5, "
+               "d=750, window 1200 at 300) into --slab when it has no slab.json (demos, tests)");
+}
+
+// Checks what CLI11 cannot; fills the size.
+void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
+  if (!ParseSize(extras.size, &config.width, &config.height)) {
+    throw InputError("--size", "size", "WxH, each 1..8192, e.g. 400x400", extras.size);
   }
-  if (config.bench) {
-    std::vector<double> seconds;
-    SceneSetup moving = setup;
-    for (int frame = 0; frame < config.bench_frames; ++frame) {
-      moving.camera_yaw_deg += 1.0;
-      if (!setup.plane) renderer.SetCamera(OrbitCamera(moving, double(width) / height));
-      const auto start = std::chrono::steady_clock::now();
-      renderer.Render();
-      seconds.push_back(
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    }
-    const double median = Median(seconds);
-    LogInfo("bench: ", config.bench_frames, " frames (camera moving, shadow maps cached), median ",
-            median * 1000, " ms = ", 1.0 / median, " fps");
+  if (config.shadow_size < 16 || config.shadow_size > 4096) {
+    throw InputError("--shadow-size", "shadow-size", "16..4096",
+                     std::to_string(config.shadow_size));
   }
-  while (config.watch && renderer.PositionCount() < info.grid.count() && !g_stop) {
-    std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
-    try {
-      info = SlabInfo::Load(config.slab_dir);
-    } catch (const Error&) {
-      continue;  // slab.json being replaced: try again at the next poll
-    }
-    const auto added = LoadNewPositions(config.slab_dir, info, renderer);
-    if (added.empty()) continue;
-    renderer.Render();
-    write();
-    LogInfo("positions ", renderer.PositionCount(), "/", info.grid.count(), " (new: ", added.size(),
-            ")");
-    if (renderer.PositionCount() == info.grid.count()) break;
+  if (!config.window && config.out.empty() && !config.bench) {
+    throw BadInput("headless mode needs --out <file.exr|.png> (or --bench, or --window)");
   }
-  return 0;
+}
+
+// Runs the configured preview inside a stop-signal scope (Ctrl-C ends --watch cleanly).
+int Run(const PreviewConfig& config, bool write_test_slab) {
+  if (write_test_slab && !std::filesystem::exists(config.slab_dir + "/slab.json")) {
+    WriteTruthSlab(DefaultPointEmitters(), MakeSlabInfo(750, 9, 7, 5, 1200, 300), config.slab_dir);
+    LogInfo("wrote the built-in test slab to ", config.slab_dir);
+  }
+  const StopSignalScope stop_signals;
+  const std::optional<SlabInfo> info = WaitForSlabInfo(config);
+  if (!info) {
+    LogInfo("stopped before ", config.slab_dir, "/slab.json appeared");
+    return 0;
+  }
+  return config.window ? RunWindow(config, *info) : RunHeadless(config, *info);
 }
 
 }  // namespace
-
-bool PreviewStopRequested() { return g_stop != 0; }
 
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
   RenderOptions options;
@@ -138,180 +110,63 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   return options;
 }
 
-SceneSetup MakeSceneSetup(const PreviewConfig& config, const SlabInfo& info) {
-  SceneSetup s;
-  if (config.scene == "plane") {
-    s.plane = true;
-    s.plane_z = config.receiver_plane_mm > 0 ? config.receiver_plane_mm : info.distance_mm;
-    s.extent = config.extent_mm > 0 ? config.extent_mm
-                                    : info.layout.window_w_mm * s.plane_z / info.distance_mm;
-    s.mesh = MakeReceiverPlane(s.plane_z, 1.2 * s.extent);
-  } else if (config.scene == "crypt") {
-    s.mesh = MakeCrypt();
-    s.pose = PoseFromValues({250, 2300, -150, 90, 0, 0});  // hanging, shining down
-    s.camera_target = {0, 500, 0};
-    s.camera_distance = 3900;
-    s.camera_yaw_deg = 35;
-    s.camera_pitch_deg = 38;
-    s.closed_room = true;
-  } else if (config.scene == "cloister") {
-    s.mesh = MakeCloister();
-    s.pose = PoseFromValues({900, 3700, 900, 90, 0, 0});
-    s.camera_target = {0, 500, 0};
-    s.camera_distance = 9000;
-    s.camera_yaw_deg = 35;
-    s.camera_pitch_deg = 38;
-    s.closed_room = true;
-  } else {
-    s.mesh = LoadSceneFile(config.scene);
-    Eigen::Vector3f lo = s.mesh.positions[0], hi = lo;
-    for (const auto& p : s.mesh.positions) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    s.camera_target = (0.5f * (lo + hi)).cast<double>();
-    s.camera_distance = 1.5 * (hi - lo).norm();
-    s.pose = PoseFromValues(
-        {s.camera_target.x(), hi.y() - 0.05 * (hi.y() - lo.y()), s.camera_target.z(), 90, 0, 0});
+std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config) {
+  const std::string json = config.slab_dir + "/slab.json";
+  while (config.watch && !std::filesystem::exists(json)) {
+    if (StopRequested()) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
   }
-  if (!config.pose.empty()) s.pose = PoseFromValues(config.pose);
-  return s;
-}
-
-Eigen::Matrix4f OrbitCamera(const SceneSetup& s, double aspect) {
-  const double yaw = s.camera_yaw_deg * M_PI / 180, pitch = s.camera_pitch_deg * M_PI / 180;
-  const Eigen::Vector3d eye =
-      s.camera_target + s.camera_distance * Eigen::Vector3d(std::cos(pitch) * std::sin(yaw),
-                                                            std::sin(pitch),
-                                                            std::cos(pitch) * std::cos(yaw));
-  return Perspective(70, aspect, 20, 100000) * LookAt(eye, s.camera_target, {0, 1, 0});
+  return SlabInfo::Load(config.slab_dir);
 }
 
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
-                                                  Renderer& renderer) {
+                                                  Renderer& renderer, int threads) {
   std::vector<std::pair<int, int>> added;
   for (const auto& [i, j] : ScanSlabPositions(slab_dir, info.grid)) {
-    if (renderer.HasPosition(i, j)) continue;
-    const SlabPosition p = ReadSlabPosition(slab_dir, info, i, j);
-    renderer.SetPosition(i, j, IntensityFromIrradiance(info, i, j, p.irradiance));
-    added.emplace_back(i, j);
+    if (!renderer.HasPosition(i, j)) added.emplace_back(i, j);
+  }
+  // E' of a batch on `threads` threads, then uploaded on this one (the GL context's); batches
+  // bound the memory held for a large slab.
+  const size_t batch = size_t(std::max(16, 2 * threads));
+  for (size_t start = 0; start < added.size(); start += batch) {
+    const std::vector<std::pair<int, int>> part(
+        added.begin() + start, added.begin() + std::min(added.size(), start + batch));
+    const std::vector<ImageF> intensities = ReadIntensities(slab_dir, info, part, threads);
+    for (size_t k = 0; k < part.size(); ++k) {
+      renderer.SetPosition(part[k].first, part[k].second, intensities[k]);
+    }
   }
   return added;
 }
 
-double ExposureFactor(const ImageF& image, double stops, bool automatic) {
-  double factor = std::pow(2.0, stops);
-  if (automatic) {
-    std::vector<float> values;
-    for (int y = 0; y < image.height; ++y) {
-      for (int x = 0; x < image.width; ++x) {
-        values.push_back(std::max({image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)}));
-      }
-    }
-    if (!values.empty()) {
-      std::nth_element(values.begin(), values.begin() + values.size() * 99 / 100, values.end());
-      const double p99 = values[values.size() * 99 / 100];
-      if (p99 > 0) factor *= 0.8 / p99;
-    }
-  }
-  return factor;
-}
-
-void WriteImage(const std::string& path, const ImageF& image, double exposure_factor) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".exr") {
-    WriteExr(path, image, {"R", "G", "B"});
-    return;
-  }
-  if (ext != ".png") throw BadInput(path + ": output must end in .exr or .png");
-  cv::Mat out(image.height, image.width, CV_8UC3);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        double v = std::clamp(image.at(x, y, c) * exposure_factor, 0.0, 1.0);
-        v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-        out.at<cv::Vec3b>(y, x)[2 - c] = cv::saturate_cast<uchar>(v * 255.0 + 0.5);
-      }
-    }
-  }
-  WriteAtomically(path, [&](const std::string& tmp) {
-    if (!cv::imwrite(tmp, out)) throw IoError(path, "cannot write PNG");
-  });
+bool ParseSize(const std::string& text, int* width, int* height) {
+  static const std::regex pattern("([0-9]{1,5})x([0-9]{1,5})");
+  std::smatch match;
+  if (!std::regex_match(text, match, pattern)) return false;
+  *width = std::stoi(match[1].str());
+  *height = std::stoi(match[2].str());
+  return *width > 0 && *height > 0 && *width <= 8192 && *height <= 8192;
 }
 
 int RunPreview(int argc, char** argv) {
-  PreviewConfig config;
-  bool verbose = false;
-  int threads = 0;
-  std::string size = "400x400";
   CLI::App app{
       "lumislab-preview: the measured luminaire lighting a scene (docs/design.md §4); headless "
       "(OSMesa, --out) or in a window (--window)"};
-  app.add_option("--slab", config.slab_dir, "slab folder (slab.json + pos_<i>_<j>.exr)")
-      ->required();
-  app.add_option("--scene", config.scene, "crypt | cloister | plane | scene file (Assimp)")
-      ->capture_default_str();
-  app.add_option("--luminaire-pose", config.pose,
-                 "luminaire frame in the scene: x,y,z (mm),rx,ry,rz (degrees, R = Rz Ry Rx)")
-      ->delimiter(',')
-      ->expected(6);
-  app.add_option("--size", size, "image size WxH")->capture_default_str();
-  app.add_option("--out", config.out, "headless output: .exr (linear) or .png (tone-mapped)");
-  app.add_option("--receiver-plane", config.receiver_plane_mm,
-                 "plane mode: D in mm (default: the slab's d)");
-  app.add_option("--extent", config.extent_mm, "plane mode: side W in mm (default: window D/d)");
-  app.add_option("--exposure", config.exposure_stops, "exposure in stops (on top of auto)");
-  app.add_flag("!--no-auto-exposure", config.auto_exposure, "no automatic exposure");
-  app.add_flag("!--no-shadows", config.shadows, "no shadow maps");
-  app.add_flag("--srgbe", config.srgbe, "sRGBE-packed accumulation (paper §4.2)");
-  app.add_flag("--srgbe-error", config.report_srgbe_error,
-               "also render with the other accumulation format and report the difference");
-  app.add_option("--shadow-size", config.shadow_size, "shadow-map size")->capture_default_str();
-  app.add_flag("--shadow-pcf", config.shadow_pcf, "2x2 filtered shadow-map lookups");
-  app.add_flag("--watch", config.watch, "poll the slab folder and add positions as they arrive");
-  app.add_option("--poll", config.poll_s, "--watch polling interval (s)")->capture_default_str();
-  app.add_flag("--window", config.window, "interactive GLFW window (needs a display)");
-  app.add_option("--screenshot", config.screenshot,
-                 "--window: save the window to this PNG once all positions are in, then quit");
-  app.add_flag("--bench", config.bench, "time frames with a moving camera");
-  app.add_option("--bench-frames", config.bench_frames)->capture_default_str();
-  app.add_option("--threads", threads, "render threads (LP_NUM_THREADS; default: all cores)");
-  bool write_test_slab = false;
-  app.add_flag("--write-test-slab", write_test_slab,
-               "first write the exact slab of the built-in point-emitter luminaire (9x7, h=5, "
-               "d=750, window 1200 at 300) into --slab when it has no slab.json (demos, tests)");
-  app.add_flag("--verbose", verbose, "debug log");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
-  }
-  SetLogTool("preview");
-  if (verbose) SetLogLevel(LogLevel::kDebug);
-  if (std::sscanf(size.c_str(), "%dx%d", &config.width, &config.height) != 2 || config.width <= 0 ||
-      config.height <= 0 || config.width > 8192 || config.height > 8192) {
-    throw InputError("--size", "size", "WxH, e.g. 400x400", size);
-  }
-  if (threads > 0) setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
-  if (config.shadow_size < 16 || config.shadow_size > 4096) {
-    throw InputError("--shadow-size", "shadow-size", "16..4096",
-                     std::to_string(config.shadow_size));
-  }
-  if (write_test_slab && !std::filesystem::exists(config.slab_dir + "/slab.json")) {
-    WriteTruthSlab(DefaultPointEmitters(), MakeSlabInfo(750, 9, 7, 5, 1200, 300), config.slab_dir);
-    LogInfo("wrote the built-in test slab to ", config.slab_dir);
-  }
-  std::signal(SIGINT, OnSignal);
-  std::signal(SIGTERM, OnSignal);
-  if (config.window) {
-    SlabInfo info = LoadInfo(config);
-    return RunWindow(config, info);
-  }
-  if (config.out.empty() && !config.bench) {
-    throw BadInput("headless mode needs --out <file.exr|.png> (or --bench, or --window)");
-  }
-  return RunHeadless(config);
+  app.footer(
+      "--threads sizes lumislab's own CPU work (deriving E' of the slab positions as they are "
+      "loaded). The renderer's threads are llvmpipe's: set them with the LP_NUM_THREADS "
+      "environment variable (default: all cores).");
+  PreviewConfig config;
+  CommonOptions common;
+  CommandLineExtras extras;
+  AddCommonOptions(&app, &common);
+  AddSceneOptions(app, config, extras);
+  AddRenderOptions(app, config);
+  AddModeOptions(app, config, extras);
+  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
+  config.threads = StartTool("preview", common);
+  CheckOptions(extras, config);
+  return Run(config, extras.write_test_slab);
 }
 
 }  // namespace lumislab

@@ -9,6 +9,6 @@
 
 namespace lumislab {
 
-int RunWindow(const PreviewConfig& config, SlabInfo info);
+int RunWindow(const PreviewConfig& config, const SlabInfo& info);
 
 }  // namespace lumislab

@@ -9,10 +9,11 @@
 #include "lib/synthetic/truth.h"
 #include "core/geometry.h"
 #include "core/slab.h"
+#include "lib/lightfield/camera.h"
+#include "lib/lightfield/light_field.h"
+#include "lib/lightfield/scenes.h"
 #include "preview/gl_context.h"
-#include "preview/light_field.h"
 #include "preview/renderer.h"
-#include "preview/scenes.h"
 
 namespace lumislab {
 namespace {

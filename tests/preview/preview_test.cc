@@ -7,14 +7,17 @@
 #include <filesystem>
 #include <memory>
 
+#include "core/error.h"
 #include "core/geometry.h"
 #include "core/slab.h"
+#include "lib/lightfield/camera.h"
+#include "lib/lightfield/light_field.h"
+#include "lib/lightfield/scene_setup.h"
+#include "lib/lightfield/scenes.h"
 #include "preview/gl_context.h"
-#include "preview/light_field.h"
 #include "preview/point_emitters.h"
 #include "preview/renderer.h"
 #include "preview/run_preview.h"
-#include "preview/scenes.h"
 
 namespace lumislab {
 namespace {
@@ -116,9 +119,7 @@ class PreviewSlabFiles : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   std::unique_ptr<Renderer> MakeRenderer(const RenderOptions& options = {}) {
-    PreviewConfig config;
-    config.scene = "crypt";
-    const SceneSetup setup = MakeSceneSetup(config, info_);
+    const SceneSetup setup = MakeSceneSetup("crypt", info_);
     auto renderer = std::make_unique<Renderer>(info_, 96, 96, options);
     renderer->SetScene(setup.mesh);
     renderer->SetPose(setup.pose);
@@ -128,8 +129,7 @@ class PreviewSlabFiles : public ::testing::Test {
   // Uploads positions (i, j) from the files.
   void Upload(Renderer& r, const std::vector<std::pair<int, int>>& positions) {
     for (const auto& [i, j] : positions) {
-      const SlabPosition p = ReadSlabPosition(dir_.string(), info_, i, j);
-      r.SetPosition(i, j, IntensityFromIrradiance(info_, i, j, p.irradiance));
+      r.SetPosition(i, j, ReadIntensity(dir_.string(), info_, i, j));
     }
   }
   static double RelativeDifference(const ImageF& a, const ImageF& b) {
@@ -179,14 +179,13 @@ TEST_F(PreviewSlabFiles, IncrementalPositionsEqualAFullRenderAndReuseShadowMaps)
   }
   EXPECT_EQ(live->Render(), 0);
   auto full = MakeRenderer();
-  EXPECT_EQ(int(LoadNewPositions(dir_.string(), info_, *full).size()), info_.grid.count());
+  EXPECT_EQ(int(LoadNewPositions(dir_.string(), info_, *full, 3).size()), info_.grid.count());
   full->Render();
   EXPECT_LE(RelativeDifference(live->Read(), full->Read()), 1e-5);
   // Moving the camera re-accumulates all lights but renders no shadow map again.
   const int shadow_renders = full->ShadowMapRenders();
   EXPECT_EQ(shadow_renders, info_.grid.count());
-  PreviewConfig config;
-  SceneSetup moved = MakeSceneSetup(config, info_);
+  SceneSetup moved = MakeSceneSetup("crypt", info_);
   moved.camera_yaw_deg += 20;
   full->SetCamera(OrbitCamera(moved, 1.0));
   EXPECT_EQ(full->Render(), info_.grid.count());
@@ -211,6 +210,40 @@ TEST_F(PreviewSlabFiles, SrgbeAccumulationStaysCloseToFloat) {
   // Each pass re-encodes the sum (25 lights fit one pass here): ~1/255 relative per pass.
   EXPECT_LE(error, 0.01);
   EXPECT_GT(error, 0.0);  // it is really packed
+}
+
+int RunPreviewWith(std::vector<std::string> args) {
+  args.insert(args.begin(), "lumislab-preview");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
+}
+
+TEST(PreviewCommandLine, SizeIsCheckedStrictly) {
+  int w = 0, h = 0;
+  EXPECT_TRUE(ParseSize("640x480", &w, &h));
+  EXPECT_EQ(w, 640);
+  EXPECT_EQ(h, 480);
+  for (const char* bad : {"400x400junk", "400x", "x400", " 400x400", "400X400", "-4x400", "0x400",
+                          "400x9000", "400x400x3", "+400x400", ""}) {
+    EXPECT_FALSE(ParseSize(bad, &w, &h)) << bad;
+  }
+  testing::internal::CaptureStderr();
+  const int code = RunPreviewWith(
+      {"--slab", "/nonexistent-lumislab-slab", "--size", "400x400junk", "--out", "x.png"});
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("--size"), std::string::npos) << err;
+  EXPECT_NE(err.find("400x400junk"), std::string::npos) << err;
+}
+
+TEST(PreviewCommandLine, HelpNamesLlvmpipeThreads) {
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(RunPreviewWith({"--help"}), 0);
+  const std::string help = testing::internal::GetCapturedStdout();
+  EXPECT_NE(help.find("--threads"), std::string::npos);
+  EXPECT_NE(help.find("LP_NUM_THREADS"), std::string::npos) << help;
+  EXPECT_EQ(RunPreviewWith({"--slab", "x", "--threads", "-1", "--out", "x.png"}), 2);
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
-#include "preview/light_field.h"
+#include "lib/lightfield/light_field.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/geometry.h"
+#include "core/parallel.h"
 
 namespace lumislab {
 
@@ -57,6 +58,21 @@ Eigen::Vector3d SpotIrradiance(const SlabInfo& info, int i, int j, const ImageF&
   const double s = c.x() + rel.x() * info.distance_mm / rel.z();
   const double t = c.y() + rel.y() * info.distance_mm / rel.z();
   return SampleLayout(info.layout, intensity, s, t) * f_m2;
+}
+
+ImageF ReadIntensity(const std::string& slab_dir, const SlabInfo& info, int i, int j) {
+  const SlabPosition position = ReadSlabPosition(slab_dir, info, i, j);
+  return IntensityFromIrradiance(info, i, j, position.irradiance);
+}
+
+std::vector<ImageF> ReadIntensities(const std::string& slab_dir, const SlabInfo& info,
+                                    const std::vector<std::pair<int, int>>& positions,
+                                    int threads) {
+  std::vector<ImageF> out(positions.size());
+  ParallelFor(int(positions.size()), threads, [&](int k) {
+    out[k] = ReadIntensity(slab_dir, info, positions[k].first, positions[k].second);
+  });
+  return out;
 }
 
 }  // namespace lumislab

@@ -1,6 +1,7 @@
 // The slab as the renderer uses it (docs/design.md §4): per grid position the texture
-// E'_ij = E_ij / g_ij in W/sr (g_ij the shift-invariant geometry term, converted to m^-2), and the
-// CPU evaluation of the same textured-spot-light formula (for tests and the exact comparisons).
+// E'_ij = E_ij / g_ij in W/sr (g_ij the shift-invariant geometry term, converted to m^-2), read
+// from disk ready to upload, and the CPU evaluation of the same textured-spot-light formula (eq. 14
+// for one position; tests and exact comparisons). No GL here: the renderer only uploads E'.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,5 +25,11 @@ Eigen::Vector3d SampleLayout(const SlabLayout& layout, const ImageF& texture, do
 // the luminaire frame, mm), without visibility: V=1. W/m^2.
 Eigen::Vector3d SpotIrradiance(const SlabInfo& info, int i, int j, const ImageF& intensity,
                                const Eigen::Vector3d& x, const Eigen::Vector3d& n);
+
+// E'_ij of position (i, j) read from the slab folder (ReadSlabPosition, checked against `info`).
+ImageF ReadIntensity(const std::string& slab_dir, const SlabInfo& info, int i, int j);
+// E' of each of `positions` (i, j), read and derived on `threads` threads; same order.
+std::vector<ImageF> ReadIntensities(const std::string& slab_dir, const SlabInfo& info,
+                                    const std::vector<std::pair<int, int>>& positions, int threads);
 
 }  // namespace lumislab

@@ -1,4 +1,4 @@
-#include "preview/scenes.h"
+#include "lib/lightfield/scenes.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -32,13 +32,15 @@ void AddPillar(Mesh& m, float x, float z, float r, float y0, float y1, int sides
 }
 
 // An arch between pillar tops a and b (at height y), `thickness` across, `segments` pieces of a
-// half ellipse (rise 0.3 span), the spandrels filled up to a band 0.1 span above the crown.
+// half ellipse (rise 0.3 span), the spandrels filled up to a band 0.1 span above the crown, closed
+// on top and at both ends: a solid whose faces all point out.
 void AddArch(Mesh& m, const V& a, const V& b, float y, float thickness, int segments,
              const V& colour) {
   const V axis = (b - a);
   const float span = axis.norm();
   const V dir = axis / span;
-  const V side = V(0, 1, 0).cross(dir).normalized() * (0.5f * thickness);
+  // dir x up: with the quads below, the intrados faces down and each spandrel away from the arch.
+  const V side = dir.cross(V(0, 1, 0)).normalized() * (0.5f * thickness);
   const float half = 0.5f * span;
   const float rise = 0.3f * span;  // elliptical arch, flatter than a half circle
   const float top = y + rise + 0.1f * span;
@@ -55,6 +57,12 @@ void AddArch(Mesh& m, const V& a, const V& b, float y, float thickness, int segm
     m.AddQuad(q0 + side, q1 + side, u1 + side, u0 + side, colour);
     m.AddQuad(q1 - side, q0 - side, u0 - side, u1 - side, colour);
   }
+  // Top band (extrados) facing up, and the two ends (they show at a pillar's outer corner).
+  const V e0 = centre - dir * half, e1 = centre + dir * half;
+  const V top0(e0.x(), top, e0.z()), top1(e1.x(), top, e1.z());
+  m.AddQuad(top0 + side, top1 + side, top1 - side, top0 - side, colour);
+  m.AddQuad(e0 - side, e0 + side, top0 + side, top0 - side, colour);
+  m.AddQuad(e1 + side, e1 - side, top1 - side, top1 + side, colour);
 }
 
 void AddRoom(Mesh& m, const V& lo, const V& hi, const V& floor, const V& wall, const V& ceiling) {

@@ -1,0 +1,58 @@
+#include "lib/lightfield/camera.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace lumislab {
+
+Eigen::Matrix4f Perspective(double fov_y_deg, double aspect, double near_mm, double far_mm) {
+  const double f = 1.0 / std::tan(0.5 * fov_y_deg * M_PI / 180.0);
+  Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
+  m(0, 0) = float(f / aspect);
+  m(1, 1) = float(f);
+  m(2, 2) = float((far_mm + near_mm) / (near_mm - far_mm));
+  m(2, 3) = float(2 * far_mm * near_mm / (near_mm - far_mm));
+  m(3, 2) = -1;
+  return m;
+}
+
+Eigen::Matrix4f LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                       const Eigen::Vector3d& up) {
+  const Eigen::Vector3d f = (target - eye).normalized();
+  const Eigen::Vector3d s = f.cross(up).normalized();
+  const Eigen::Vector3d u = s.cross(f);
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<1, 3>(0, 0) = s.transpose();
+  m.block<1, 3>(1, 0) = u.transpose();
+  m.block<1, 3>(2, 0) = -f.transpose();
+  m(0, 3) = -s.dot(eye);
+  m(1, 3) = -u.dot(eye);
+  m(2, 3) = f.dot(eye);
+  return m.cast<float>();
+}
+
+Eigen::Matrix4f PlaneView(double plane_z_mm, double extent_mm) {
+  Eigen::Matrix4f m = Eigen::Matrix4f::Zero();
+  m(0, 0) = float(2.0 / extent_mm);
+  m(1, 1) = float(2.0 / extent_mm);
+  // depth = (D - z) / 4D: the plane (z = D) is nearest, anything in front of it is behind it.
+  m(2, 2) = float(-1.0 / (4.0 * plane_z_mm));
+  m(2, 3) = 0.25f;
+  m(3, 3) = 1;
+  return m;
+}
+
+Eigen::Isometry3d PoseFromValues(const std::vector<double>& v) {
+  if (v.size() != 6) throw BadInput("--luminaire-pose needs x,y,z,rx,ry,rz (mm, degrees)");
+  const double k = M_PI / 180.0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(v[5] * k, Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(v[4] * k, Eigen::Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(v[3] * k, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return pose;
+}
+
+}  // namespace lumislab

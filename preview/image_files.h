@@ -1,0 +1,18 @@
+// Image files of lumislab-preview, written atomically: linear EXR, or PNG tone-mapped by
+// lib/lightfield/tone_map.h (OpenCV only encodes the bytes).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+
+namespace lumislab {
+
+// 8-bit RGB, rows top first (width * height * 3 bytes), as a PNG.
+void WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+// .exr (linear RGB) or .png (times exposure_factor, sRGB 8-bit); BadInput for other endings.
+void WriteImage(const std::string& path, const ImageF& image, double exposure_factor);
+
+}  // namespace lumislab

@@ -10,6 +10,6 @@ if(TARGET lumislab_preview_renderer)
   # binary and a few libraries can be carried to a GPU node.
   add_executable(preview_gpu_check ${CMAKE_CURRENT_LIST_DIR}/preview_gpu_check.cc)
   target_link_libraries(preview_gpu_check PRIVATE lumislab_preview_renderer lumislab_lightfield
-                        lumislab_point_emitters ${CMAKE_DL_LIBS})
+                        lumislab_synthetic ${CMAKE_DL_LIBS})
   lumislab_warnings(preview_gpu_check)
 endif()

@@ -19,7 +19,7 @@
 #include "core/exr_io.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
-#include "preview/point_emitters.h"
+#include "lib/synthetic/truth.h"
 #include "preview/renderer.h"
 
 namespace lumislab {
@@ -141,8 +141,8 @@ int Run(int argc, char** argv) {
               reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
               reinterpret_cast<const char*>(glGetString(GL_VERSION)));
 
-  const SlabInfo info = MakeSlabInfo(750, 9, 7, 5, 1200, 300);
-  const auto emitters = DefaultPointEmitters();
+  const SlabInfo info = DefaultSlabInfo(9, 7, 5, 300);
+  const Luminaire luminaire = DefaultScene().luminaire;
   const int w = 400, h = 400;
   // The crypt as lumislab-preview sets it up: mesh, luminaire pose, orbit camera, culling.
   SceneSetup setup = MakeSceneSetup("crypt", info);
@@ -161,7 +161,7 @@ int Run(int argc, char** argv) {
     for (int i = 0; i < info.grid.nu; ++i)
       renderer.SetPosition(
           i, j,
-          IntensityFromIrradiance(info, i, j, TruthPosition(emitters, info, i, j).irradiance));
+          IntensityFromIrradiance(info, i, j, TruthPosition(luminaire, info, i, j).irradiance));
   auto t0 = std::chrono::steady_clock::now();
   renderer.Render();  // includes all 63 shadow maps
   const double first_ms =

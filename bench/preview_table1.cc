@@ -13,8 +13,8 @@
 #include "core/log.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
+#include "lib/synthetic/truth.h"
 #include "preview/gl_context.h"
-#include "preview/point_emitters.h"
 #include "preview/renderer.h"
 
 namespace lumislab {
@@ -37,12 +37,12 @@ struct Slab {
 };
 
 Slab MakeSlab(int nu, int nv) {
-  Slab slab{MakeSlabInfo(750, nu, nv, 5, 1200, 300), {}};
-  const auto emitters = DefaultPointEmitters();
+  Slab slab{DefaultSlabInfo(nu, nv, 5, 300), {}};
+  const Luminaire luminaire = DefaultScene().luminaire;
   for (int j = 0; j < nv; ++j) {
     for (int i = 0; i < nu; ++i) {
       slab.intensity.push_back(IntensityFromIrradiance(
-          slab.info, i, j, TruthPosition(emitters, slab.info, i, j).irradiance));
+          slab.info, i, j, TruthPosition(luminaire, slab.info, i, j).irradiance));
     }
   }
   return slab;
@@ -153,10 +153,10 @@ int Run(int argc, char** argv) {
     r.SetCamera(OrbitCamera(setup, 1.0));
     r.Render();
     std::vector<double> upload, add;
+    const Luminaire luminaire = DefaultScene().luminaire;
     for (int j = 0; j < 7; ++j) {
       for (int i = 0; i < 9; ++i) {
-        const auto emitters = DefaultPointEmitters();
-        const SlabPosition pos = TruthPosition(emitters, slab.info, i, j);
+        const SlabPosition pos = TruthPosition(luminaire, slab.info, i, j);
         auto start = Clock::now();
         r.SetPosition(i, j, IntensityFromIrradiance(slab.info, i, j, pos.irradiance));
         upload.push_back(Seconds(start));

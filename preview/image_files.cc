@@ -2,12 +2,11 @@
 
 #include <filesystem>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "lib/lightfield/tone_map.h"
+#include "lib/photo/photo_io.h"
 
 namespace lumislab {
 
@@ -20,9 +19,7 @@ void WritePng(const std::string& path, int width, int height, const std::vector<
       bgr.at<cv::Vec3b>(y, x) = cv::Vec3b(p[2], p[1], p[0]);
     }
   }
-  WriteAtomically(path, [&](const std::string& tmp) {
-    if (!cv::imwrite(tmp, bgr)) throw IoError(path, "cannot write PNG");
-  });
+  WriteImageFile(path, bgr);
 }
 
 void WriteImage(const std::string& path, const ImageF& image, double exposure_factor) {

@@ -1,5 +1,5 @@
 // Image files of lumislab-preview, written atomically: linear EXR, or PNG tone-mapped by
-// lib/lightfield/tone_map.h (OpenCV only encodes the bytes).
+// lib/lightfield/tone_map.h and written by lib/photo (the one image-file writer).
 #pragma once
 
 #include <cstdint>

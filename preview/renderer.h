@@ -1,6 +1,6 @@
-// The preview renderer (docs/design.md §4): per grid position a textured spot light at c_ij with the
-// projective texture E'_ij, f = cos(theta) cos(theta') / delta^2 and a shadow map from c_ij; light
-// only towards +z of the luminaire frame and only through the screen window; Lambertian
+// The preview renderer (docs/design.md §4): per grid position a textured spot light at c_ij with
+// the projective texture E'_ij, f = cos(theta) cos(theta') / delta^2 and a shadow map from c_ij;
+// light only towards +z of the luminaire frame and only through the screen window; Lambertian
 // materials; float (RGBA32F, additive blending) or sRGBE-packed accumulation (paper §4.2).
 // Needs a current GL 4.5 core context (OffscreenContext or WindowContext).
 //

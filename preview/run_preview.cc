@@ -12,8 +12,8 @@
 #include "core/log.h"
 #include "core/stop_signal.h"
 #include "lib/lightfield/light_field.h"
+#include "lib/synthetic/truth.h"
 #include "preview/headless.h"
-#include "preview/point_emitters.h"
 #include "preview/window.h"
 
 namespace lumislab {
@@ -64,7 +64,8 @@ void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ext
   app.add_flag("--bench", config.bench, "time frames with a moving camera");
   app.add_option("--bench-frames", config.bench_frames)->capture_default_str();
   app.add_flag("--write-test-slab", extras.write_test_slab,
-               "first write the exact slab of the built-in point-emitter luminaire (9x7, h=5, "
+               "first write the exact slab of the built-in synthetic luminaire (the default scene "
+               "of lumislab-acquire synth: 9x7, h=5, "
                "d=750, window 1200 at 300) into --slab when it has no slab.json (demos, tests)");
 }
 
@@ -85,7 +86,8 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
 // Runs the configured preview inside a stop-signal scope (Ctrl-C ends --watch cleanly).
 int Run(const PreviewConfig& config, bool write_test_slab) {
   if (write_test_slab && !std::filesystem::exists(config.slab_dir + "/slab.json")) {
-    WriteTruthSlab(DefaultPointEmitters(), MakeSlabInfo(750, 9, 7, 5, 1200, 300), config.slab_dir);
+    const SynthScene scene = DefaultScene();
+    WriteTruthSlab(scene.luminaire, TruthSlabInfo(scene, 300), config.slab_dir, config.threads);
     LogInfo("wrote the built-in test slab to ", config.slab_dir);
   }
   const StopSignalScope stop_signals;

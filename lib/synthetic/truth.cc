@@ -44,6 +44,12 @@ SlabInfo TruthSlabInfo(const SynthScene& scene, int resolution) {
   return SlabInfo::FromDataset(DatasetSkeleton(scene), resolution);
 }
 
+SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution) {
+  SynthScene scene = DefaultScene();
+  scene.grid = {nu, nv, spacing_mm};
+  return TruthSlabInfo(scene, resolution);
+}
+
 namespace {
 nlohmann::json RowMajor(const Eigen::Matrix3d& m) {
   nlohmann::json a = nlohmann::json::array();

@@ -24,6 +24,10 @@ void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string
 // filter, W/m^2).
 SlabInfo TruthSlabInfo(const SynthScene& scene, int resolution);
 
+// The built-in scene's setup (d = 750 mm, 1.2 m window, K = 1) with an nu x nv grid of spacing
+// h: the slab layout the preview's tests and benchmarks light scenes with.
+SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution);
+
 // truth/camera.json: intrinsics, pose (lab frame), and the exact homographies of the screen
 // plane (screen_from_image: pixel -> lab mm, row-major, and its inverse).
 void WriteTruthCamera(const SynthScene& scene, const std::string& path);

@@ -5,13 +5,13 @@
 
 #include <cmath>
 
-#include "lib/synthetic/scene.h"
-#include "lib/synthetic/truth.h"
 #include "core/geometry.h"
 #include "core/slab.h"
 #include "lib/lightfield/camera.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scenes.h"
+#include "lib/synthetic/scene.h"
+#include "lib/synthetic/truth.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
 
@@ -37,8 +37,9 @@ Errors AgainstAnalytic(double factor) {
   renderer.SetCamera(PlaneView(plane_z, extent));
   for (int j = 0; j < info.grid.nv; ++j) {
     for (int i = 0; i < info.grid.nu; ++i) {
-      renderer.SetPosition(
-          i, j, IntensityFromIrradiance(info, i, j, TruthPosition(scene.luminaire, info, i, j).irradiance));
+      renderer.SetPosition(i, j,
+                           IntensityFromIrradiance(
+                               info, i, j, TruthPosition(scene.luminaire, info, i, j).irradiance));
     }
   }
   renderer.Render();

@@ -14,8 +14,8 @@
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/scenes.h"
+#include "lib/synthetic/truth.h"
 #include "preview/gl_context.h"
-#include "preview/point_emitters.h"
 #include "preview/renderer.h"
 #include "preview/run_preview.h"
 
@@ -32,7 +32,7 @@ OffscreenContext& Context() {
 // the same sum with exact ray-cast visibility.
 TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
   Context();
-  const SlabInfo info = MakeSlabInfo(750, 3, 3, 20, 1200, 100);
+  const SlabInfo info = DefaultSlabInfo(3, 3, 20, 100);
   const double plane_z = 1000, extent = 1400, occ_z = 500,
                occ_half = 103;  // shadow edges pass near pixel centres
   Mesh mesh = MakeReceiverPlane(plane_z, 2 * extent);
@@ -48,12 +48,12 @@ TEST(PreviewRenderer, MatchesCpuEvaluationWithShadows) {
   Renderer renderer(info, pixels, pixels, options);
   renderer.SetScene(mesh);
   renderer.SetCamera(PlaneView(plane_z, extent));
-  const auto emitters = DefaultPointEmitters();
+  const Luminaire luminaire = DefaultScene().luminaire;
   std::vector<ImageF> intensity;
   for (int j = 0; j < 3; ++j) {
     for (int i = 0; i < 3; ++i) {
       intensity.push_back(
-          IntensityFromIrradiance(info, i, j, TruthPosition(emitters, info, i, j).irradiance));
+          IntensityFromIrradiance(info, i, j, TruthPosition(luminaire, info, i, j).irradiance));
       renderer.SetPosition(i, j, intensity.back());
     }
   }
@@ -113,8 +113,8 @@ class PreviewSlabFiles : public ::testing::Test {
     dir_ = std::filesystem::temp_directory_path() /
            ("lumislab_preview_test_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir_);
-    info_ = MakeSlabInfo(750, 5, 5, 5, 1200, 60);
-    WriteTruthSlab(DefaultPointEmitters(), info_, dir_.string());
+    info_ = DefaultSlabInfo(5, 5, 5, 60);
+    WriteTruthSlab(DefaultScene().luminaire, info_, dir_.string(), 2);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 

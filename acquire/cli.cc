@@ -10,6 +10,7 @@
 #include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/stop_signal.h"
 
 namespace lumislab {
 namespace {
@@ -87,10 +88,15 @@ int RunSynthCommand(SynthOptions synth, int threads) {
          << " force=" << (synth.force ? "yes" : "no") << " photo_format=" << synth.photo_format
          << " threads=" << synth.threads;
   LogInfo("parameters: ", params.str());
+  const StopSignalScope stop_signals;  // Ctrl-C: finish the photos in hand, then stop
   const SynthReport r = RunSynth(synth);
   if (!r.skipped)
     LogInfo("wrote ", r.photos_written, " photos, radiometric scale ", r.radiometric_scale,
             " W/m^2 per unit");
+  if (StopRequested()) {
+    LogWarning("interrupted: the dataset is partial; run the same command again to redo it");
+    return 1;
+  }
   std::printf("dataset: %s\n", synth.out_dir.c_str());
   return 0;
 }

@@ -1,5 +1,7 @@
 #include "acquire/synth.h"
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <thread>
@@ -11,6 +13,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/slab.h"
+#include "core/stop_signal.h"
 #include "lib/photo/photo_io.h"
 #include "lib/synthetic/render.h"
 #include "lib/synthetic/truth.h"
@@ -75,18 +78,32 @@ ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale,
 
 namespace {
 
+// Sleeps `seconds` in short slices so that a stop signal ends the pause at once; false when
+// stopped.
+bool PauseUnlessStopped(double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!StopRequested()) {
+    const std::chrono::duration<double> left = end - std::chrono::steady_clock::now();
+    if (left.count() <= 0) return true;
+    std::this_thread::sleep_for(std::min(left, std::chrono::duration<double>(0.05)));
+  }
+  return false;
+}
+
 // Renders, applies the effects to and writes the photos of every position: in order with a
-// pause for a live acquisition, else on `threads` threads. Returns the number of photos.
+// pause for a live acquisition, else on `threads` threads. A stop signal ends it after the
+// positions in hand (each written whole). Returns the number of photos written.
 int CapturePositions(const SynthScene& scene, const Dataset& dataset, const SynthOptions& options,
                      PhotoEncoding encoding, int threads) {
   const ScreenView view = ScreenView::Of(scene);
   const double scale = *dataset.radiometric_scale;
   const int count = scene.grid.count();
   Progress progress("acquire", count);
+  std::atomic<int> written{0};
   auto capture = [&](int q) {
     const int i = q % scene.grid.nu, j = q / scene.grid.nu;
-    if (options.interval_s >= 0 && q > 0)
-      std::this_thread::sleep_for(std::chrono::duration<double>(options.interval_s));
+    if (options.interval_s >= 0 && q > 0 && !PauseUnlessStopped(options.interval_s)) return;
+    if (StopRequested()) return;
     ImageF plus, minus;
     RenderPosition(scene, view, i, j, scale, &plus, &minus);
     for (bool positive : {true, false}) {
@@ -94,12 +111,13 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const Synt
       const int index = PhotoIndex(scene, i, j, positive);
       ApplyEffects(scene, index, &photo);
       WritePhoto(options.out_dir + "/" + dataset.photos[index].file, photo, encoding);
+      ++written;
     }
     progress.Advance();
   };
   ParallelFor(count, options.interval_s >= 0 ? 1 : threads, capture);
   progress.Finish();
-  return int(dataset.photos.size());
+  return written;
 }
 
 }  // namespace

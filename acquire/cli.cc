@@ -36,7 +36,7 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
       ->capture_default_str();
   cmd->add_option("--photo-format", o.photo_format,
                   "photos of a scene without a quantization effect: half (half-float EXR, "
-                  "PIZ, lossless for half: ~1 MB a photo) or float (32-bit float EXR)")
+                  "RLE, lossless for half: ~1 MB a photo) or float (32-bit float EXR)")
       ->check(CLI::IsMember({"half", "float"}))
       ->capture_default_str();
   cmd->add_flag("--compress", o.compress_float,

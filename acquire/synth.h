@@ -18,7 +18,7 @@ struct SynthOptions {
   int threads = 0;         // 0: all cores
   int truth_resolution = 300;
   // Photos of a scene without a quantization effect (which makes them 16-bit PNG): "half"
-  // (half-float EXR, PIZ: lossless for half, ~1 MB a photo) or "float" (32-bit float EXR).
+  // (half-float EXR, RLE: lossless for half, ~1 MB a photo) or "float" (32-bit float EXR).
   std::string photo_format = "half";
   bool compress_float = false;  // "float" photos PIZ-compressed (smaller, slower)
 

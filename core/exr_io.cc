@@ -24,28 +24,25 @@ void WriteExr(const std::string& path, const ImageF& image,
   WriteAtomically(path, [&](const std::string& tmp) {
     try {
       Imf::Header header(image.width, image.height);
-      header.compression() = options.compress ? Imf::PIZ_COMPRESSION : Imf::NO_COMPRESSION;
+      header.compression() = options.compression == ExrCompression::kPiz   ? Imf::PIZ_COMPRESSION
+                             : options.compression == ExrCompression::kRle ? Imf::RLE_COMPRESSION
+                                                                           : Imf::NO_COMPRESSION;
       const Imf::PixelType type = options.half ? Imf::HALF : Imf::FLOAT;
       for (const auto& name : channel_names) header.channels().insert(name, Imf::Channel(type));
       for (const auto& [k, v] : attributes.strings) header.insert(k, Imf::StringAttribute(v));
       for (const auto& [k, v] : attributes.doubles) header.insert(k, Imf::DoubleAttribute(v));
       for (const auto& [k, v] : attributes.ints) header.insert(k, Imf::IntAttribute(v));
-      // Half channels need half data: convert through a per-channel buffer.
-      std::vector<std::vector<half>> halves;
+      // Half channels need half data: one interleaved copy, converted in one pass.
+      std::vector<half> halves(options.half ? image.data.size() : 0);
+      for (size_t k = 0; k < halves.size(); ++k) halves[k] = half(image.data[k]);
       Imf::FrameBuffer fb;
-      const size_t xs = sizeof(float) * image.channels;
-      for (int c = 0; c < image.channels; ++c) {
-        if (options.half) {
-          halves.emplace_back(size_t(image.width) * image.height);
-          auto& h = halves.back();
-          for (size_t p = 0; p < h.size(); ++p) h[p] = half(image.data[p * image.channels + c]);
-          fb.insert(channel_names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(h.data()),
-                                                 sizeof(half), sizeof(half) * image.width));
-        } else {
-          char* base = reinterpret_cast<char*>(const_cast<float*>(image.data.data()) + c);
-          fb.insert(channel_names[c], Imf::Slice(Imf::FLOAT, base, xs, xs * image.width));
-        }
-      }
+      const size_t size = options.half ? sizeof(half) : sizeof(float);
+      const size_t xs = size * image.channels;
+      char* base = options.half ? reinterpret_cast<char*>(halves.data())
+                                : reinterpret_cast<char*>(const_cast<float*>(image.data.data()));
+      for (int c = 0; c < image.channels; ++c)
+        fb.insert(channel_names[c], Imf::Slice(options.half ? Imf::HALF : Imf::FLOAT,
+                                               base + c * size, xs, xs * image.width));
       Imf::OutputFile file(tmp.c_str(), header);
       file.setFrameBuffer(fb);
       file.writePixels(image.height);

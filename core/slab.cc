@@ -103,7 +103,7 @@ void WriteSlabPosition(const std::string& slab_dir, const SlabInfo& info, const 
   attr.strings["lumislab.units"] = info.units;
   attr.strings["lumislab.quantity"] = "E_ij: irradiance on M through filter (i,j), luminaire frame";
   ExrOptions options;
-  options.compress = false;  // PIZ/ZIP on noisy float data costs time for little gain
+  options.compression = ExrCompression::kNone;  // PIZ/ZIP on noisy float data: slow, little gain
   WriteExr(SlabPositionPath(slab_dir, p.i, p.j), out, {"R", "G", "B", "mask"}, attr, options);
 }
 

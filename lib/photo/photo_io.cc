@@ -231,7 +231,9 @@ void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding enc
       encoding == PhotoEncoding::kFloatExrPiz) {
     ExrOptions options;
     options.half = encoding == PhotoEncoding::kHalfExr;
-    options.compress = encoding != PhotoEncoding::kFloatExr;
+    options.compression = encoding == PhotoEncoding::kHalfExr       ? ExrCompression::kRle
+                          : encoding == PhotoEncoding::kFloatExrPiz ? ExrCompression::kPiz
+                                                                    : ExrCompression::kNone;
     const std::vector<std::string> names = linear.channels == 3
                                                ? std::vector<std::string>{"R", "G", "B"}
                                                : std::vector<std::string>{"Y"};

@@ -90,7 +90,7 @@ void WriteImageFile(const std::string& path, const cv::Mat& image);
 enum class PhotoEncoding {
   kLinear16Png,  // round(v * 65535), clipped: a 16-bit camera (values already quantised)
   kSrgb8Png,     // through the sRGB curve, 8 bit: a camera's PNG/JPEG-like output
-  kHalfExr,      // half-float EXR, PIZ (lossless for half; ~3e-4 relative precision)
+  kHalfExr,      // half-float EXR, RLE (lossless for half; ~5e-4 relative precision)
   kFloatExr,     // 32-bit float EXR, uncompressed
   kFloatExrPiz,  // 32-bit float EXR, PIZ
 };

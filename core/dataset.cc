@@ -34,7 +34,7 @@ SamplingGrid ParseGrid(const JsonView& grid) {
   SamplingGrid g;
   g.nu = grid["nu"].IntIn(1, kMaxGridSide);
   g.nv = grid["nv"].IntIn(1, kMaxGridSide);
-  g.spacing_mm = grid["spacing_mm"].Positive();
+  g.spacing_mm = grid["spacing_mm"].NumberIn(kMinSpacingMm, kMaxSpacingMm);
   return g;
 }
 
@@ -44,8 +44,15 @@ nlohmann::json GridJson(const SamplingGrid& grid) {
 
 Eigen::Vector2d ParseLengthPair(const JsonView& value) {
   const std::vector<double> v = value.Numbers(2);
-  if (!(v[0] > 0) || !(v[1] > 0)) value.Fail("two lengths > 0 (width, height in mm)");
+  for (double x : v)
+    if (!(x >= kMinScreenMm && x <= kMaxScreenMm))
+      value.Fail("two lengths in [" + std::to_string(int(kMinScreenMm)) +
+                 ", 1e5] mm (width, height)");
   return {v[0], v[1]};
+}
+
+double ParseDistance(const JsonView& value) {
+  return value.NumberIn(kMinDistanceMm, kMaxDistanceMm);
 }
 
 int ParseFilterTruncation(const JsonView& k_max) {
@@ -63,7 +70,7 @@ FilterInfo FilterInfo::Of(const DualFilter& filter, double spacing_mm) {
 FilterInfo ParseFilterInfo(const JsonView& filter, const SamplingGrid& grid) {
   FilterInfo f;
   f.basis = filter["basis"].OneOf({"bell"});
-  f.spacing_mm = filter["spacing_mm"].Positive();
+  f.spacing_mm = filter["spacing_mm"].NumberIn(kMinSpacingMm, kMaxSpacingMm);
   if (std::abs(f.spacing_mm - grid.spacing_mm) > 1e-9 * grid.spacing_mm)
     filter["spacing_mm"].Fail("the grid spacing (" + std::to_string(grid.spacing_mm) + " mm)");
   f.dual_coefficients = filter["dual_coefficients"].Numbers();
@@ -112,7 +119,7 @@ Dataset Dataset::Load(const std::string& dir) {
   ds.synthetic = root.BoolOr("synthetic", false);
 
   const JsonView setup = root["setup"];
-  ds.distance_mm = setup["distance_mm"].Positive();
+  ds.distance_mm = ParseDistance(setup["distance_mm"]);
   ds.grid = ParseGrid(setup["grid"]);
   const Eigen::Vector2d screen = ParseLengthPair(setup["screen_mm"]);
   ds.screen_w_mm = screen.x();
@@ -120,9 +127,10 @@ Dataset Dataset::Load(const std::string& dir) {
   ds.filter = ParseFilterInfo(root["filter"], ds.grid);
 
   const JsonView radiometry = root["radiometry"];
-  if (radiometry.Has("scale_w_m2")) ds.radiometric_scale = radiometry["scale_w_m2"].Positive();
+  if (radiometry.Has("scale_w_m2"))
+    ds.radiometric_scale = radiometry["scale_w_m2"].NumberIn(1e-12, 1e12);
   ds.saturation_level =
-      radiometry.Has("saturation_level") ? radiometry["saturation_level"].Positive() : 1.0;
+      radiometry.Has("saturation_level") ? radiometry["saturation_level"].NumberIn(1e-6, 1e6) : 1.0;
   ds.photo_transfer = radiometry.Has("transfer")
                           ? radiometry["transfer"].OneOf({"auto", "linear", "srgb"})
                           : "auto";
@@ -137,8 +145,10 @@ Dataset Dataset::Load(const std::string& dir) {
   target["type"].OneOf({"checkerboard"});
   ds.calibration.squares_x = target["squares"][0].IntIn(kMinBoardSquares, kMaxBoardSquares);
   ds.calibration.squares_y = target["squares"][1].IntIn(kMinBoardSquares, kMaxBoardSquares);
-  ds.calibration.square_mm = target["square_mm"].Positive();
+  ds.calibration.square_mm = target["square_mm"].NumberIn(kMinSpacingMm, kMaxScreenMm);
   const std::vector<double> origin = target["origin_mm"].Numbers(2);
+  for (double v : origin)
+    if (std::abs(v) > kMaxCoordinateMm) target["origin_mm"].Fail("coordinates within 1e6 mm");
   ds.calibration.origin_mm = {origin[0], origin[1]};
   ds.calibration.Check(file, "calibration.target");
 
@@ -152,7 +162,7 @@ Dataset Dataset::Load(const std::string& dir) {
     e.positive = p["slide"].OneOf({"p", "n"}) == "p";
     e.file = p["file"].String();
     if (!IsRelativeInside(e.file)) p["file"].Fail("a path relative to the dataset folder");
-    e.exposure = p.Has("exposure") ? p["exposure"].Positive() : 1.0;
+    e.exposure = p.Has("exposure") ? p["exposure"].NumberIn(1e-9, 1e9) : 1.0;
     slides.insert({e.i, e.j, e.positive});
     ds.photos.push_back(e);
   }

@@ -49,15 +49,22 @@ struct CalibrationTarget {
   void Check(const std::string& file, const std::string& field) const;
 };
 
-// Limits shared by every file that holds a grid.
-constexpr int kMaxGridSide = 1000;  // positions per axis
+// Limits shared by every file that holds a grid. Lengths outside physically meaningful ranges
+// are refused, not computed with (a distance of 1e-9 mm or 1e12 mm is a typo, not a setup).
+constexpr int kMaxGridSide = 1000;                           // positions per axis
+constexpr double kMinDistanceMm = 1, kMaxDistanceMm = 1e5;   // d, S to M
+constexpr double kMinSpacingMm = 0.01, kMaxSpacingMm = 1e3;  // h
+constexpr double kMinScreenMm = 1, kMaxScreenMm = 1e5;       // screen / slab window sides
+constexpr double kMaxCoordinateMm = 1e6;                     // any position in the lab
 constexpr int kMinBoardSquares = 3, kMaxBoardSquares = 200;
 
 // {"nu": int, "nv": int, "spacing_mm": > 0}.
 SamplingGrid ParseGrid(const JsonView& grid);
 nlohmann::json GridJson(const SamplingGrid& grid);
-// [a, b], both > 0 and finite (screen or window size in mm).
+// [w, h] in [kMinScreenMm, kMaxScreenMm] (screen or window size in mm).
 Eigen::Vector2d ParseLengthPair(const JsonView& value);
+// d in [kMinDistanceMm, kMaxDistanceMm].
+double ParseDistance(const JsonView& value);
 // The truncation K of a filter (scene files, the printer's --k-max).
 int ParseFilterTruncation(const JsonView& k_max);
 

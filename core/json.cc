@@ -1,5 +1,6 @@
 #include "core/json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -9,11 +10,43 @@
 
 namespace lumislab {
 namespace {
+// What a value is, for messages: scalars and small flat containers as written, anything else by
+// size (dumping a nested container would recurse through whatever a hostile file holds).
 std::string Got(const nlohmann::json* value) {
   if (value == nullptr) return "nothing (missing)";
+  if (value->is_structured()) {
+    bool flat = value->size() <= 8;
+    for (const auto& element : *value) flat = flat && element.is_primitive();
+    if (!flat)
+      return (value->is_object() ? "an object of " : "an array of ") +
+             std::to_string(value->size()) + " value(s)";
+  }
   std::string text = value->dump();
   if (text.size() > 60) text = text.substr(0, 57) + "...";
   return text;
+}
+
+// Deepest nesting of arrays and objects in `text` (strings skipped), stopping once past `limit`.
+int NestingDepth(const std::string& text, int limit) {
+  int depth = 0, deepest = 0;
+  bool in_string = false;
+  for (size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (in_string) {
+      if (c == '\\')
+        ++k;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > limit) break;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
 }
 std::string FormatNumber(double v) {
   std::ostringstream os;
@@ -64,8 +97,10 @@ double JsonView::Number() const {
 }
 
 double JsonView::NumberIn(double lo, double hi) const {
-  const double v = Number();
-  if (v < lo || v > hi) Fail("number in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+  const std::string expected = "number in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]";
+  if (value_ == nullptr || !value_->is_number()) Fail(expected);
+  const double v = value_->get<double>();
+  if (!std::isfinite(v) || v < lo || v > hi) Fail(expected);
   return v;
 }
 
@@ -146,18 +181,37 @@ void JsonView::Fail(const std::string& expected) const {
 
 JsonDocument JsonDocument::Load(const std::string& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw BadInput(path + ": file not found (or not a regular file)");
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw BadInput(path + ": file not found");
+  if (!std::filesystem::is_regular_file(status))
+    throw BadInput(path + ": not a regular file (a folder, FIFO or device is not a JSON file)");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxJsonBytes)
+    throw InputError(path, "", "a JSON file of at most " + std::to_string(kMaxJsonBytes) + " bytes",
+                     std::to_string(size) + " bytes");
   return Parse(ReadTextFile(path), path);
 }
 
 JsonDocument JsonDocument::Parse(const std::string& text, const std::string& name) {
+  if (text.size() > kMaxJsonBytes)
+    throw InputError(name, "", "a JSON text of at most " + std::to_string(kMaxJsonBytes) + " bytes",
+                     std::to_string(text.size()) + " bytes");
+  if (NestingDepth(text, kMaxJsonDepth) > kMaxJsonDepth)
+    throw InputError(name, "",
+                     "arrays and objects nested at most " + std::to_string(kMaxJsonDepth) + " deep",
+                     "deeper nesting");
   JsonDocument doc;
   doc.file_ = std::make_shared<const std::string>(name);
   try {
     doc.json_ = std::make_shared<nlohmann::json>(nlohmann::json::parse(text));
   } catch (const nlohmann::json::parse_error& e) {
-    throw BadInput(name + ": not valid JSON: " + e.what());
+    // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ...":
+    // keep the part a person reads.
+    std::string what = e.what();
+    const size_t at = what.find("] ");
+    if (what.rfind("[json.exception", 0) == 0 && at != std::string::npos)
+      what = what.substr(at + 2);
+    throw BadInput(name + ": not valid JSON: " + what);
   }
   return doc;
 }

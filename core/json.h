@@ -51,9 +51,15 @@ class JsonView {
   std::string path_;
 };
 
+// Every JSON input is refused (bad input naming the file) past these limits, before it is parsed:
+// lumislab's files are a few KB and a few levels deep.
+constexpr size_t kMaxJsonBytes = 16 << 20;
+constexpr int kMaxJsonDepth = 64;
+
 class JsonDocument {
  public:
-  // Missing file: IoError? No: a missing input file is bad input (exit 2) naming the file.
+  // A missing file, a folder, FIFO or device, too large or too deep: bad input (exit 2) naming
+  // the file. Not valid JSON: bad input with the line and column.
   static JsonDocument Load(const std::string& path);
   static JsonDocument Parse(const std::string& text, const std::string& name);
   JsonView root() const { return JsonView(json_.get(), file_, ""); }

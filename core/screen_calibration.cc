@@ -59,11 +59,12 @@ ScreenCalibration ScreenCalibration::Load(const std::string& path) {
     root["screen_from_image"].Fail("an invertible 3x3 homography");
   const JsonView dist = root["distortion"];
   dist["model"].OneOf({"radial2"});
-  c.k1 = dist["k1"].Number();
-  c.k2 = dist["k2"].Number();
+  // |k| beyond 10 over a radius of one half-diagonal is no lens: a corrupt file.
+  c.k1 = dist["k1"].NumberIn(-10, 10);
+  c.k2 = dist["k2"].NumberIn(-10, 10);
   const std::vector<double> centre = dist["centre_px"].Numbers(2);
   c.centre_px = {centre[0], centre[1]};
-  c.scale_px = dist["scale_px"].Positive();
+  c.scale_px = dist["scale_px"].NumberIn(1, 1e6);
   const JsonView report = root["report"];
   c.rms_px = report["rms_px"].NumberIn(0, 1e9);
   c.rms_mm = report["rms_mm"].NumberIn(0, 1e9);

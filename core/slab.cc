@@ -37,7 +37,7 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
   doc.CheckSchemaVersion(kSlabSchemaVersion);
   const JsonView root = doc.root();
   SlabInfo info;
-  info.distance_mm = root["distance_mm"].Positive();
+  info.distance_mm = ParseDistance(root["distance_mm"]);
   info.grid = ParseGrid(root["grid"]);
   const Eigen::Vector2d window = ParseLengthPair(root["window_mm"]);
   info.layout.window_w_mm = window.x();

@@ -26,7 +26,7 @@ void CheckKeys(const JsonView& spec, const std::vector<std::string>& allowed) {
 
 std::shared_ptr<const Effect> MakeSensorNoise(const JsonView& spec) {
   CheckKeys(spec, {"full_well_e", "read_noise_e", "seed"});
-  const double full_well = spec.Has("full_well_e") ? spec["full_well_e"].Positive() : 20000;
+  const double full_well = spec.Has("full_well_e") ? spec["full_well_e"].NumberIn(1, 1e9) : 20000;
   const double read_noise = spec.Has("read_noise_e") ? spec["read_noise_e"].NumberIn(0, 1e9) : 3.0;
   const int seed = spec.Has("seed") ? spec["seed"].IntAtLeast(0) : 0;
   return std::make_shared<SensorNoiseEffect>(full_well, read_noise, seed);

@@ -23,21 +23,17 @@ const char* kDefaultSceneJson = R"({
 }
 )";
 
-double NonNegative(const JsonView& v) {
-  if (!v.raw().is_number() || !std::isfinite(v.raw().get<double>()) ||
-      !(v.raw().get<double>() >= 0))
-    v.Fail("number >= 0");
-  return v.raw().get<double>();
-}
-
+// A point of the lab or luminaire frame, mm: three finite numbers within kMaxCoordinateMm.
 Eigen::Vector3d Vec3(const JsonView& v) {
   const std::vector<double> a = v.Numbers(3);
+  for (double x : a)
+    if (std::abs(x) > kMaxCoordinateMm) v.Fail("three coordinates within 1e6 mm");
   return {a[0], a[1], a[2]};
 }
 
 void ParseSetup(const JsonView& root, SynthScene* scene) {
   const JsonView setup = root["setup"];
-  scene->distance_mm = setup["distance_mm"].Positive();
+  scene->distance_mm = ParseDistance(setup["distance_mm"]);
   scene->grid = ParseGrid(setup["grid"]);
   const Eigen::Vector2d screen = ParseLengthPair(setup["screen_mm"]);
   scene->screen_w_mm = screen.x();
@@ -56,9 +52,9 @@ void ParseLuminaire(const JsonView& root, SynthScene* scene) {
     if (!(emitter.position_mm.z() < 0))
       e["position_mm"].Fail("a point behind the filter plane S (z < 0 mm)");
     const JsonView intensity = e["intensity_w_sr"];
-    emitter.intensity_w_sr = Vec3(intensity);
-    for (size_t c = 0; c < 3; ++c) NonNegative(intensity[c]);
-    emitter.lobe_exponent = NonNegative(e["lobe_exponent"]);
+    for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
+    if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr");
+    emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
     scene->luminaire.emitters.push_back(emitter);
   }
 }
@@ -69,7 +65,7 @@ void ParseCamera(const JsonView& root, SynthScene* scene) {
   c.width = cam["size_px"][0].IntIn(16, 20000);
   c.height = cam["size_px"][1].IntIn(16, 20000);
   if (cam["size_px"].Size() != 2) cam["size_px"].Fail("[width, height] in pixels");
-  c.focal_px = cam["focal_px"].Positive();
+  c.focal_px = cam["focal_px"].NumberIn(1, 1e7);
   c.position_mm = Vec3(cam["position_mm"]);
   c.look_at_mm = Vec3(cam["look_at_mm"]);
   if ((c.look_at_mm - c.position_mm).norm() < 1e-6)
@@ -77,9 +73,9 @@ void ParseCamera(const JsonView& root, SynthScene* scene) {
   if (std::abs(c.position_mm.z() - scene->distance_mm) < 1e-6)
     cam["position_mm"].Fail(
         "a point off the screen plane z = " + std::to_string(scene->distance_mm) + " mm");
-  c.exposure = cam.Has("exposure") ? cam["exposure"].Positive() : 1.0;
+  c.exposure = cam.Has("exposure") ? cam["exposure"].NumberIn(1e-6, 1e6) : 1.0;
   c.radiometric_scale_w_m2 =
-      cam.Has("radiometric_scale_w_m2") ? cam["radiometric_scale_w_m2"].Positive() : 0.0;
+      cam.Has("radiometric_scale_w_m2") ? cam["radiometric_scale_w_m2"].NumberIn(1e-12, 1e12) : 0.0;
 }
 
 // A checkerboard centred on the screen: 14 x 13 squares of 80 mm (smaller on small screens),
@@ -120,7 +116,7 @@ void ParseCalibration(const JsonView& root, SynthScene* scene) {
       t.squares_x = c["squares"][0].IntIn(3, 200);
       t.squares_y = c["squares"][1].IntIn(3, 200);
     }
-    if (c.Has("square_mm")) t.square_mm = c["square_mm"].Positive();
+    if (c.Has("square_mm")) t.square_mm = c["square_mm"].NumberIn(kMinSpacingMm, kMaxScreenMm);
     if (t.squares_x * t.square_mm > scene->screen_w_mm ||
         t.squares_y * t.square_mm > scene->screen_h_mm)
       c.Fail("a checkerboard that fits on the screen");
@@ -138,7 +134,10 @@ bool SynthScene::Quantized() const {
 }
 
 SynthScene ParseScene(const std::string& json_text, const std::string& name) {
-  const JsonDocument doc = JsonDocument::Parse(json_text, name);
+  return ParseScene(JsonDocument::Parse(json_text, name), name);
+}
+
+SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   doc.CheckSchemaVersion(kSceneSchemaVersion);
   const JsonView root = doc.root();
   SynthScene scene;
@@ -156,8 +155,7 @@ SynthScene ParseScene(const std::string& json_text, const std::string& name) {
 
 SynthScene LoadScene(const std::string& path_or_default) {
   if (path_or_default == "default") return DefaultScene();
-  const JsonDocument doc = JsonDocument::Load(path_or_default);  // bad input if missing
-  return ParseScene(doc.raw().dump(), path_or_default);
+  return ParseScene(JsonDocument::Load(path_or_default), path_or_default);
 }
 
 SynthScene DefaultScene() {

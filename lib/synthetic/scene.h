@@ -39,6 +39,7 @@ struct SynthScene {
 // "default" or a scene file; errors name the file and the field (exit 2).
 SynthScene LoadScene(const std::string& path_or_default);
 SynthScene ParseScene(const std::string& json_text, const std::string& name);
+SynthScene ParseScene(const JsonDocument& doc, const std::string& name);
 SynthScene DefaultScene();
 std::string DefaultSceneJson();  // the built-in scene as a scene file
 

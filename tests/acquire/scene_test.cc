@@ -48,9 +48,10 @@ TEST(SceneFile, DefaultSceneIsValid) {
 
 TEST(SceneFile, BadFieldsNameFileAndField) {
   EXPECT_EQ(ParseError("\"lobe_exponent\": 8", "\"lobe_exponent\": \"x\""),
-            "scene.json: luminaire.emitters[0].lobe_exponent: expected number >= 0, got \"x\"");
+            "scene.json: luminaire.emitters[0].lobe_exponent: expected number in [0, 1e+06], got "
+            "\"x\"");
   EXPECT_NE(ParseError("\"lobe_exponent\": 3", "\"lobe_exponent\": -1")
-                .find("luminaire.emitters[1].lobe_exponent: expected number >= 0, got -1"),
+                .find("luminaire.emitters[1].lobe_exponent: expected number in [0, 1e+06], got -1"),
             std::string::npos);
   EXPECT_NE(ParseError("\"nu\": 9", "\"nu\": -3").find("scene.json: setup.grid.nu"),
             std::string::npos);

@@ -1,6 +1,10 @@
 #include "core/json.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 #include "core/error.h"
 
@@ -69,6 +73,42 @@ TEST(JsonTest, SchemaVersionIsChecked) {
             }).find("newer"),
             std::string::npos);
   EXPECT_NO_THROW(JsonDocument::Parse(R"({"schema_version": 1})", "s.json").CheckSchemaVersion(1));
+}
+
+// Hostile files are refused before parsing: deep nesting (nlohmann recurses while parsing and
+// destroying), huge texts, and paths that are no regular file (a FIFO would block the read).
+TEST(JsonTest, RefusesDeepLargeAndNonRegularInputs) {
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_NE(MessageOf([&] {
+              JsonDocument::Parse(deep, "deep.json");
+            }).find("deep.json: expected arrays and objects nested at most 64 deep"),
+            std::string::npos);
+  // In a string, brackets do not nest.
+  EXPECT_NO_THROW(JsonDocument::Parse("{\"s\": \"" + std::string(1000, '[') + "\"}", "s.json"));
+  EXPECT_NE(MessageOf([] {
+              JsonDocument::Parse(std::string(kMaxJsonBytes + 1, ' '), "big.json");
+            }).find("big.json: expected a JSON text of at most"),
+            std::string::npos);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("lumislab_json_test_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir / "folder.json");
+  const std::string fifo = (dir / "fifo.json").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(MessageOf([&] { JsonDocument::Load(fifo); }).find("not a regular file"),
+            std::string::npos);
+  EXPECT_NE(MessageOf([&] {
+              JsonDocument::Load((dir / "folder.json").string());
+            }).find("not a regular file"),
+            std::string::npos);
+  EXPECT_NE(MessageOf([&] {
+              JsonDocument::Load((dir / "missing.json").string());
+            }).find("missing.json: file not found"),
+            std::string::npos);
+  EXPECT_NE(MessageOf([] {
+              JsonDocument::Parse("{\"a\": x}", "bad.json");
+            }).find("bad.json: not valid JSON: parse error at line 1, column 7"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -164,6 +164,10 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
           scene.effects.size(), " effect(s)");
   MakeDirectories(out + "/photos");
   MakeDirectories(out + "/truth");
+  int orphans = 0;
+  for (const std::string& dir : {out, out + "/photos", out + "/truth"})
+    orphans += RemoveOrphanedTemporaries(dir);
+  if (orphans > 0) LogInfo(out, ": removed ", orphans, " temporary file(s) of an interrupted run");
 
   // dataset.json and the calibration photo come first: a live reader can start at once.
   dataset.Save(out);

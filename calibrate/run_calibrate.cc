@@ -37,6 +37,7 @@ int RunScreen(const ScreenCommand& command, int threads) {
   ScreenCalibrationReport report;
   const ScreenCalibration c = CalibrateScreen(dataset, command.options, &report);
   MakeDirectories(dataset.Path("calib"));
+  RemoveOrphanedTemporaries(dataset.Path("calib"));
   c.Save(out);
   LogInfo("board: ", c.corners_used, " corners (", report.corners.detector, " detector, grid ",
           report.corners.orientation, ", squares ", report.corners.square_px, " px, dot contrast ",

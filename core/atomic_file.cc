@@ -1,11 +1,14 @@
 #include "core/atomic_file.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "core/error.h"
@@ -16,10 +19,31 @@ namespace lumislab {
 
 std::string TemporaryPathFor(const std::string& final_path) {
   static std::atomic<int> counter{0};
+  constexpr size_t kMaxName = 255;  // NAME_MAX of every file system lumislab runs on
   const fs::path p(final_path);
-  const std::string name = "." + p.stem().string() + ".tmp" + std::to_string(getpid()) + "_" +
-                           std::to_string(counter++) + p.extension().string();
-  return (p.parent_path() / name).string();
+  const std::string tag = ".tmp" + std::to_string(getpid()) + "_" + std::to_string(counter++);
+  std::string stem = p.stem().string();
+  const std::string ext = p.extension().string();
+  const size_t room =
+      kMaxName > 1 + tag.size() + ext.size() ? kMaxName - 1 - tag.size() - ext.size() : 0;
+  if (stem.size() > room) stem.resize(room);
+  return (p.parent_path() / ("." + stem + tag + ext)).string();
+}
+
+int RemoveOrphanedTemporaries(const std::string& dir) {
+  static const std::regex kTemporary(R"(^\..*\.tmp([0-9]+)_[0-9]+(\.[^.]*)?$)");
+  int removed = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::smatch m;
+    if (!std::regex_match(name, m, kTemporary) || m[1].length() > 9) continue;
+    const long pid = std::stol(m[1].str());
+    if (pid == getpid() || kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // still running
+    std::error_code remove_ec;
+    if (fs::remove(it->path(), remove_ec)) ++removed;
+  }
+  return removed;
 }
 
 void WriteAtomically(const std::string& final_path,

@@ -9,6 +9,7 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "core/atomic_file.h"
@@ -21,6 +22,9 @@ void WriteExr(const std::string& path, const ImageF& image,
               const ExrOptions& options) {
   if (int(channel_names.size()) != image.channels || image.empty())
     throw Failure(path + ": WriteExr: channel names do not match the image");
+  // A non-finite value never reaches a file.
+  for (float v : image.data)
+    if (!std::isfinite(v)) throw Failure(path + ": refusing to write a NaN or infinite value");
   WriteAtomically(path, [&](const std::string& tmp) {
     try {
       Imf::Header header(image.width, image.height);
@@ -63,8 +67,10 @@ ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_
     const Imf::Header& header = file.header();
     const Imath::Box2i dw = header.dataWindow();
     const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
-    if (width <= 0 || height <= 0 || width > 1 << 15 || height > 1 << 15)
-      throw InputError(path, "dataWindow", "a sane image size",
+    if (width <= 0 || height <= 0 || width > 1 << 15 || height > 1 << 15 ||
+        (long long)width * height > kMaxExrPixels)
+      throw InputError(path, "dataWindow",
+                       "an image of at most " + std::to_string(kMaxExrPixels) + " pixels",
                        std::to_string(width) + "x" + std::to_string(height));
     ImageF image(width, height, int(channel_names.size()));
     Imf::FrameBuffer fb;
@@ -95,6 +101,26 @@ ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_
     throw;
   } catch (const std::exception& e) {
     throw BadInput(path + ": not a readable EXR file: " + e.what());
+  }
+}
+
+bool ExrComplete(const std::string& path, int width, int height) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    if (dw.max.x - dw.min.x + 1 != width || dw.max.y - dw.min.y + 1 != height ||
+        !file.isComplete())
+      return false;
+    // isComplete() only checks the offset table: read the last block's bytes too, which a
+    // truncated file does not hold.
+    const char* data = nullptr;
+    int size = 0;
+    file.rawPixelData(dw.max.y, data, size);
+    return size > 0;
+  } catch (const std::exception&) {
+    return false;
   }
 }
 

@@ -38,4 +38,10 @@ ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_
                ExrAttributes* attributes = nullptr);
 std::vector<std::string> ExrChannelNames(const std::string& path);
 
+// Largest image ReadExr allocates (pixels): a header may claim any size, the file need not hold it.
+constexpr long long kMaxExrPixels = 1LL << 26;  // 8192 x 8192
+// True when `path` is a complete EXR file (every line block present) of width x height pixels:
+// what a resumed run checks before it trusts a file it skips.
+bool ExrComplete(const std::string& path, int width, int height);
+
 }  // namespace lumislab

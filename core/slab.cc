@@ -80,13 +80,7 @@ void WriteSlabPosition(const std::string& slab_dir, const SlabInfo& info, const 
     throw Failure("WriteSlabPosition: image size does not match the slab layout");
   ImageF out(w, h, 4);
   for (size_t k = 0; k < size_t(w) * h; ++k) {
-    for (int c = 0; c < 3; ++c) {
-      const float v = p.irradiance.data[k * 3 + c];
-      if (!std::isfinite(v))
-        throw Failure(SlabPositionPath(slab_dir, p.i, p.j) +
-                      ": refusing to write a non-finite value");
-      out.data[k * 4 + c] = v;
-    }
+    for (int c = 0; c < 3; ++c) out.data[k * 4 + c] = p.irradiance.data[k * 3 + c];
     out.data[k * 4 + 3] = p.mask.data[k];
   }
   ExrAttributes attr;
@@ -138,12 +132,11 @@ SlabPosition ReadSlabPosition(const std::string& slab_dir, const SlabInfo& info,
 }
 
 std::vector<std::pair<int, int>> ScanSlabPositions(const std::string& slab_dir,
-                                                   const SamplingGrid& grid) {
+                                                   const SlabInfo& info) {
   std::vector<std::pair<int, int>> found;
-  std::error_code ec;
-  for (int j = 0; j < grid.nv; ++j)
-    for (int i = 0; i < grid.nu; ++i)
-      if (std::filesystem::is_regular_file(SlabPositionPath(slab_dir, i, j), ec))
+  for (int j = 0; j < info.grid.nv; ++j)
+    for (int i = 0; i < info.grid.nu; ++i)
+      if (ExrComplete(SlabPositionPath(slab_dir, i, j), info.layout.res_x, info.layout.res_y))
         found.emplace_back(i, j);
   std::sort(found.begin(), found.end());
   return found;

@@ -44,8 +44,10 @@ std::string SlabPositionPath(const std::string& slab_dir, int i, int j);
 void WriteSlabPosition(const std::string& slab_dir, const SlabInfo& info, const SlabPosition& p);
 // Reads and checks size/attributes against `info`.
 SlabPosition ReadSlabPosition(const std::string& slab_dir, const SlabInfo& info, int i, int j);
-// Positions whose EXR exists in the folder (for watchers that do not trust slab.json yet).
+// Positions whose EXR is in the folder, complete and of info's resolution (for watchers that do
+// not trust slab.json yet, and for resumed runs: a file of another resolution left by an
+// interrupted --force run, or a truncated one, is not counted).
 std::vector<std::pair<int, int>> ScanSlabPositions(const std::string& slab_dir,
-                                                   const SamplingGrid& grid);
+                                                   const SlabInfo& info);
 
 }  // namespace lumislab

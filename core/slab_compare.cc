@@ -15,7 +15,13 @@ std::string SlabComparison::Summary() const {
                 "overall %.3f %%",
                 positions.size(), 100 * max_relative_l2, 100 * median_relative_l2,
                 100 * overall_relative_l2);
-  return buf;
+  int unseen = 0, lit = 0;
+  for (const auto& p : positions) unseen += p.unseen_lit_texels, lit += p.lit_texels;
+  std::string summary = buf;
+  if (unseen > 0)
+    summary += "; " + std::to_string(unseen) + " of " + std::to_string(lit) +
+               " lit texels not seen (mask 0)";
+  return summary;
 }
 
 SlabComparison CompareSlabs(const std::string& slab_dir, const std::string& reference_dir,
@@ -57,7 +63,9 @@ SlabComparison CompareSlabs(const std::string& slab_dir, const std::string& refe
         e.max_abs = std::max(e.max_abs, std::abs(d));
       }
     }
-    e.relative_l2 = ref2 > 0 ? std::sqrt(err2 / ref2) : 0;
+    // Lit in the reference but nothing of it seen in the slab: nothing was recovered (100 %),
+    // not "no error".
+    e.relative_l2 = ref2 > 0 ? std::sqrt(err2 / ref2) : (e.lit_texels > 0 ? 1.0 : 0.0);
     total_err2 += err2;
     total_ref2 += ref2;
     out.positions.push_back(e);

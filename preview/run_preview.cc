@@ -124,7 +124,7 @@ std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config) {
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
                                                   Renderer& renderer, int threads) {
   std::vector<std::pair<int, int>> added;
-  for (const auto& [i, j] : ScanSlabPositions(slab_dir, info.grid)) {
+  for (const auto& [i, j] : ScanSlabPositions(slab_dir, info)) {
     if (!renderer.HasPosition(i, j)) added.emplace_back(i, j);
   }
   // E' of a batch on `threads` threads, then uploaded on this one (the GL context's); batches

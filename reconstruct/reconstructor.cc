@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -39,6 +40,22 @@ std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
   for (const auto& e : entries) photos.push_back(DecodeDatasetPhoto(dataset, e));
   CheckPhotoSizes(photos, calibration.image_width, calibration.image_height,
                   dataset.Path("calib/screen.json"));
+  // One camera writes one kind of photo: an 8-bit photo among 16-bit ones (or the other way)
+  // would be linearised differently and merged as if it were the same measurement.
+  for (const auto& p : photos)
+    if (p.photo.pixels.depth() != photos[0].photo.pixels.depth())
+      throw InputError(p.photo.path, "bit depth",
+                       std::to_string(photos[0].photo.pixels.elemSize1() * 8) + " bits like " +
+                           photos[0].photo.path,
+                       std::to_string(p.photo.pixels.elemSize1() * 8) + " bits");
+  if (photos[0].photo.transfer == Transfer::kSrgb && dataset.photo_transfer == "auto") {
+    static std::once_flag said;
+    std::call_once(said, [&] {
+      LogWarning("8-bit photos (", photos[0].photo.path,
+                 ", ...) are linearised through the sRGB curve; set radiometry.transfer in "
+                 "dataset.json if the camera wrote them otherwise");
+    });
+  }
   return photos;
 }
 
@@ -89,6 +106,12 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
     }
   }
   r.rectify_s = SecondsSince(t0);
+  if (r.seen_texels == 0)
+    throw InputError(dataset.Path("calib/screen.json"),
+                     "position " + std::to_string(i) + "," + std::to_string(j),
+                     "a view of the position's slab window",
+                     r.saturated_texels > 0 ? "only saturated texels (every photo clipped)"
+                                            : "no texel inside the photo and the screen");
   // 3. Deconvolution onto the bell basis.
   t0 = std::chrono::steady_clock::now();
   BellFitOptions fit_options;

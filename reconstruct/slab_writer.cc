@@ -19,8 +19,10 @@ SlabWriter::SlabWriter(const Dataset& dataset, int resolution, bool force)
                        std::to_string(old.layout.res_x) + "x" + std::to_string(old.layout.res_y));
   }
   MakeDirectories(dir_);
+  if (const int n = RemoveOrphanedTemporaries(dir_))
+    LogInfo(dir_, ": removed ", n, " temporary file(s) of an interrupted run");
   if (!force)
-    for (const auto& [i, j] : ScanSlabPositions(dir_, info_.grid)) info_.MarkPresent(i, j);
+    for (const auto& [i, j] : ScanSlabPositions(dir_, info_)) info_.MarkPresent(i, j);
   info_.Save(dir_);
 }
 

@@ -81,7 +81,7 @@ TEST(Live, WatchFollowsPositionsAsTheirPhotosArrive) {
     DeliverPhotos(photos, live, i, j);
     EXPECT_TRUE(WaitUntil([&] { return fs::exists(SlabPositionPath(slab, i, j)); }, 60))
         << "position " << i << "," << j << " never reached the slab";
-    EXPECT_EQ(ScanSlabPositions(slab, photos.grid).size(), size_t(q + 1));
+    EXPECT_EQ(ScanSlabPositions(slab, SlabInfo::Load(slab)).size(), size_t(q + 1));
   }
   watcher.join();  // the watcher ends by itself once the grid is complete (or times out)
   ASSERT_EQ(watch.exit_code, 0) << watch.output;

@@ -1,5 +1,8 @@
 // Round trips of the on-disk formats: EXR (pixels + attributes), slab, dataset.json,
 // calib/screen.json, and the atomic-write guarantee.
+#include <ImfChannelList.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -144,11 +147,57 @@ TEST_F(IoTest, SlabRoundTripAndPartialSlabs) {
   EXPECT_DOUBLE_EQ(attr.doubles["lumislab.centre_x_mm"], 5.0);
   EXPECT_DOUBLE_EQ(attr.doubles["lumislab.distance_mm"], 750.0);
   EXPECT_EQ(attr.ints["lumislab.j"], 1);
-  const auto scanned = ScanSlabPositions(dir_.string(), back.grid);
+  const auto scanned = ScanSlabPositions(dir_.string(), back);
   ASSERT_EQ(scanned.size(), 1u);  // (0,0) is listed but its file is not there yet
   EXPECT_EQ(scanned[0], std::make_pair(2, 1));
   // Reading under the wrong position or resolution is refused.
   EXPECT_THROW(ReadSlabPosition(dir_.string(), SlabInfo::FromDataset(ds, 9), 2, 1), Error);
+  // A resumed run at another resolution does not count the file as done...
+  EXPECT_TRUE(ScanSlabPositions(dir_.string(), SlabInfo::FromDataset(ds, 9)).empty());
+  // ...nor a truncated one (a run killed without atomic writes, a full disk).
+  const std::string path = SlabPositionPath(dir_.string(), 2, 1);
+  fs::resize_file(path, fs::file_size(path) - 40);
+  EXPECT_TRUE(ScanSlabPositions(dir_.string(), back).empty());
+}
+
+TEST_F(IoTest, ExrHeaderClaimingAHugeImageIsRefusedBeforeAllocating) {
+  // A few hundred bytes whose header says 32768 x 32768 (12 GB as float RGB).
+  const std::string path = (dir_ / "huge.exr").string();
+  {
+    Imf::Header header(32768, 32768);
+    header.channels().insert("R", Imf::Channel(Imf::HALF));
+    Imf::OutputFile file(path.c_str(), header);  // no pixels written: a header-only file
+  }
+  ASSERT_LT(fs::file_size(path), 1 << 20);
+  try {
+    ReadExr(path, {"R"});
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_NE(std::string(e.what()).find("huge.exr: dataWindow: expected an image of at most"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(ExrComplete(path, 32768, 32768));
+}
+
+TEST_F(IoTest, TemporaryNamesFitAndOrphansOfDeadProcessesAreRemoved) {
+  // A legal 254-byte name still gets a temporary name within the 255-byte limit.
+  const std::string name = std::string(250, 'a') + ".exr";
+  const std::string tmp = TemporaryPathFor((dir_ / name).string());
+  EXPECT_LE(fs::path(tmp).filename().string().size(), 255u);
+  EXPECT_TRUE(IsTemporaryName(tmp));
+  WriteTextAtomically((dir_ / name).string(), "x");
+  EXPECT_TRUE(fs::exists(dir_ / name));
+  // An orphan of a process that is gone is removed; one of a live process (this one) is kept.
+  std::ofstream(dir_ / ".pos_1_2.tmp999999999_3.exr") << "half";
+  const std::string mine = TemporaryPathFor((dir_ / "slab.json").string());
+  std::ofstream(mine) << "{";
+  std::ofstream(dir_ / ".hidden_but_not_ours") << "keep";
+  EXPECT_EQ(RemoveOrphanedTemporaries(dir_.string()), 1);
+  EXPECT_FALSE(fs::exists(dir_ / ".pos_1_2.tmp999999999_3.exr"));
+  EXPECT_TRUE(fs::exists(mine));
+  EXPECT_TRUE(fs::exists(dir_ / ".hidden_but_not_ours"));
 }
 
 TEST_F(IoTest, SlabRefusesNonFiniteValues) {

@@ -158,5 +158,15 @@ TEST_F(LightFieldSceneFiles, RefusesMissingAndNonMeshFilesNamingThem) {
   ExpectBadInputNaming(Write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"));  // no faces
 }
 
+// A face naming a vertex the file does not have once corrupted memory in the renderer.
+TEST_F(LightFieldSceneFiles, RefusesAFaceIndexOutOfRange) {
+  ExpectBadInputNaming(Write("bad_index.ply",
+                             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                             "property float y\nproperty float z\nelement face 1\n"
+                             "property list uchar int vertex_indices\nend_header\n"
+                             "0 0 0\n1 0 0\n0 1 0\n3 0 1 99999\n"));
+  ExpectBadInputNaming(Write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"));
+}
+
 }  // namespace
 }  // namespace lumislab

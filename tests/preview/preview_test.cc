@@ -167,7 +167,7 @@ TEST_F(PreviewSlabFiles, PartialSlabIsTheSumOfItsPositions) {
 
 TEST_F(PreviewSlabFiles, IncrementalPositionsEqualAFullRenderAndReuseShadowMaps) {
   auto live = MakeRenderer();
-  const auto scanned = ScanSlabPositions(dir_.string(), info_.grid);
+  const auto scanned = ScanSlabPositions(dir_.string(), info_);
   ASSERT_EQ(int(scanned.size()), info_.grid.count());
   // Arrive in three groups, like --watch; each Render adds only the new lights.
   size_t done = 0;
@@ -201,8 +201,8 @@ TEST_F(PreviewSlabFiles, SrgbeAccumulationStaysCloseToFloat) {
   packed.srgbe = true;
   auto a = MakeRenderer();
   auto b = MakeRenderer(packed);
-  Upload(*a, ScanSlabPositions(dir_.string(), info_.grid));
-  Upload(*b, ScanSlabPositions(dir_.string(), info_.grid));
+  Upload(*a, ScanSlabPositions(dir_.string(), info_));
+  Upload(*b, ScanSlabPositions(dir_.string(), info_));
   a->Render();
   b->Render();
   const double error = RelativeDifference(b->Read(), a->Read());

@@ -53,6 +53,24 @@ cv::Mat DecodeWithOpenCv(const std::string& path) {
   return pixels;
 }
 
+// A PNG's size from its IHDR chunk (bytes 16..23, big-endian), refused before decoding when the
+// header claims more pixels than any camera: the decoder would allocate them first.
+void CheckPngSize(const std::string& path) {
+  unsigned char h[24] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(h), sizeof h);
+  if (in.gcount() < 24) throw BadInput(path + ": truncated PNG (no image header)");
+  auto be32 = [&](int at) {
+    return (uint32_t(h[at]) << 24) | (uint32_t(h[at + 1]) << 16) | (uint32_t(h[at + 2]) << 8) |
+           uint32_t(h[at + 3]);
+  };
+  const uint64_t w = be32(16), ht = be32(20);
+  if (w == 0 || ht == 0 || w * ht > uint64_t(kMaxPhotoPixels))
+    throw InputError(path, "IHDR",
+                     "an image of 1 .. " + std::to_string(kMaxPhotoPixels) + " pixels",
+                     std::to_string(w) + "x" + std::to_string(ht));
+}
+
 }  // namespace
 
 void PhotoSpec::Check(const std::string& where) const {
@@ -153,6 +171,7 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
         cv::Mat(rgb.height, rgb.width, CV_32FC3, const_cast<float*>(rgb.data.data())).clone();
     photo.rgb_order = true;
   } else {
+    if (photo.format == PhotoFormat::kPng) CheckPngSize(path);
     photo.pixels = DecodeWithOpenCv(path);
   }
   photo.transfer = spec.transfer != Transfer::kAuto ? spec.transfer

@@ -20,6 +20,8 @@
 namespace lumislab {
 
 enum class PhotoFormat { kPng, kJpeg, kTiff, kExr };
+// Largest photo decoded (pixels; a 100-megapixel camera fits), checked from the header.
+constexpr long long kMaxPhotoPixels = 1LL << 27;
 enum class Transfer { kAuto, kLinear, kSrgb };
 
 // How to interpret a photo's codes (dataset.json radiometry and the photo's exposure).

@@ -3,11 +3,13 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <regex>
 #include <thread>
 
 #include "core/command_line.h"
+#include "core/dataset.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/stop_signal.h"
@@ -81,6 +83,25 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   if (!config.window && config.out.empty() && !config.bench) {
     throw BadInput("headless mode needs --out <file.exr|.png> (or --bench, or --window)");
   }
+  // 0 means "the default" for the plane; anything else must be a distance a lab could mean.
+  auto length = [](const char* option, double v) {
+    if (v != 0 && !(v >= 1 && v <= kMaxDistanceMm))
+      throw InputError(option, "", "0 (default) or a length in [1, 1e5] mm", std::to_string(v));
+  };
+  length("--receiver-plane", config.scene.receiver_plane_mm);
+  length("--extent", config.scene.extent_mm);
+  for (size_t k = 0; k < config.scene.pose.size(); ++k) {
+    const double v = config.scene.pose[k];
+    const double limit = k < 3 ? kMaxCoordinateMm : 360.0 * 100;
+    if (!std::isfinite(v) || std::abs(v) > limit)
+      throw InputError("--luminaire-pose", "value " + std::to_string(k + 1),
+                       k < 3 ? "a coordinate within 1e6 mm" : "an angle within 36000 degrees",
+                       std::to_string(v));
+  }
+  if (!(config.poll_s > 0 && config.poll_s <= 60))
+    throw InputError("--poll", "", "seconds in (0, 60]", std::to_string(config.poll_s));
+  if (config.bench_frames < 1 || config.bench_frames > 100000)
+    throw InputError("--bench-frames", "", "1 .. 100000", std::to_string(config.bench_frames));
 }
 
 // Runs the configured preview inside a stop-signal scope (Ctrl-C ends --watch cleanly).

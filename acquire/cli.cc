@@ -94,7 +94,9 @@ int RunSynthCommand(SynthOptions synth, int threads) {
     LogInfo("wrote ", r.photos_written, " photos, radiometric scale ", r.radiometric_scale,
             " W/m^2 per unit");
   if (StopRequested()) {
-    LogWarning("interrupted: the dataset is partial; run the same command again to redo it");
+    LogWarning(synth.interval_s >= 0
+                   ? "interrupted: the dataset is partial; run the same command again to redo it"
+                   : "interrupted: nothing was written (a previous dataset there is unchanged)");
     return 1;
   }
   std::printf("dataset: %s\n", synth.out_dir.c_str());

@@ -93,8 +93,8 @@ bool PauseUnlessStopped(double seconds) {
 // Renders, applies the effects to and writes the photos of every position: in order with a
 // pause for a live acquisition, else on `threads` threads. A stop signal ends it after the
 // positions in hand (each written whole). Returns the number of photos written.
-int CapturePositions(const SynthScene& scene, const Dataset& dataset, const SynthOptions& options,
-                     PhotoEncoding encoding, int threads) {
+int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
+                     const SynthOptions& options, PhotoEncoding encoding, int threads) {
   const ScreenView view = ScreenView::Of(scene);
   const double scale = *dataset.radiometric_scale;
   const int count = scene.grid.count();
@@ -110,7 +110,7 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const Synt
       ImageF& photo = positive ? plus : minus;
       const int index = PhotoIndex(scene, i, j, positive);
       ApplyEffects(scene, index, &photo);
-      WritePhoto(options.out_dir + "/" + dataset.photos[index].file, photo, encoding);
+      WritePhoto(dir + "/" + dataset.photos[index].file, photo, encoding);
       ++written;
     }
     progress.Advance();
@@ -140,6 +140,47 @@ SynthReport RunSynth(const SynthOptions& options) {
   return RunSynth(LoadScene(options.scene), options);
 }
 
+namespace {
+
+// Writes the whole dataset into `dir`: dataset.json and the calibration photo first (a live
+// reader can start at once), the truth, then the photos. Returns the number of photos written.
+int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
+                 const SynthOptions& options, PhotoEncoding encoding, int threads) {
+  MakeDirectories(dir + "/photos");
+  MakeDirectories(dir + "/truth");
+  int orphans = 0;
+  for (const std::string& d : {dir, dir + "/photos", dir + "/truth"})
+    orphans += RemoveOrphanedTemporaries(d);
+  if (orphans > 0) LogInfo(dir, ": removed ", orphans, " temporary file(s) of an interrupted run");
+  dataset.Save(dir);
+  WriteCalibrationPhoto(scene, dir + "/" + scene.calibration.photo, threads);
+  WriteTruthCamera(scene, dir + "/truth/camera.json");
+  WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
+                 dir + "/truth", threads);
+  return CapturePositions(scene, dataset, dir, options, encoding, threads);
+}
+
+// Puts the finished folder `staging` where `out` is: the old one (if any) is moved aside first
+// and removed only once the new one is in place.
+void SwapIntoPlace(const std::string& staging, const std::string& out) {
+  std::error_code ec;
+  const bool had_old = fs::exists(out, ec);
+  const std::string old = TemporaryPathFor(out);
+  if (had_old) {
+    fs::rename(out, old, ec);
+    if (ec) throw IoError(out, "cannot move the previous dataset aside: " + ec.message());
+  }
+  fs::rename(staging, out, ec);
+  if (ec) {
+    std::error_code back;
+    if (had_old) fs::rename(old, out, back);
+    throw IoError(out, "cannot move the new dataset into place: " + ec.message());
+  }
+  if (had_old) fs::remove_all(old, ec);
+}
+
+}  // namespace
+
 SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
   options.Check();
   SynthReport report;
@@ -162,20 +203,30 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
                                                   : "float EXR",
           "), radiometric scale ", report.radiometric_scale, " W/m^2 per unit, ",
           scene.effects.size(), " effect(s)");
-  MakeDirectories(out + "/photos");
-  MakeDirectories(out + "/truth");
-  int orphans = 0;
-  for (const std::string& dir : {out, out + "/photos", out + "/truth"})
-    orphans += RemoveOrphanedTemporaries(dir);
-  if (orphans > 0) LogInfo(out, ": removed ", orphans, " temporary file(s) of an interrupted run");
-
-  // dataset.json and the calibration photo come first: a live reader can start at once.
-  dataset.Save(out);
-  WriteCalibrationPhoto(scene, out + "/" + scene.calibration.photo, threads);
-  WriteTruthCamera(scene, out + "/truth/camera.json");
-  WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
-                 out + "/truth", threads);
-  report.photos_written = CapturePositions(scene, dataset, options, encoding, threads);
+  if (options.interval_s >= 0) {  // live: readers follow the files where they will stay
+    report.photos_written = WriteDataset(scene, dataset, out, options, encoding, threads);
+    return report;
+  }
+  // Offline: into a staging folder beside `out`, swapped in when complete, so that a failure, a
+  // stop signal or a --force over a good dataset leaves the previous folder as it was.
+  const fs::path parent = fs::absolute(out).parent_path();
+  MakeDirectories(parent.string());
+  if (const int n = RemoveOrphanedTemporaries(parent.string()))
+    LogInfo(parent.string(), ": removed ", n, " staging folder(s) of an interrupted run");
+  const std::string staging = TemporaryPathFor(out);
+  try {
+    report.photos_written = WriteDataset(scene, dataset, staging, options, encoding, threads);
+    if (StopRequested()) {
+      fs::remove_all(staging);
+      report.photos_written = 0;
+      return report;
+    }
+    SwapIntoPlace(staging, out);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(staging, ec);
+    throw;
+  }
   return report;
 }
 

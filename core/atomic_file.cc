@@ -30,6 +30,18 @@ std::string TemporaryPathFor(const std::string& final_path) {
   return (p.parent_path() / ("." + stem + tag + ext)).string();
 }
 
+namespace {
+// True while process `pid` runs (a zombie, killed but not yet reaped, does not).
+bool ProcessRuns(long pid) {
+  if (kill(pid_t(pid), 0) != 0 && errno == ESRCH) return false;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return true;  // no /proc: trust kill()
+  const size_t close = line.rfind(')');        // "pid (comm) S ...": the state follows the name
+  return !(close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'Z');
+}
+}  // namespace
+
 int RemoveOrphanedTemporaries(const std::string& dir) {
   static const std::regex kTemporary(R"(^\..*\.tmp([0-9]+)_[0-9]+(\.[^.]*)?$)");
   int removed = 0;
@@ -39,9 +51,9 @@ int RemoveOrphanedTemporaries(const std::string& dir) {
     std::smatch m;
     if (!std::regex_match(name, m, kTemporary) || m[1].length() > 9) continue;
     const long pid = std::stol(m[1].str());
-    if (pid == getpid() || kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // still running
-    std::error_code remove_ec;
-    if (fs::remove(it->path(), remove_ec)) ++removed;
+    if (pid == getpid() || ProcessRuns(pid)) continue;
+    std::error_code remove_ec;  // a staging folder (acquire) is removed with its contents
+    if (fs::remove_all(it->path(), remove_ec) > 0) ++removed;
   }
   return removed;
 }

@@ -11,8 +11,9 @@ namespace lumislab {
 // "dir/.name.tmp<pid>_<n>.ext" for "dir/name.ext"; the name part is shortened so that the
 // temporary name stays within 255 bytes when the final one does.
 std::string TemporaryPathFor(const std::string& final_path);
-// Removes the temporary files in `dir` (not recursive) left by lumislab processes that no longer
-// run (killed mid-write): names of TemporaryPathFor's form whose pid is gone. Returns how many.
+// Removes the temporary files (and staging folders) in `dir` left by lumislab processes that no
+// longer run (killed mid-write): names of TemporaryPathFor's form whose pid is gone. Returns how
+// many.
 int RemoveOrphanedTemporaries(const std::string& dir);
 // Calls write(tmp_path), then renames tmp_path onto final_path. On any exception the temporary
 // file is removed and the exception rethrown; a failed rename is an IoError (exit 3).

@@ -160,25 +160,6 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
   return CapturePositions(scene, dataset, dir, options, encoding, threads);
 }
 
-// Puts the finished folder `staging` where `out` is: the old one (if any) is moved aside first
-// and removed only once the new one is in place.
-void SwapIntoPlace(const std::string& staging, const std::string& out) {
-  std::error_code ec;
-  const bool had_old = fs::exists(out, ec);
-  const std::string old = TemporaryPathFor(out);
-  if (had_old) {
-    fs::rename(out, old, ec);
-    if (ec) throw IoError(out, "cannot move the previous dataset aside: " + ec.message());
-  }
-  fs::rename(staging, out, ec);
-  if (ec) {
-    std::error_code back;
-    if (had_old) fs::rename(old, out, back);
-    throw IoError(out, "cannot move the new dataset into place: " + ec.message());
-  }
-  if (had_old) fs::remove_all(old, ec);
-}
-
 }  // namespace
 
 SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
@@ -221,7 +202,7 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
       report.photos_written = 0;
       return report;
     }
-    SwapIntoPlace(staging, out);
+    ReplaceFolder(staging, out);
   } catch (...) {
     std::error_code ec;
     fs::remove_all(staging, ec);

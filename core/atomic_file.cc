@@ -91,6 +91,23 @@ std::string ReadTextFile(const std::string& path) {
   return ss.str();
 }
 
+void ReplaceFolder(const std::string& staging, const std::string& final_dir) {
+  std::error_code ec;
+  const bool had_old = fs::exists(final_dir, ec);
+  const std::string old = TemporaryPathFor(final_dir);
+  if (had_old) {
+    fs::rename(final_dir, old, ec);
+    if (ec) throw IoError(final_dir, "cannot move the previous folder aside: " + ec.message());
+  }
+  fs::rename(staging, final_dir, ec);
+  if (ec) {
+    std::error_code back;
+    if (had_old) fs::rename(old, final_dir, back);
+    throw IoError(final_dir, "cannot move the new folder into place: " + ec.message());
+  }
+  if (had_old) fs::remove_all(old, ec);
+}
+
 bool IsTemporaryName(const std::string& filename) {
   const std::string name = fs::path(filename).filename().string();
   return !name.empty() && name[0] == '.';

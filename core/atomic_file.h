@@ -21,6 +21,9 @@ void WriteAtomically(const std::string& final_path,
                      const std::function<void(const std::string& tmp_path)>& write);
 void WriteTextAtomically(const std::string& final_path, const std::string& text);
 std::string ReadTextFile(const std::string& path);  // IoError when missing/unreadable
+// Puts the finished folder `staging` where `final_dir` is: an old folder there is moved aside
+// first and removed only once the new one is in place (restored if the move fails; IoError).
+void ReplaceFolder(const std::string& staging, const std::string& final_dir);
 bool IsTemporaryName(const std::string& filename);  // starts with '.'
 void MakeDirectories(const std::string& dir);       // IoError on failure
 

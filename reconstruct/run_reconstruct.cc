@@ -6,6 +6,7 @@
 #include <sstream>
 #include <thread>
 
+#include "core/atomic_file.h"
 #include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -106,33 +107,57 @@ std::string CalibrationPath(const std::string& dir) { return dir + "/calib/scree
 
 void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_dir);
 
-int RunBatch(const RunConfig& config) {
-  const Dataset dataset = Dataset::Load(config.dataset_dir);
-  const std::string calib_path = CalibrationPath(config.dataset_dir);
-  if (!fs::exists(calib_path))
-    throw BadInput(calib_path + ": missing; run lumislab-calibrate screen first");
-  const ScreenCalibration calibration = ScreenCalibration::Load(calib_path);
-  std::vector<Position> todo;
-  for (int j = 0; j < dataset.grid.nv; ++j)
-    for (int i = 0; i < dataset.grid.nu; ++i) todo.push_back({i, j});
-  CheckPhotosExist(dataset, todo);
-  SlabWriter writer(dataset, config.options.resolution, config.force);
-  todo = Missing(dataset, writer);
+// Reconstructs every position the slab in `dir` lacks; false when stopped by a signal.
+bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, const std::string& dir,
+              const RunConfig& config) {
+  SlabWriter writer(dataset, config.options.resolution, config.force, dir);
+  const std::vector<Position> todo = Missing(dataset, writer);
   const int skipped = dataset.grid.count() - int(todo.size());
   if (skipped > 0)
     LogInfo(skipped, " position(s) already in ", writer.dir(), " (use --force to redo them)");
   Progress progress("reconstruct", int(todo.size()));
   ProcessPositions(dataset, calibration, writer, todo, config, &progress);
   progress.Finish();
-  if (StopRequested()) {
+  if (StopRequested() && dir == dataset.Path("slab"))
     LogWarning("interrupted: slab is partial (", writer.PresentCount(), "/", dataset.grid.count(),
                " positions); run again to continue");
-    return 1;
+  return !StopRequested();
+}
+
+int RunBatch(const RunConfig& config) {
+  const Dataset dataset = Dataset::Load(config.dataset_dir);
+  const std::string calib_path = CalibrationPath(config.dataset_dir);
+  if (!fs::exists(calib_path))
+    throw BadInput(calib_path + ": missing; run lumislab-calibrate screen first");
+  const ScreenCalibration calibration = ScreenCalibration::Load(calib_path);
+  std::vector<Position> all;
+  for (int j = 0; j < dataset.grid.nv; ++j)
+    for (int i = 0; i < dataset.grid.nu; ++i) all.push_back({i, j});
+  CheckPhotosExist(dataset, all);
+  const std::string slab_dir = dataset.Path("slab");
+  // --force over an existing slab builds the new one beside it and swaps it in when complete:
+  // a failure or a stop leaves the previous slab as it was (and then nothing is resumable).
+  const bool staged = config.force && fs::exists(slab_dir);
+  if (staged) RemoveOrphanedTemporaries(dataset.dir);
+  const std::string dir = staged ? TemporaryPathFor(slab_dir) : slab_dir;
+  try {
+    if (!FillSlab(dataset, calibration, dir, config)) {
+      if (staged) {
+        fs::remove_all(dir);
+        LogWarning("interrupted: the previous slab is unchanged (--force starts over)");
+      }
+      return 1;
+    }
+    if (staged) ReplaceFolder(dir, slab_dir);
+  } catch (...) {
+    std::error_code ec;
+    if (staged) fs::remove_all(dir, ec);
+    throw;
   }
-  LogInfo("slab: ", writer.dir(), " (", writer.PresentCount(), "/", dataset.grid.count(),
-          " positions, ", config.options.resolution, "x", config.options.resolution, ", ",
-          writer.info().units, ")");
-  ReportAgainstTruth(config.dataset_dir, writer.dir());
+  const SlabInfo info = SlabInfo::Load(slab_dir);
+  LogInfo("slab: ", slab_dir, " (", info.present.size(), "/", dataset.grid.count(), " positions, ",
+          config.options.resolution, "x", config.options.resolution, ", ", info.units, ")");
+  ReportAgainstTruth(config.dataset_dir, slab_dir);
   return 0;
 }
 

@@ -8,8 +8,9 @@
 
 namespace lumislab {
 
-SlabWriter::SlabWriter(const Dataset& dataset, int resolution, bool force)
-    : dir_(dataset.Path("slab")), info_(SlabInfo::FromDataset(dataset, resolution)) {
+SlabWriter::SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir)
+    : dir_(dir.empty() ? dataset.Path("slab") : dir),
+      info_(SlabInfo::FromDataset(dataset, resolution)) {
   info_.present.clear();
   if (!force && std::filesystem::exists(dir_ + "/slab.json")) {
     const SlabInfo old = SlabInfo::Load(dir_);

@@ -13,9 +13,10 @@ namespace lumislab {
 
 class SlabWriter {
  public:
-  // Opens dataset/slab: keeps positions whose EXR already exists (unless `force`), rejects an
-  // existing slab of another resolution unless `force`; writes a valid slab.json right away.
-  SlabWriter(const Dataset& dataset, int resolution, bool force);
+  // Opens `dir` (default: dataset/slab): keeps positions whose EXR already exists (unless
+  // `force`), rejects an existing slab of another resolution unless `force`; writes a valid
+  // slab.json right away.
+  SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir = "");
 
   const SlabInfo& info() const { return info_; }
   const std::string& dir() const { return dir_; }

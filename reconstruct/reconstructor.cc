@@ -117,8 +117,13 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   BellFitOptions fit_options;
   fit_options.lambda = options.lambda;
   BellFitReport fit_report;
-  const std::vector<double> c =
-      FitBell(data, seen, layout.res_x, layout.res_y, 3, fit_options, &fit_report);
+  std::vector<double> c;
+  try {
+    c = FitBell(data, seen, layout.res_x, layout.res_y, 3, fit_options, &fit_report);
+  } catch (const Error& e) {
+    throw Failure("position " + std::to_string(i) + "," + std::to_string(j) +
+                  ": the fit onto the bell basis failed (" + e.what() + ")");
+  }
   r.fit_iterations = fit_report.iterations;
   r.fit_residual = fit_report.relative_residual;
   SlabPosition out;

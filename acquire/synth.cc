@@ -48,9 +48,9 @@ void SynthOptions::Check() const {
   ResolveThreads(threads);  // BadInput naming --threads when out of range
   if (photo_format != "half" && photo_format != "float")
     throw BadInput("--photo-format: expected half or float, got " + photo_format);
-  if (truth_resolution < 1 || truth_resolution > 16384)
-    throw BadInput("--truth-resolution: expected 1 .. 16384, got " +
-                   std::to_string(truth_resolution));
+  if (truth_resolution < 1 || truth_resolution > kMaxSlabResolution)
+    throw BadInput("--truth-resolution: expected 1 .. " + std::to_string(kMaxSlabResolution) +
+                   ", got " + std::to_string(truth_resolution));
 }
 
 double ChooseRadiometricScale(const SynthScene& scene, int threads) {

@@ -42,8 +42,8 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
   const Eigen::Vector2d window = ParseLengthPair(root["window_mm"]);
   info.layout.window_w_mm = window.x();
   info.layout.window_h_mm = window.y();
-  info.layout.res_x = root["resolution"][0].IntIn(1, 16384);
-  info.layout.res_y = root["resolution"][1].IntIn(1, 16384);
+  info.layout.res_x = root["resolution"][0].IntIn(1, kMaxSlabResolution);
+  info.layout.res_y = root["resolution"][1].IntIn(1, kMaxSlabResolution);
   info.units = root["units"].OneOf({"W/m^2", "relative"});
   info.filter = ParseFilterInfo(root["filter"], info.grid);
   const JsonView present = root["present"];

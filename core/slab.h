@@ -15,6 +15,8 @@
 namespace lumislab {
 
 constexpr int kSlabSchemaVersion = 1;
+// Texels per side of a slab: what ReadExr reads back (kMaxExrPixels = 8192^2).
+constexpr int kMaxSlabResolution = 8192;
 
 struct SlabInfo {
   double distance_mm = 0;

@@ -253,6 +253,17 @@ TEST_F(IoTest, DatasetRoundTripAndValidation) {
   expect_error("\"schema_version\": 2", "\"schema_version\": 3", "schema_version");
 }
 
+// Old files stay readable: a version-1 dataset.json reads with the version-2 defaults.
+TEST_F(IoTest, ReadsADatasetOfSchemaVersion1) {
+  const Dataset ds = Dataset::Load(std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/v1");
+  EXPECT_EQ(ds.grid.nu, 2);
+  EXPECT_EQ(ds.photos.size(), 4u);
+  EXPECT_EQ(ds.photo_transfer, "auto");
+  EXPECT_EQ(ds.black_level, 0.0);
+  EXPECT_EQ(ds.white_level, 1.0);
+  EXPECT_DOUBLE_EQ(*ds.radiometric_scale, 1.92376);
+}
+
 TEST_F(IoTest, ScreenCalibrationRoundTripAndDistortionInverse) {
   ScreenCalibration c;
   c.image_width = 1600;

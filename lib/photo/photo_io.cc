@@ -53,22 +53,36 @@ cv::Mat DecodeWithOpenCv(const std::string& path) {
   return pixels;
 }
 
-// A PNG's size from its IHDR chunk (bytes 16..23, big-endian), refused before decoding when the
-// header claims more pixels than any camera: the decoder would allocate them first.
-void CheckPngSize(const std::string& path) {
-  unsigned char h[24] = {};
+// Checks a PNG's chunk structure before OpenCV decodes it (libpng prints its own "libpng error"
+// lines and OpenCV then only says it failed): the size in IHDR (refused beyond kMaxPhotoPixels,
+// which the decoder would allocate first) and a chunk sequence that ends in IEND within the
+// file (a truncated copy does not). Walks the chunk headers only.
+void CheckPng(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(h), sizeof h);
-  if (in.gcount() < 24) throw BadInput(path + ": truncated PNG (no image header)");
-  auto be32 = [&](int at) {
-    return (uint32_t(h[at]) << 24) | (uint32_t(h[at + 1]) << 16) | (uint32_t(h[at + 2]) << 8) |
-           uint32_t(h[at + 3]);
+  auto be32 = [](const unsigned char* b) {
+    return (uint32_t(b[0]) << 24) | (uint32_t(b[1]) << 16) | (uint32_t(b[2]) << 8) | uint32_t(b[3]);
   };
-  const uint64_t w = be32(16), ht = be32(20);
+  unsigned char h[24] = {};
+  in.read(reinterpret_cast<char*>(h), sizeof h);
+  if (in.gcount() < 24 || std::memcmp(h + 12, "IHDR", 4) != 0)
+    throw BadInput(path + ": truncated or corrupt PNG (no image header)");
+  const uint64_t w = be32(h + 16), ht = be32(h + 20);
   if (w == 0 || ht == 0 || w * ht > uint64_t(kMaxPhotoPixels))
     throw InputError(path, "IHDR",
                      "an image of 1 .. " + std::to_string(kMaxPhotoPixels) + " pixels",
                      std::to_string(w) + "x" + std::to_string(ht));
+  std::error_code ec;
+  const uint64_t file_size = std::filesystem::file_size(path, ec);
+  uint64_t at = 8;  // after the signature
+  for (;;) {
+    unsigned char chunk[8];
+    in.seekg(std::streamoff(at));
+    in.read(reinterpret_cast<char*>(chunk), 8);
+    if (in.gcount() < 8) throw BadInput(path + ": truncated PNG (no IEND chunk)");
+    at += 12 + uint64_t(be32(chunk));  // length, type, data, CRC
+    if (at > file_size) throw BadInput(path + ": truncated PNG (a chunk runs past the end)");
+    if (std::memcmp(chunk + 4, "IEND", 4) == 0) return;
+  }
 }
 
 }  // namespace
@@ -171,7 +185,7 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
         cv::Mat(rgb.height, rgb.width, CV_32FC3, const_cast<float*>(rgb.data.data())).clone();
     photo.rgb_order = true;
   } else {
-    if (photo.format == PhotoFormat::kPng) CheckPngSize(path);
+    if (photo.format == PhotoFormat::kPng) CheckPng(path);
     photo.pixels = DecodeWithOpenCv(path);
   }
   photo.transfer = spec.transfer != Transfer::kAuto ? spec.transfer

@@ -30,7 +30,8 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
   cmd->add_option("--out", o.out_dir, "dataset folder to write");
   cmd->add_option("--interval", o.interval_s,
                   "live acquisition: dataset.json and the calibration photo first, then "
-                  "the positions one by one with this pause (s)");
+                  "the positions one by one with this pause (s)")
+      ->check(FiniteIn(0, 3600));
   cmd->add_flag("--force", o.force, "redo a dataset that is already complete");
   cmd->add_option("--truth-resolution", o.truth_resolution, "texels per side of the truth slab")
       ->capture_default_str();

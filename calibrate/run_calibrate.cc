@@ -74,15 +74,19 @@ int RunCalibrate(int argc, char** argv) {
   AddCommonOptions(sub, &common);
   sub->add_option("--huber-px", screen.options.refiner.huber_px,
                   "scale of the robust (Huber) loss, pixels")
+      ->check(FiniteIn(1e-3, 1e3))
       ->capture_default_str();
   sub->add_option("--distortion-terms", screen.options.refiner.distortion_terms,
                   "radial terms to fit: 0, 1 (k1) or 2 (k1, k2)")
+      ->check(CLI::Range(0, 2))
       ->capture_default_str();
   sub->add_option("--max-rms-px", screen.options.max_rms_px,
                   "refuse the calibration when the reprojection RMS exceeds this (pixels)")
+      ->check(FiniteIn(1e-3, 1e3))
       ->capture_default_str();
   sub->add_option("--max-detection-px", screen.options.detection.max_detection_px,
                   "find corners on a copy whose long side is at most this (pixels)")
+      ->check(CLI::Range(200, 100000))
       ->capture_default_str();
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("calibrate", common);

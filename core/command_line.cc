@@ -1,5 +1,7 @@
 #include "core/command_line.h"
 
+#include <cmath>
+
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parallel.h"
@@ -27,6 +29,19 @@ int StartTool(const std::string& tool, const CommonOptions& options) {
   SetLogTool(tool);
   if (options.verbose) SetLogLevel(LogLevel::kDebug);
   return ResolveThreads(options.threads);
+}
+
+CLI::Validator FiniteIn(double lo, double hi) {
+  const std::string range =
+      "[" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]";
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi)
+          return "expected a number in " + range + ", got " + text;
+        return "";
+      },
+      "NUMBER in " + range);
 }
 
 std::string TrimTrailingSlashes(std::string path) {

@@ -27,6 +27,10 @@ std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv);
 // Sets the log prefix ("lumislab-<tool>") and level; returns the resolved thread count
 // (BadInput naming --threads when out of range).
 int StartTool(const std::string& tool, const CommonOptions& options);
+// A CLI11 check that a number is finite and in [lo, hi] (CLI::Range lets NaN through); the
+// message names the option.
+CLI::Validator FiniteIn(double lo, double hi);
+
 // "out/ds///" -> "out/ds" (the root "/" stays).
 std::string TrimTrailingSlashes(std::string path);
 

@@ -136,6 +136,7 @@ Dataset Dataset::Load(const std::string& dir) {
                           : "auto";
   ds.black_level = radiometry.Has("black_level") ? radiometry["black_level"].NumberIn(0, 0.5) : 0;
   ds.white_level = radiometry.Has("white_level") ? radiometry["white_level"].NumberIn(0.5, 1e6) : 1;
+  if (!(ds.white_level > ds.black_level)) radiometry["white_level"].Fail("a level > black_level");
 
   const JsonView calib = root["calibration"];
   ds.calibration.photo = calib["photo"].String();
@@ -164,6 +165,13 @@ Dataset Dataset::Load(const std::string& dir) {
     if (!IsRelativeInside(e.file)) p["file"].Fail("a path relative to the dataset folder");
     e.exposure = p.Has("exposure") ? p["exposure"].NumberIn(1e-9, 1e9) : 1.0;
     slides.insert({e.i, e.j, e.positive});
+    // The same photo twice, or two photos of one slide at one exposure, would be merged as if
+    // they were different measurements.
+    for (const PhotoEntry& other : ds.photos)
+      if (other.file == e.file || (other.i == e.i && other.j == e.j &&
+                                   other.positive == e.positive && other.exposure == e.exposure))
+        p.Fail("a photo not listed before (" + other.file + " has the same " +
+               (other.file == e.file ? "file" : "position, slide and exposure") + ")");
     ds.photos.push_back(e);
   }
   for (int j = 0; j < ds.grid.nv; ++j)

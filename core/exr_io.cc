@@ -110,8 +110,7 @@ bool ExrComplete(const std::string& path, int width, int height) {
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i dw = file.header().dataWindow();
-    if (dw.max.x - dw.min.x + 1 != width || dw.max.y - dw.min.y + 1 != height ||
-        !file.isComplete())
+    if (dw.max.x - dw.min.x + 1 != width || dw.max.y - dw.min.y + 1 != height || !file.isComplete())
       return false;
     // isComplete() only checks the offset table: read the last block's bytes too, which a
     // truncated file does not hold.

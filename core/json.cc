@@ -204,7 +204,7 @@ JsonDocument JsonDocument::Parse(const std::string& text, const std::string& nam
   doc.file_ = std::make_shared<const std::string>(name);
   try {
     doc.json_ = std::make_shared<nlohmann::json>(nlohmann::json::parse(text));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse errors, number overflow (1e999)
     // e.what() is "[json.exception.parse_error.101] parse error at line L, column C: ...":
     // keep the part a person reads.
     std::string what = e.what();

@@ -47,9 +47,11 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
   info.units = root["units"].OneOf({"W/m^2", "relative"});
   info.filter = ParseFilterInfo(root["filter"], info.grid);
   const JsonView present = root["present"];
-  for (size_t k = 0; k < present.Size(); ++k)
+  for (size_t k = 0; k < present.Size(); ++k) {
+    if (present[k].Size() != 2) present[k].Fail("a position [i, j]");
     info.MarkPresent(present[k][0].IntIn(0, info.grid.nu - 1),
                      present[k][1].IntIn(0, info.grid.nv - 1));
+  }
   return info;
 }
 

@@ -16,6 +16,21 @@
 namespace lumislab {
 namespace {
 
+// Without --watch the slab is finished: every position slab.json lists must be there, complete
+// and of its resolution (ScanSlabPositions leaves out any that is not), and there must be one.
+void CheckListedPositionsLoaded(const std::string& slab_dir, const SlabInfo& info,
+                                const Renderer& renderer) {
+  if (info.present.empty())
+    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
+  for (const auto& [i, j] : info.present)
+    if (!renderer.HasPosition(i, j))
+      throw InputError(SlabPositionPath(slab_dir, i, j), "",
+                       "a complete EXR of " + std::to_string(info.layout.res_x) + "x" +
+                           std::to_string(info.layout.res_y) +
+                           " texels (slab.json lists the position)",
+                       "a missing, truncated or other-sized file");
+}
+
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -97,6 +112,7 @@ int RunHeadless(const PreviewConfig& config, const SlabInfo& info) {
   renderer.SetCamera(setup.plane ? PlaneView(setup.plane_z, setup.extent)
                                  : OrbitCamera(setup, aspect));
   LoadNewPositions(config.slab_dir, info, renderer, config.threads);
+  if (!config.watch) CheckListedPositionsLoaded(config.slab_dir, info, renderer);
   renderer.Render();
   WriteOutput(config, renderer);
   LogInfo("rendered ", renderer.PositionCount(), "/", info.grid.count(), " positions, ",

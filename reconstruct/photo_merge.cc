@@ -19,7 +19,7 @@ void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int hei
   for (const auto& p : photos)
     if (p.photo.pixels.cols != width || p.photo.pixels.rows != height)
       throw InputError(
-          p.photo.path, "image size",
+          p.photo.path, "image size (calib/screen.json image_size)",
           std::to_string(width) + "x" + std::to_string(height) + " as in " + calibration_file,
           std::to_string(p.photo.pixels.cols) + "x" + std::to_string(p.photo.pixels.rows));
 }

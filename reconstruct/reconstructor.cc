@@ -22,7 +22,7 @@ void ReconstructOptions::Check() const {
   if (!(lambda >= 0 && lambda <= 1))
     throw BadInput("--lambda: expected a number in [0, 1], got " + std::to_string(lambda));
   if (samples_per_texel < 0 || samples_per_texel > 64)
-    throw BadInput("samples per texel: expected 0 (auto) .. 64, got " +
+    throw BadInput("--samples-per-texel: expected 0 (auto) .. 64, got " +
                    std::to_string(samples_per_texel));
 }
 

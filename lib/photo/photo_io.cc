@@ -181,6 +181,9 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
   photo.format = DetectPhotoFormat(path);
   if (photo.format == PhotoFormat::kExr) {
     const ImageF rgb = ReadExr(path, {"R", "G", "B"});  // BadInput naming file and channel
+    // A camera never writes NaN or Inf: such a photo is corrupt, not dark or clipped.
+    for (float v : rgb.data)
+      if (!std::isfinite(v)) throw InputError(path, "pixel data", "finite values", "NaN or Inf");
     photo.pixels =
         cv::Mat(rgb.height, rgb.width, CV_32FC3, const_cast<float*>(rgb.data.data())).clone();
     photo.rgb_order = true;

@@ -165,7 +165,7 @@ TEST_F(CalibrateCli, HelpAndBadUsage) {
   EXPECT_EQ(RunTool({"screen"}).exit_code, 2);  // no --dataset
   const Result r = Calibrate({"--distortion-terms", "3"});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("distortion_terms"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--distortion-terms"), std::string::npos) << r.output;
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "core/command_line.h"
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -16,6 +18,22 @@ void AddCommonOptions(CLI::App* app, CommonOptions* options) {
 }
 
 std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  // CLI11 answers a mistyped subcommand with "A subcommand is required": name the word.
+  const auto subcommands = app.get_subcommands([](CLI::App*) { return true; });
+  if (argc > 1 && !subcommands.empty() && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : subcommands) {
+      known = known || sub->get_name() == argv[1];
+      names += (names.empty() ? "" : " | ") + sub->get_name();
+    }
+    if (!known) {
+      const std::string tool = std::filesystem::path(argv[0]).filename().string();
+      std::fprintf(stderr, "%s: error: unknown subcommand \"%s\" (expected %s)\n", tool.c_str(),
+                   argv[1], names.c_str());
+      return static_cast<int>(ExitCode::kBadInput);
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -90,6 +90,10 @@ void WatchSlab(const PreviewConfig& config, SlabInfo info, Renderer& renderer) {
     }
     const auto added = LoadNewPositions(config.slab_dir, info, renderer, config.threads);
     if (added.empty()) continue;
+    // The last update sums every light afresh: the float sum of batches depends on how the
+    // positions happened to arrive, and the final image should not (it then equals a render of
+    // the finished slab, byte for byte).
+    if (renderer.PositionCount() == info.grid.count()) renderer.SetOptions(renderer.options());
     renderer.Render();
     WriteOutput(config, renderer);
     LogInfo("positions ", renderer.PositionCount(), "/", info.grid.count(), " (new: ", added.size(),

@@ -8,6 +8,7 @@
 #include <regex>
 #include <thread>
 
+#include "core/atomic_file.h"
 #include "core/command_line.h"
 #include "core/dataset.h"
 #include "core/error.h"
@@ -110,6 +111,10 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     const SynthScene scene = DefaultScene();
     WriteTruthSlab(scene.luminaire, TruthSlabInfo(scene, 300), config.slab_dir, config.threads);
     LogInfo("wrote the built-in test slab to ", config.slab_dir);
+  }
+  if (!config.out.empty()) {  // a killed --watch run may have left its output half-written
+    const std::string folder = std::filesystem::absolute(config.out).parent_path().string();
+    if (std::filesystem::is_directory(folder)) RemoveOrphanedTemporaries(folder);
   }
   const StopSignalScope stop_signals;
   const std::optional<SlabInfo> info = WaitForSlabInfo(config);

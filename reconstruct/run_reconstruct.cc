@@ -134,6 +134,9 @@ int RunBatch(const RunConfig& config) {
   for (int j = 0; j < dataset.grid.nv; ++j)
     for (int i = 0; i < dataset.grid.nu; ++i) all.push_back({i, j});
   CheckPhotosExist(dataset, all);
+  // Photos that do not fit the calibration (size, format) are refused before anything is
+  // written: decode the first position's photos now.
+  DecodePosition(dataset, calibration, 0, 0);
   const std::string slab_dir = dataset.Path("slab");
   // --force over an existing slab builds the new one beside it and swaps it in when complete:
   // a failure or a stop leaves the previous slab as it was (and then nothing is resumable).

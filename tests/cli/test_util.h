@@ -1,7 +1,9 @@
 // Helpers for tests that run the lumislab executables.
 #pragma once
 
+#include <map>
 #include <string>
+#include <vector>
 
 namespace lumislab::testing {
 
@@ -21,5 +23,26 @@ std::string SceneJson(int nu, int nv, const std::string& camera_json,
 // Files under `dir` (recursively) whose name does not start with '.', and those that do.
 int CountFinalFiles(const std::string& dir);
 int CountTemporaryFiles(const std::string& dir);
+
+// Runs build/bin/<tool> <args> from the working folder `cwd` (so that relative paths in `args`
+// and in the tool's messages are relative to it), through `timeout` (exit 124 when it runs past
+// `timeout_s`) and, when `memory_kb` > 0, under `ulimit -v memory_kb`. stdin is /dev/null.
+CommandResult RunToolIn(const std::string& cwd, const std::string& tool, const std::string& args,
+                        double timeout_s = 20, long memory_kb = 0);
+// Single-quotes `text` for sh.
+std::string ShellQuote(const std::string& text);
+
+// What is under `dir`, recursively, without following links or opening anything that is not a
+// regular file (a FIFO stays unopened): relative path -> "file <size> <hash>", "dir", "fifo",
+// "link -> target" or "other". Regular files are hashed over all their bytes.
+using TreeSnapshot = std::map<std::string, std::string>;
+TreeSnapshot SnapshotTree(const std::string& dir);
+// Paths that differ between two snapshots (added, removed or changed), each with what happened.
+std::vector<std::string> DiffSnapshots(const TreeSnapshot& before, const TreeSnapshot& after);
+// Paths in a snapshot one of whose components starts with '.' (temporary names, §7.5).
+std::vector<std::string> TemporaryPaths(const TreeSnapshot& snapshot);
+
+std::string ReadBinaryFile(const std::string& path);  // "" when missing
+void WriteBinaryFile(const std::string& path, const std::string& bytes);
 
 }  // namespace lumislab::testing

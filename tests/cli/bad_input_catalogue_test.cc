@@ -1,0 +1,1516 @@
+// The bad-input catalogue: one table of cases over the four tools, each a mutation of a small
+// valid input, the command that must refuse it, and what the refusal must look like
+// (docs/design.md §7): exit code 2, one error line naming the file and the field, no crash, no
+// hang, and nothing under the case folder changed (every file's bytes hashed before and after;
+// only what a case allows may change) with no temporary file ('.' names, §7.5) left behind.
+//
+// The cases are written to the contract, not to today's behaviour: a failing case is a bug in a
+// tool (or a contract to settle), never a reason to edit the expectation.
+//
+// Each case is its own ctest entry (TEST_P; ctest runs them in separate processes, several at
+// once; ctest -L catalogue runs them all). The valid inputs (a 2x2 grid of 320x240 photos,
+// 16-bit PNG and half-float EXR, calibrated, a 40x40 slab) are made once per build of the tools
+// under a lock in the build tree (see Masters) and copied into a fresh folder per case; the
+// tools run from the case folder (paths in messages read "ds/dataset.json"), through `timeout`
+// and under `ulimit -v` 2 GiB, so a hang or an allocation of gigabytes fails the case instead of
+// the machine. LUMISLAB_KEEP_CASES=1 keeps the case folders.
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfOutputFile.h>
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_util.h"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace lumislab {
+namespace {
+
+using testing::CommandResult;
+using testing::ReadBinaryFile;
+using testing::RunToolIn;
+using testing::SnapshotTree;
+using testing::TreeSnapshot;
+using testing::WriteBinaryFile;
+
+constexpr long kMemoryLimitKb = 2L << 20;  // ulimit -v: 2 GiB for every case
+constexpr double kTimeoutS = 20;           // per tool run; a hang ends as exit 124
+
+// ------------------------------------------------------------------------------------------
+// The valid inputs.
+
+// The scene of tests/cli/cli_bad_input_test.cc with smaller photos: 2x2 grid, 320x240 px.
+std::string ValidScene(bool png) {
+  json scene = {{"schema_version", 1},
+                {"setup",
+                 {{"distance_mm", 750},
+                  {"grid", {{"nu", 2}, {"nv", 2}, {"spacing_mm", 5}}},
+                  {"screen_mm", {1200, 1200}}}},
+                {"luminaire",
+                 {{"emitters",
+                   {{{"position_mm", {1.5, -2, -20}},
+                     {"intensity_w_sr", {1.0, 0.9, 0.8}},
+                     {"lobe_exponent", 8}},
+                    {{"position_mm", {-3, 1, -12}},
+                     {"intensity_w_sr", {0.5, 0.6, 0.9}},
+                     {"lobe_exponent", 3}}}}}},
+                {"camera",
+                 {{"size_px", {320, 240}},
+                  {"focal_px", 280},
+                  {"position_mm", {0, -200, 2400}},
+                  {"look_at_mm", {0, 0, 750}}}},
+                {"effects", png ? json::array({{{"type", "quantization"}, {"bit_depth", 16}}})
+                                : json::array()}};
+  return scene.dump(2) + "\n";
+}
+
+// What a case starts from (all under the case folder): scene.json (always), and ds/ at a stage.
+enum class Input {
+  kScene,          // scene.json only
+  kDataset,        // ds/: acquired (16-bit PNG photos), no calib/, no slab/
+  kCalibrated,     // ds/: + calib/screen.json
+  kSlab,           // ds/: + slab/ (40x40, complete)
+  kExrCalibrated,  // ds/: acquired with half-float EXR photos, + calib/screen.json
+};
+
+// The valid datasets, made once for a build of the tools and shared by every case process:
+// ctest starts one process per case, and making them in each (acquire, calibrate, reconstruct:
+// about 0.5 s) would double the catalogue's time. They live in the build tree under a key of the
+// sizes and times of the tools and of this test, are made under an exclusive lock (flock) into a
+// staging folder that is renamed into place, and are only ever read (each case works on its own
+// copy).
+class Masters {
+ public:
+  // The master dataset folder for `input` ("" for kScene); "" and `error` when making it failed.
+  static std::string Get(Input input, std::string* error) {
+    if (input == Input::kScene) return "";
+    const std::string root = Root(error);
+    if (root.empty()) return "";
+    return root + (input == Input::kExrCalibrated ? "/exr/ds" : "/png/ds");
+  }
+
+ private:
+  static std::string Key() {
+    uint64_t key = 1469598103934665603ull;
+    const std::string bin = std::string(LUMISLAB_BIN_DIR) + "/";
+    // The tools that make the masters, and this test (which holds the scene).
+    for (const std::string& file : {bin + "lumislab-acquire", bin + "lumislab-calibrate",
+                                    bin + "lumislab-reconstruct", std::string("/proc/self/exe")}) {
+      struct stat st {};
+      stat(file.c_str(), &st);
+      for (const uint64_t v :
+           {uint64_t(st.st_size), uint64_t(st.st_mtim.tv_sec), uint64_t(st.st_mtim.tv_nsec)})
+        key = (key ^ v) * 1099511628211ull;
+    }
+    std::ostringstream os;
+    os << std::hex << key;
+    return os.str();
+  }
+  static std::string Root(std::string* error) {
+    static std::string root, failure;
+    if (!root.empty() || !failure.empty()) {
+      *error = failure;
+      return root;
+    }
+    const std::string cache = LUMISLAB_CATALOGUE_CACHE;
+    fs::create_directories(cache);
+    const std::string dir = cache + "/" + Key();
+    const int lock = open((cache + "/lock").c_str(), O_CREAT | O_RDWR, 0644);
+    if (lock < 0 || flock(lock, LOCK_EX) != 0) {
+      failure = "cannot lock " + cache + "/lock";
+    } else {
+      if (!fs::exists(dir + "/complete")) {
+        // Masters of other builds of the tools are stale: remove them with any staging folder.
+        for (const auto& entry : fs::directory_iterator(cache))
+          if (entry.is_directory()) fs::remove_all(entry.path());
+        const std::string staging = cache + "/.staging" + std::to_string(getpid());
+        if (Build(staging + "/png", true, &failure) && Build(staging + "/exr", false, &failure)) {
+          testing::WriteFile(staging + "/complete", "");
+          fs::rename(staging, dir);
+        }
+        fs::remove_all(staging);
+      }
+      flock(lock, LOCK_UN);
+    }
+    if (lock >= 0) close(lock);
+    if (failure.empty()) root = dir;
+    *error = failure;
+    return root;
+  }
+  // acquire + calibrate (+ reconstruct at 40x40 for the PNG dataset) into dir/ds.
+  static bool Build(const std::string& dir, bool png, std::string* error) {
+    auto run = [&](const std::string& tool, const std::string& args) {
+      const CommandResult r = RunToolIn(dir, tool, args, 120);
+      if (r.exit_code != 0)
+        *error += tool + " " + args + " -> " + std::to_string(r.exit_code) + "\n" + r.output;
+      return r.exit_code == 0;
+    };
+    fs::create_directories(dir);
+    testing::WriteFile(dir + "/scene.json", ValidScene(png));
+    return run("lumislab-acquire", "synth --scene scene.json --out ds --truth-resolution 40") &&
+           run("lumislab-calibrate", "screen --dataset ds") &&
+           (!png || run("lumislab-reconstruct", "--dataset ds --resolution 40"));
+  }
+};
+
+// ------------------------------------------------------------------------------------------
+// Mutations: each changes the copy in the case folder (paths relative to it).
+
+using Mutation = std::function<void(const std::string& dir)>;
+
+json ReadJson(const std::string& path) { return json::parse(ReadBinaryFile(path)); }
+void WriteJson(const std::string& path, const json& value) {
+  WriteBinaryFile(path, value.dump(2) + "\n");
+}
+
+Mutation EditJson(const std::string& file, std::function<void(json&)> edit) {
+  return [=](const std::string& dir) {
+    json value = ReadJson(dir + "/" + file);
+    edit(value);
+    WriteJson(dir + "/" + file, value);
+  };
+}
+Mutation SetJson(const std::string& file, const std::string& pointer, const json& value) {
+  return EditJson(file, [=](json& j) { j[json::json_pointer(pointer)] = value; });
+}
+// Puts `raw` text (not necessarily JSON: NaN, 1e999, 100000 nested arrays) where `pointer` is.
+Mutation SetRaw(const std::string& file, const std::string& pointer, const std::string& raw) {
+  return [=](const std::string& dir) {
+    json value = ReadJson(dir + "/" + file);
+    value[json::json_pointer(pointer)] = "@@RAW@@";
+    std::string text = value.dump(2);
+    text.replace(text.find("\"@@RAW@@\""), 9, raw);
+    WriteBinaryFile(dir + "/" + file, text + "\n");
+  };
+}
+Mutation EraseJson(const std::string& file, const std::string& pointer) {
+  return EditJson(file, [=](json& j) {
+    const json::json_pointer ptr(pointer);
+    json& parent = j[ptr.parent_pointer()];
+    const std::string last = ptr.back();
+    if (parent.is_array())
+      parent.erase(size_t(std::stoul(last)));
+    else
+      parent.erase(last);
+  });
+}
+Mutation WriteText(const std::string& file, const std::string& text) {
+  return [=](const std::string& dir) { WriteBinaryFile(dir + "/" + file, text); };
+}
+Mutation Truncate(const std::string& file, double keep_fraction) {
+  return [=](const std::string& dir) {
+    const std::string bytes = ReadBinaryFile(dir + "/" + file);
+    WriteBinaryFile(dir + "/" + file, bytes.substr(0, size_t(bytes.size() * keep_fraction)));
+  };
+}
+Mutation RemovePath(const std::string& path) {
+  return [=](const std::string& dir) { fs::remove_all(dir + "/" + path); };
+}
+Mutation MakeFolder(const std::string& path) {
+  return [=](const std::string& dir) {
+    fs::remove_all(dir + "/" + path);
+    fs::create_directories(dir + "/" + path + "/inside");
+  };
+}
+Mutation MakeFifo(const std::string& path) {
+  return [=](const std::string& dir) {
+    fs::remove_all(dir + "/" + path);
+    if (mkfifo((dir + "/" + path).c_str(), 0644) != 0) throw std::runtime_error("mkfifo failed");
+  };
+}
+Mutation CopyPath(const std::string& from, const std::string& to) {
+  return [=](const std::string& dir) {
+    fs::remove_all(dir + "/" + to);
+    fs::copy(dir + "/" + from, dir + "/" + to, fs::copy_options::recursive);
+  };
+}
+std::string Nested(int depth) {
+  return std::string(size_t(depth), '[') + std::string(size_t(depth), ']');
+}
+// A valid JSON file of `megabytes` MB: the file's own content plus a long string member.
+Mutation Bloat(const std::string& file, int megabytes) {
+  return EditJson(file, [=](json& j) { j["padding"] = std::string(size_t(megabytes) << 20, 'x'); });
+}
+std::string Garbage() {
+  std::string bytes;
+  uint32_t x = 12345;
+  for (int k = 0; k < 4096; ++k) {
+    x = x * 1664525u + 1013904223u;
+    bytes += char(x >> 24);
+  }
+  return bytes;
+}
+
+// --- images
+
+cv::Mat ReadImage(const std::string& path) { return cv::imread(path, cv::IMREAD_UNCHANGED); }
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image)) throw std::runtime_error("cannot write " + path);
+}
+// The same photo as 8-bit (a camera's sRGB output among 16-bit linear photos).
+Mutation PngTo8Bit(const std::string& file) {
+  return [=](const std::string& dir) {
+    cv::Mat image = ReadImage(dir + "/" + file), out;
+    image.convertTo(out, CV_8U, 1.0 / 257);
+    WriteImage(dir + "/" + file, out);
+  };
+}
+Mutation PngResize(const std::string& file, int width, int height) {
+  return [=](const std::string& dir) {
+    cv::Mat image = ReadImage(dir + "/" + file), out;
+    cv::resize(image, out, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+    WriteImage(dir + "/" + file, out);
+  };
+}
+// A 32-bit float TIFF under the photo's name (float data comes only from EXR, §5.4).
+Mutation FloatTiff(const std::string& file) {
+  return [=](const std::string& dir) {
+    cv::Mat image = ReadImage(dir + "/" + file), out;
+    image.convertTo(out, CV_32F, 1.0 / 65535);
+    std::vector<uchar> bytes;
+    cv::imencode(".tiff", out, bytes);
+    WriteBinaryFile(dir + "/" + file, std::string(bytes.begin(), bytes.end()));
+  };
+}
+
+uint32_t Crc32(const std::string& bytes) {
+  uint32_t crc = 0xffffffffu;
+  for (const unsigned char c : bytes) {
+    crc ^= c;
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+std::string Be32(uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
+std::string PngChunk(const std::string& type, const std::string& data) {
+  return Be32(uint32_t(data.size())) + type + data + Be32(Crc32(type + data));
+}
+// A PNG whose header claims width x height 16-bit RGB pixels and which holds none of them.
+Mutation PngHugeHeader(const std::string& file, uint32_t width, uint32_t height) {
+  return [=](const std::string& dir) {
+    const std::string ihdr = Be32(width) + Be32(height) + std::string("\x10\x02\x00\x00\x00", 5);
+    // A valid zlib stream of a few zero bytes: the decoder would have to allocate first.
+    const std::string idat("\x78\x9c\x63\x00\x00\x00\x01\x00\x01", 9);
+    WriteBinaryFile(dir + "/" + file, std::string("\x89PNG\r\n\x1a\n", 8) + PngChunk("IHDR", ihdr) +
+                                          PngChunk("IDAT", idat) + PngChunk("IEND", ""));
+  };
+}
+
+// An EXR read as FLOAT channels with its header, to be changed and written back.
+struct ExrImage {
+  Imf::Header header;
+  int width = 0, height = 0;
+  std::map<std::string, std::vector<float>> channels;
+};
+ExrImage ReadAnyExr(const std::string& path) {
+  Imf::InputFile in(path.c_str());
+  ExrImage image;
+  image.header = in.header();
+  const Imath::Box2i dw = in.header().dataWindow();
+  image.width = dw.max.x - dw.min.x + 1;
+  image.height = dw.max.y - dw.min.y + 1;
+  Imf::FrameBuffer fb;
+  for (auto it = in.header().channels().begin(); it != in.header().channels().end(); ++it) {
+    auto& pixels = image.channels[it.name()];
+    pixels.assign(size_t(image.width) * image.height, 0.f);
+    char* base =
+        reinterpret_cast<char*>(pixels.data()) -
+        (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * image.width) * ptrdiff_t(sizeof(float));
+    fb.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * image.width));
+  }
+  in.setFrameBuffer(fb);
+  in.readPixels(dw.min.y, dw.max.y);
+  return image;
+}
+// Writes `image` as FLOAT channels with its header's attributes and a data window of its size.
+void WriteAnyExr(const std::string& path, ExrImage image) {
+  Imf::Header header = image.header;
+  const Imath::Box2i box(Imath::V2i(0, 0), Imath::V2i(image.width - 1, image.height - 1));
+  header.dataWindow() = box;
+  header.displayWindow() = box;
+  Imf::ChannelList channels;
+  for (const auto& entry : image.channels) channels.insert(entry.first, Imf::Channel(Imf::FLOAT));
+  header.channels() = channels;
+  Imf::OutputFile out(path.c_str(), header);
+  Imf::FrameBuffer fb;
+  for (auto& entry : image.channels)
+    fb.insert(entry.first, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(entry.second.data()),
+                                      sizeof(float), sizeof(float) * image.width));
+  out.setFrameBuffer(fb);
+  out.writePixels(image.height);
+}
+Mutation EditExr(const std::string& file, std::function<void(ExrImage&)> edit) {
+  return [=](const std::string& dir) {
+    ExrImage image = ReadAnyExr(dir + "/" + file);
+    edit(image);
+    WriteAnyExr(dir + "/" + file, image);
+  };
+}
+// A few values of `channel` set to `value` (NaN, Inf) in the middle of the image.
+Mutation ExrPoison(const std::string& file, const std::string& channel, float value) {
+  return EditExr(file, [=](ExrImage& image) {
+    auto& pixels = image.channels.at(channel);
+    const size_t centre = size_t(image.height / 2) * image.width + image.width / 2;
+    for (size_t k = 0; k < 16; ++k) pixels[centre + k] = value;
+  });
+}
+Mutation ExrResize(const std::string& file, int width, int height) {
+  return EditExr(file, [=](ExrImage& image) {
+    for (auto& entry : image.channels) {
+      cv::Mat in(image.height, image.width, CV_32F, entry.second.data()), out;
+      cv::resize(in, out, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+      entry.second.assign(out.begin<float>(), out.end<float>());
+    }
+    image.width = width;
+    image.height = height;
+  });
+}
+Mutation ExrDropChannel(const std::string& file, const std::string& channel) {
+  return EditExr(file, [=](ExrImage& image) { image.channels.erase(channel); });
+}
+Mutation ExrSetInt(const std::string& file, const std::string& attribute, int value) {
+  return EditExr(
+      file, [=](ExrImage& image) { image.header.insert(attribute, Imf::IntAttribute(value)); });
+}
+// A header that claims width x height pixels of `channels` and not one line of them (OpenEXR
+// writes the line-offset table as zeros): a reader must refuse it before allocating.
+Mutation ExrHugeHeader(const std::string& file, std::vector<std::string> channels, int width,
+                       int height) {
+  return [=](const std::string& dir) {
+    Imf::Header header(width, height);
+    for (const auto& c : channels) header.channels().insert(c, Imf::Channel(Imf::HALF));
+    header.compression() = Imf::ZIP_COMPRESSION;
+    const std::string path = dir + "/" + file;
+    fs::remove(path);
+    Imf::OutputFile out(path.c_str(), header);
+  };
+}
+
+// ------------------------------------------------------------------------------------------
+// The table.
+
+struct Case {
+  std::string name;
+  Input input = Input::kScene;
+  std::string tool;
+  std::string args;
+  std::vector<Mutation> mutations;
+  std::vector<std::string> mentions;  // all on one output line
+  int exit_code = 2;
+  // 8-bit among 16-bit photos: exit 2 naming the file, or exit 0 with a warning naming it.
+  bool warning_ok = false;
+  std::vector<std::string> may_change;      // path prefixes, relative to the case folder
+  std::vector<std::string> must_not_exist;  // even where may_change allows changes
+};
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+const std::string kPreview = "--slab ds/slab --scene plane --size 32x32 --out r.exr";
+
+// Fluent construction of a Case.
+class C {
+ public:
+  explicit C(std::string name) { c_.name = std::move(name); }
+  // lumislab-acquire synth on scene.json into out/ (nothing may appear there).
+  C& Synth(const std::string& extra = "") {
+    c_.tool = "lumislab-acquire";
+    c_.args = "synth --scene scene.json --out out" + (extra.empty() ? "" : " " + extra);
+    c_.input = Input::kScene;
+    return *this;
+  }
+  C& Filter(const std::string& args) {
+    c_.tool = "lumislab-acquire";
+    c_.args = "filter --out filt " + args;
+    c_.input = Input::kScene;
+    return *this;
+  }
+  C& Calibrate(const std::string& extra = "") {
+    c_.tool = "lumislab-calibrate";
+    c_.args = "screen --dataset ds" + (extra.empty() ? "" : " " + extra);
+    c_.input = Input::kDataset;
+    return *this;
+  }
+  C& Reconstruct(const std::string& extra = "") {
+    c_.tool = "lumislab-reconstruct";
+    c_.args = "--dataset ds --resolution 40" + (extra.empty() ? "" : " " + extra);
+    c_.input = Input::kCalibrated;
+    return *this;
+  }
+  C& ReconstructArgs(const std::string& args) {
+    c_.tool = "lumislab-reconstruct";
+    c_.args = args;
+    c_.input = Input::kCalibrated;
+    return *this;
+  }
+  C& Preview(const std::string& args = kPreview) {
+    c_.tool = "lumislab-preview";
+    c_.args = args;
+    c_.input = Input::kSlab;
+    return *this;
+  }
+  C& Args(const std::string& args) {
+    c_.args = args;
+    return *this;
+  }
+  C& From(Input input) {
+    c_.input = input;
+    return *this;
+  }
+  C& Do(Mutation m) {
+    c_.mutations.push_back(std::move(m));
+    return *this;
+  }
+  C& Names(std::vector<std::string> mentions) {
+    c_.mentions = std::move(mentions);
+    return *this;
+  }
+  C& Exit(int code) {
+    c_.exit_code = code;
+    return *this;
+  }
+  C& WarningOk() {
+    c_.warning_ok = true;
+    return *this;
+  }
+  C& MayChange(const std::string& prefix) {
+    c_.may_change.push_back(prefix);
+    return *this;
+  }
+  C& MustNotExist(const std::string& path) {
+    c_.must_not_exist.push_back(path);
+    return *this;
+  }
+  operator Case() const { return c_; }  // NOLINT: the table reads better without casts
+
+ private:
+  Case c_;
+};
+
+const std::string kDs = "ds/dataset.json";
+const std::string kScr = "ds/calib/screen.json";
+const std::string kSlabJson = "ds/slab/slab.json";
+const std::string kSceneFile = "scene.json";
+
+std::vector<Case> DatasetCases() {
+  std::vector<Case> v;
+  auto R = [](const std::string& name) { return C("dataset_" + name).Reconstruct(); };
+  auto K = [](const std::string& name) { return C("dataset_" + name).Calibrate(); };
+  // Whole file.
+  v.push_back(R("missing").Do(RemovePath(kDs)).Names({kDs}));
+  v.push_back(R("empty").Do(WriteText(kDs, "")).Names({kDs}));
+  v.push_back(R("not_json").Do(WriteText(kDs, "this is not JSON\n")).Names({kDs}));
+  v.push_back(R("binary_garbage").Do(WriteText(kDs, Garbage())).Names({kDs}));
+  v.push_back(R("truncated").Do(Truncate(kDs, 0.5)).Names({kDs}));
+  v.push_back(R("top_level_array").Do(WriteText(kDs, "[1, 2, 3]\n")).Names({kDs}));
+  v.push_back(R("top_level_null").Do(WriteText(kDs, "null\n")).Names({kDs}));
+  v.push_back(R("nested_100000_arrays").Do(WriteText(kDs, Nested(100000))).Names({kDs}));
+  v.push_back(R("nested_100000_in_setup").Do(SetRaw(kDs, "/setup", Nested(100000))).Names({kDs}));
+  v.push_back(R("nested_100000_objects")
+                  .Do(WriteText(kDs,
+                                [] {
+                                  std::string s;
+                                  for (int k = 0; k < 100000; ++k) s += "{\"a\":";
+                                  return s + "1" + std::string(100000, '}');
+                                }()))
+                  .Names({kDs}));
+  v.push_back(R("file_50mb").Do(Bloat(kDs, 50)).Names({kDs}));
+  v.push_back(R("is_a_folder").Do(MakeFolder(kDs)).Names({kDs}));
+  v.push_back(R("is_a_fifo").Do(MakeFifo(kDs)).Names({kDs}));
+  v.push_back(K("is_a_fifo_calibrate").Do(MakeFifo(kDs)).Names({kDs}));
+  v.push_back(K("not_json_calibrate").Do(WriteText(kDs, "{\"schema_version\": 2,")).Names({kDs}));
+  // schema_version.
+  v.push_back(R("schema_version_99")
+                  .Do(SetJson(kDs, "/schema_version", 99))
+                  .Names({kDs, "schema_version", "99"}));
+  v.push_back(R("schema_version_string")
+                  .Do(SetJson(kDs, "/schema_version", "2"))
+                  .Names({kDs, "schema_version"}));
+  v.push_back(R("schema_version_fraction")
+                  .Do(SetJson(kDs, "/schema_version", 1.5))
+                  .Names({kDs, "schema_version"}));
+  v.push_back(R("schema_version_missing")
+                  .Do(EraseJson(kDs, "/schema_version"))
+                  .Names({kDs, "schema_version"}));
+  // setup.distance_mm.
+  const std::vector<std::pair<std::string, json>> bad_lengths = {
+      {"string", "far"},     {"zero", 0},
+      {"negative", -750},    {"tiny", 1e-9},
+      {"huge", 1e12},        {"max", 1e308},
+      {"nan_string", "NaN"}, {"null", nullptr},
+      {"array", {750}},      {"inf_string", "Infinity"}};
+  for (const auto& [suffix, value] : bad_lengths)
+    v.push_back(R("distance_" + suffix)
+                    .Do(SetJson(kDs, "/setup/distance_mm", value))
+                    .Names({kDs, "setup.distance_mm"}));
+  v.push_back(R("distance_missing")
+                  .Do(EraseJson(kDs, "/setup/distance_mm"))
+                  .Names({kDs, "setup.distance_mm"}));
+  v.push_back(R("distance_1e999").Do(SetRaw(kDs, "/setup/distance_mm", "1e999")).Names({kDs}));
+  v.push_back(R("distance_bare_nan").Do(SetRaw(kDs, "/setup/distance_mm", "NaN")).Names({kDs}));
+  v.push_back(K("distance_negative_calibrate")
+                  .Do(SetJson(kDs, "/setup/distance_mm", -750))
+                  .Names({kDs, "setup.distance_mm"}));
+  // setup.grid.
+  for (const auto& [suffix, value] :
+       std::vector<std::pair<std::string, json>>{{"negative", -3},
+                                                 {"zero", 0},
+                                                 {"1001", 1001},
+                                                 {"1e9", 1000000000},
+                                                 {"fraction", 2.5},
+                                                 {"string", "2"},
+                                                 {"huge_float", 1e12}})
+    v.push_back(R("grid_nu_" + suffix)
+                    .Do(SetJson(kDs, "/setup/grid/nu", value))
+                    .Names({kDs, "setup.grid.nu"}));
+  v.push_back(
+      R("grid_nv_zero").Do(SetJson(kDs, "/setup/grid/nv", 0)).Names({kDs, "setup.grid.nv"}));
+  v.push_back(
+      R("grid_nv_missing").Do(EraseJson(kDs, "/setup/grid/nv")).Names({kDs, "setup.grid.nv"}));
+  v.push_back(
+      R("grid_not_object").Do(SetJson(kDs, "/setup/grid", "2x2")).Names({kDs, "setup.grid"}));
+  v.push_back(K("grid_nu_negative_calibrate")
+                  .Do(SetJson(kDs, "/setup/grid/nu", -3))
+                  .Names({kDs, "setup.grid.nu", "-3"}));
+  for (const auto& [suffix, value] : std::vector<std::pair<std::string, json>>{
+           {"zero", 0}, {"negative", -5}, {"huge", 1e12}, {"nan_string", "NaN"}})
+    v.push_back(R("grid_spacing_" + suffix)
+                    .Do(SetJson(kDs, "/setup/grid/spacing_mm", value))
+                    .Names({kDs, "setup.grid.spacing_mm"}));
+  // setup.screen_mm.
+  for (const auto& [suffix, value] :
+       std::vector<std::pair<std::string, json>>{{"one_value", {1200}},
+                                                 {"three_values", {1200, 1200, 1200}},
+                                                 {"zero", {0, 1200}},
+                                                 {"negative", {1200, -1}},
+                                                 {"huge", {1e308, 1200}},
+                                                 {"string_element", {1200, "x"}},
+                                                 {"string", "wide"}})
+    v.push_back(R("screen_" + suffix)
+                    .Do(SetJson(kDs, "/setup/screen_mm", value))
+                    .Names({kDs, "setup.screen_mm"}));
+  // filter.
+  v.push_back(R("filter_missing").Do(EraseJson(kDs, "/filter")).Names({kDs, "filter"}));
+  v.push_back(
+      R("filter_basis_box").Do(SetJson(kDs, "/filter/basis", "box")).Names({kDs, "filter.basis"}));
+  v.push_back(R("filter_spacing_mismatch")
+                  .Do(SetJson(kDs, "/filter/spacing_mm", 6))
+                  .Names({kDs, "filter.spacing_mm"}));
+  v.push_back(R("filter_spacing_negative")
+                  .Do(SetJson(kDs, "/filter/spacing_mm", -5))
+                  .Names({kDs, "filter.spacing_mm"}));
+  v.push_back(R("filter_coefficients_empty")
+                  .Do(SetJson(kDs, "/filter/dual_coefficients", json::array()))
+                  .Names({kDs, "filter.dual_coefficients"}));
+  v.push_back(R("filter_coefficients_ten")
+                  .Do(SetJson(kDs, "/filter/dual_coefficients", std::vector<double>(10, 0.1)))
+                  .Names({kDs, "filter.dual_coefficients"}));
+  v.push_back(R("filter_coefficients_string")
+                  .Do(SetJson(kDs, "/filter/dual_coefficients", {1.36, "x"}))
+                  .Names({kDs, "filter.dual_coefficients"}));
+  v.push_back(R("filter_coefficients_nan_string")
+                  .Do(SetJson(kDs, "/filter/dual_coefficients/0", "NaN"))
+                  .Names({kDs, "filter.dual_coefficients"}));
+  v.push_back(
+      R("filter_peak_zero").Do(SetJson(kDs, "/filter/peak", 0)).Names({kDs, "filter.peak"}));
+  v.push_back(
+      R("filter_peak_negative").Do(SetJson(kDs, "/filter/peak", -1.8)).Names({kDs, "filter.peak"}));
+  v.push_back(R("filter_peak_inf_string")
+                  .Do(SetJson(kDs, "/filter/peak", "Infinity"))
+                  .Names({kDs, "filter.peak"}));
+  // radiometry.
+  v.push_back(R("radiometry_missing").Do(EraseJson(kDs, "/radiometry")).Names({kDs, "radiometry"}));
+  v.push_back(R("radiometry_scale_zero")
+                  .Do(SetJson(kDs, "/radiometry/scale_w_m2", 0))
+                  .Names({kDs, "radiometry.scale_w_m2"}));
+  v.push_back(R("radiometry_scale_negative")
+                  .Do(SetJson(kDs, "/radiometry/scale_w_m2", -1.9))
+                  .Names({kDs, "radiometry.scale_w_m2"}));
+  v.push_back(R("radiometry_saturation_zero")
+                  .Do(SetJson(kDs, "/radiometry/saturation_level", 0))
+                  .Names({kDs, "radiometry.saturation_level"}));
+  v.push_back(R("radiometry_transfer_gamma")
+                  .Do(SetJson(kDs, "/radiometry/transfer", "gamma"))
+                  .Names({kDs, "radiometry.transfer"}));
+  v.push_back(R("radiometry_black_level_high")
+                  .Do(SetJson(kDs, "/radiometry/black_level", 0.7))
+                  .Names({kDs, "radiometry.black_level"}));
+  v.push_back(R("radiometry_black_level_negative")
+                  .Do(SetJson(kDs, "/radiometry/black_level", -0.1))
+                  .Names({kDs, "radiometry.black_level"}));
+  v.push_back(R("radiometry_white_level_low")
+                  .Do(SetJson(kDs, "/radiometry/white_level", 0.1))
+                  .Names({kDs, "radiometry.white_level"}));
+  v.push_back(R("radiometry_white_level_huge")
+                  .Do(SetJson(kDs, "/radiometry/white_level", 1e7))
+                  .Names({kDs, "radiometry.white_level"}));
+  v.push_back(R("radiometry_white_equals_black")
+                  .Do(SetJson(kDs, "/radiometry/black_level", 0.5))
+                  .Do(SetJson(kDs, "/radiometry/white_level", 0.5))
+                  .Names({kDs, "white_level"}));
+  // calibration (read by calibrate).
+  v.push_back(
+      K("calibration_missing").Do(EraseJson(kDs, "/calibration")).Names({kDs, "calibration"}));
+  v.push_back(K("calibration_photo_number")
+                  .Do(SetJson(kDs, "/calibration/photo", 5))
+                  .Names({kDs, "calibration.photo"}));
+  v.push_back(K("calibration_photo_empty")
+                  .Do(SetJson(kDs, "/calibration/photo", ""))
+                  .Names({kDs, "calibration.photo"}));
+  v.push_back(K("calibration_photo_dotdot")
+                  .Do(SetJson(kDs, "/calibration/photo", "../ds/photos/calib_0.png"))
+                  .Names({kDs, "calibration.photo"}));
+  v.push_back(K("calibration_photo_absolute")
+                  .Do(SetJson(kDs, "/calibration/photo", "/etc/hostname"))
+                  .Names({kDs, "calibration.photo"}));
+  v.push_back(K("calibration_type_circles")
+                  .Do(SetJson(kDs, "/calibration/target/type", "circles"))
+                  .Names({kDs, "calibration.target.type"}));
+  v.push_back(K("calibration_squares_square")
+                  .Do(SetJson(kDs, "/calibration/target/squares", {14, 14}))
+                  .Names({kDs, "calibration.target.squares"}));
+  v.push_back(K("calibration_squares_two")
+                  .Do(SetJson(kDs, "/calibration/target/squares", {2, 13}))
+                  .Names({kDs, "calibration.target.squares"}));
+  v.push_back(K("calibration_squares_201")
+                  .Do(SetJson(kDs, "/calibration/target/squares", {201, 13}))
+                  .Names({kDs, "calibration.target.squares"}));
+  v.push_back(K("calibration_squares_one_value")
+                  .Do(SetJson(kDs, "/calibration/target/squares", {14}))
+                  .Names({kDs, "calibration.target.squares"}));
+  v.push_back(K("calibration_square_mm_zero")
+                  .Do(SetJson(kDs, "/calibration/target/square_mm", 0))
+                  .Names({kDs, "calibration.target.square_mm"}));
+  v.push_back(K("calibration_square_mm_negative")
+                  .Do(SetJson(kDs, "/calibration/target/square_mm", -80))
+                  .Names({kDs, "calibration.target.square_mm"}));
+  v.push_back(K("calibration_origin_string")
+                  .Do(SetJson(kDs, "/calibration/target/origin_mm", {"a", 0}))
+                  .Names({kDs, "calibration.target.origin_mm"}));
+  v.push_back(K("calibration_origin_nan_string")
+                  .Do(SetJson(kDs, "/calibration/target/origin_mm/1", "NaN"))
+                  .Names({kDs, "calibration.target.origin_mm"}));
+  // photos.
+  v.push_back(R("photos_missing").Do(EraseJson(kDs, "/photos")).Names({kDs, "photos"}));
+  v.push_back(
+      R("photos_not_array").Do(SetJson(kDs, "/photos", json::object())).Names({kDs, "photos"}));
+  v.push_back(R("photos_empty").Do(SetJson(kDs, "/photos", json::array())).Names({kDs, "photos"}));
+  v.push_back(
+      R("photo_i_negative").Do(SetJson(kDs, "/photos/0/i", -1)).Names({kDs, "photos[0].i"}));
+  v.push_back(
+      R("photo_i_outside_grid").Do(SetJson(kDs, "/photos/0/i", 2)).Names({kDs, "photos[0].i"}));
+  v.push_back(
+      R("photo_j_outside_grid").Do(SetJson(kDs, "/photos/3/j", 5)).Names({kDs, "photos[3].j"}));
+  v.push_back(R("photo_i_string").Do(SetJson(kDs, "/photos/0/i", "0")).Names({kDs, "photos[0].i"}));
+  v.push_back(R("photo_i_missing").Do(EraseJson(kDs, "/photos/0/i")).Names({kDs, "photos[0].i"}));
+  v.push_back(R("photo_entry_outside_grid")
+                  .Do(EditJson(
+                      kDs,
+                      [](json& j) {
+                        j["photos"].push_back(
+                            {{"i", 7}, {"j", 0}, {"slide", "p"}, {"file", "photos/pos_0_0_p.png"}});
+                      }))
+                  .Names({kDs, "photos[8].i"}));
+  v.push_back(
+      R("photo_slide_x").Do(SetJson(kDs, "/photos/0/slide", "x")).Names({kDs, "photos[0].slide"}));
+  v.push_back(R("photo_slide_missing")
+                  .Do(EraseJson(kDs, "/photos/0/slide"))
+                  .Names({kDs, "photos[0].slide"}));
+  v.push_back(R("photo_file_absolute")
+                  .Do(SetJson(kDs, "/photos/0/file", "/etc/hostname"))
+                  .Names({kDs, "photos[0].file"}));
+  v.push_back(R("photo_file_dotdot")
+                  .Do(SetJson(kDs, "/photos/0/file", "../ds/photos/pos_0_0_p.png"))
+                  .Names({kDs, "photos[0].file"}));
+  v.push_back(R("photo_file_inner_dotdot")
+                  .Do(SetJson(kDs, "/photos/0/file", "photos/../../ds/photos/pos_0_0_p.png"))
+                  .Names({kDs, "photos[0].file"}));
+  v.push_back(
+      R("photo_file_empty").Do(SetJson(kDs, "/photos/0/file", "")).Names({kDs, "photos[0].file"}));
+  v.push_back(
+      R("photo_file_number").Do(SetJson(kDs, "/photos/0/file", 42)).Names({kDs, "photos[0].file"}));
+  v.push_back(R("photo_exposure_zero")
+                  .Do(SetJson(kDs, "/photos/0/exposure", 0))
+                  .Names({kDs, "photos[0].exposure"}));
+  v.push_back(R("photo_exposure_negative")
+                  .Do(SetJson(kDs, "/photos/0/exposure", -1))
+                  .Names({kDs, "photos[0].exposure"}));
+  v.push_back(R("photo_exposure_string")
+                  .Do(SetJson(kDs, "/photos/0/exposure", "bright"))
+                  .Names({kDs, "photos[0].exposure"}));
+  // The n photo of position (1, 1) is the last entry.
+  v.push_back(R("photo_missing_slide").Do(EraseJson(kDs, "/photos/7")).Names({kDs, "photos"}));
+  v.push_back(R("photo_duplicate_entry")
+                  .Do(EditJson(kDs, [](json& j) { j["photos"].push_back(j["photos"][0]); }))
+                  .Names({kDs, "photos"}));
+  return v;
+}
+
+std::vector<Case> ScreenCalibrationCases() {
+  std::vector<Case> v;
+  auto R = [](const std::string& name) { return C("screen_" + name).Reconstruct(); };
+  v.push_back(R("missing").Do(RemovePath(kScr)).Names({kScr}));
+  v.push_back(R("empty").Do(WriteText(kScr, "")).Names({kScr}));
+  v.push_back(R("truncated").Do(Truncate(kScr, 0.5)).Names({kScr}));
+  v.push_back(R("not_json").Do(WriteText(kScr, Garbage())).Names({kScr}));
+  v.push_back(R("nested_100000_arrays").Do(WriteText(kScr, Nested(100000))).Names({kScr}));
+  v.push_back(R("file_50mb").Do(Bloat(kScr, 50)).Names({kScr}));
+  v.push_back(R("is_a_folder").Do(MakeFolder(kScr)).Names({kScr}));
+  v.push_back(R("is_a_fifo").Do(MakeFifo(kScr)).Names({kScr}));
+  v.push_back(R("schema_version_99")
+                  .Do(SetJson(kScr, "/schema_version", 99))
+                  .Names({kScr, "schema_version"}));
+  v.push_back(
+      R("image_size_zero").Do(SetJson(kScr, "/image_size", {0, 240})).Names({kScr, "image_size"}));
+  v.push_back(R("image_size_huge")
+                  .Do(SetJson(kScr, "/image_size", {1000000000, 240}))
+                  .Names({kScr, "image_size"}));
+  v.push_back(R("image_size_one_value")
+                  .Do(SetJson(kScr, "/image_size", {320}))
+                  .Names({kScr, "image_size"}));
+  // Valid on its own, but not the size of the photos.
+  v.push_back(R("image_size_not_photos")
+                  .Do(SetJson(kScr, "/image_size", {640, 480}))
+                  .Names({kScr, "640x480"}));
+  v.push_back(R("homography_eight_values")
+                  .Do(EraseJson(kScr, "/screen_from_image/8"))
+                  .Names({kScr, "screen_from_image"}));
+  v.push_back(R("homography_zero")
+                  .Do(SetJson(kScr, "/screen_from_image", std::vector<double>(9, 0.0)))
+                  .Names({kScr, "screen_from_image"}));
+  v.push_back(
+      R("homography_singular")
+          .Do(SetJson(kScr, "/screen_from_image", {3.13, 0, -1000, 6.26, 0, -2000, 0, 0, 1}))
+          .Names({kScr, "screen_from_image"}));
+  v.push_back(R("homography_nan_string")
+                  .Do(SetJson(kScr, "/screen_from_image/4", "NaN"))
+                  .Names({kScr, "screen_from_image"}));
+  v.push_back(R("homography_null")
+                  .Do(SetJson(kScr, "/screen_from_image/0", nullptr))
+                  .Names({kScr, "screen_from_image"}));
+  v.push_back(R("homography_1e308")
+                  .Do(SetJson(kScr, "/screen_from_image/0", 1e308))
+                  .Names({kScr, "screen_from_image"}));
+  v.push_back(R("distortion_model_fisheye")
+                  .Do(SetJson(kScr, "/distortion/model", "fisheye"))
+                  .Names({kScr, "distortion.model"}));
+  v.push_back(R("distortion_k1_nan_string")
+                  .Do(SetJson(kScr, "/distortion/k1", "NaN"))
+                  .Names({kScr, "distortion.k1"}));
+  v.push_back(R("distortion_k1_huge")
+                  .Do(SetJson(kScr, "/distortion/k1", 1e6))
+                  .Names({kScr, "distortion.k1"}));
+  v.push_back(R("distortion_k2_missing")
+                  .Do(EraseJson(kScr, "/distortion/k2"))
+                  .Names({kScr, "distortion.k2"}));
+  v.push_back(R("distortion_scale_zero")
+                  .Do(SetJson(kScr, "/distortion/scale_px", 0))
+                  .Names({kScr, "distortion.scale_px"}));
+  v.push_back(R("distortion_scale_negative")
+                  .Do(SetJson(kScr, "/distortion/scale_px", -200))
+                  .Names({kScr, "distortion.scale_px"}));
+  v.push_back(R("distortion_centre_string")
+                  .Do(SetJson(kScr, "/distortion/centre_px", {"x", 119.5}))
+                  .Names({kScr, "distortion.centre_px"}));
+  v.push_back(R("report_rms_negative")
+                  .Do(SetJson(kScr, "/report/rms_px", -1))
+                  .Names({kScr, "report.rms_px"}));
+  v.push_back(R("report_corners_negative")
+                  .Do(SetJson(kScr, "/report/corners_used", -5))
+                  .Names({kScr, "report.corners_used"}));
+  return v;
+}
+
+std::vector<Case> PhotoCases() {
+  std::vector<Case> v;
+  // The bad photo is of position (1, 0); the other positions may be written (a partial slab is
+  // valid), that one never.
+  const std::string p = "ds/photos/pos_1_0_p.png";
+  auto R = [](const std::string& name) {
+    return C("photo_" + name)
+        .Reconstruct()
+        .MayChange("ds/slab/")
+        .MustNotExist("ds/slab/pos_1_0.exr");
+  };
+  v.push_back(R("missing").Do(RemovePath(p)).Names({p}));
+  v.push_back(R("empty_file").Do(WriteText(p, "")).Names({p}));
+  v.push_back(R("truncated_png").Do(Truncate(p, 0.5)).Names({p}));
+  v.push_back(
+      R("png_signature_only").Do(WriteText(p, std::string("\x89PNG\r\n\x1a\n", 8))).Names({p}));
+  v.push_back(
+      R("text_renamed_png").Do(WriteText(p, "this is a text file, not a photo\n")).Names({p}));
+  v.push_back(R("is_a_folder").Do(MakeFolder(p)).Names({p}));
+  v.push_back(R("is_a_fifo").Do(MakeFifo(p)).Names({p}));
+  v.push_back(R("wrong_size").Do(PngResize(p, 160, 120)).Names({p}));
+  v.push_back(R("float_tiff").Do(FloatTiff(p)).Names({p}));
+  v.push_back(R("png_header_32768").Do(PngHugeHeader(p, 32768, 32768)).Names({p}));
+  v.push_back(R("png_header_1x2e9").Do(PngHugeHeader(p, 1, 2000000000)).Names({p}));
+  // 8-bit among 16-bit: accepted as exit 2 naming the photo, or exit 0 with a warning naming it.
+  v.push_back(R("8bit_among_16bit").Do(PngTo8Bit(p)).Names({p}).WarningOk());
+  // --force over a complete slab: the previous slab must stay as it was, byte for byte.
+  v.push_back(C("photo_truncated_png_force_keeps_slab")
+                  .Reconstruct("--force")
+                  .From(Input::kSlab)
+                  .Do(Truncate(p, 0.5))
+                  .Names({p}));
+  v.push_back(C("photo_missing_force_keeps_slab")
+                  .Reconstruct("--force")
+                  .From(Input::kSlab)
+                  .Do(RemovePath(p))
+                  .Names({p}));
+  v.push_back(C("photo_is_a_fifo_force_keeps_slab")
+                  .Reconstruct("--force")
+                  .From(Input::kSlab)
+                  .Do(MakeFifo(p))
+                  .Names({p}));
+  // EXR photos (half-float, as acquire writes them by default).
+  const std::string e = "ds/photos/pos_1_0_p.exr";
+  auto X = [](const std::string& name) {
+    return C("photo_exr_" + name)
+        .Reconstruct()
+        .From(Input::kExrCalibrated)
+        .MayChange("ds/slab/")
+        .MustNotExist("ds/slab/pos_1_0.exr");
+  };
+  v.push_back(X("truncated").Do(Truncate(e, 0.5)).Names({e}));
+  v.push_back(X("header_only").Do(Truncate(e, 0.02)).Names({e}));
+  v.push_back(X("empty_file").Do(WriteText(e, "")).Names({e}));
+  v.push_back(
+      X("header_32768x32768").Do(ExrHugeHeader(e, {"R", "G", "B"}, 32768, 32768)).Names({e}));
+  v.push_back(
+      X("nan_values").Do(ExrPoison(e, "G", std::numeric_limits<float>::quiet_NaN())).Names({e}));
+  v.push_back(
+      X("inf_values").Do(ExrPoison(e, "R", std::numeric_limits<float>::infinity())).Names({e}));
+  v.push_back(X("negative_inf_values")
+                  .Do(ExrPoison(e, "B", -std::numeric_limits<float>::infinity()))
+                  .Names({e}));
+  v.push_back(X("no_green_channel").Do(ExrDropChannel(e, "G")).Names({e, "G"}));
+  v.push_back(X("wrong_size").Do(ExrResize(e, 160, 120)).Names({e}));
+  // The board photo, read by calibrate.
+  const std::string b = "ds/photos/calib_0.png";
+  auto B = [](const std::string& name) { return C("calib_photo_" + name).Calibrate(); };
+  v.push_back(B("missing").Do(RemovePath(b)).Names({b}));
+  v.push_back(B("empty_file").Do(WriteText(b, "")).Names({b}));
+  v.push_back(B("truncated").Do(Truncate(b, 0.5)).Names({b}));
+  v.push_back(B("text_renamed_png").Do(WriteText(b, "not a photo\n")).Names({b}));
+  v.push_back(B("is_a_folder").Do(MakeFolder(b)).Names({b}));
+  v.push_back(B("is_a_fifo").Do(MakeFifo(b)).Names({b}));
+  v.push_back(B("png_header_32768").Do(PngHugeHeader(b, 32768, 32768)).Names({b}));
+  v.push_back(B("no_board").Do(CopyPath("ds/photos/pos_0_0_p.png", b)).Names({b}));
+  v.push_back(B("tiny_32x24").Do(PngResize(b, 32, 24)).Names({b}));
+  return v;
+}
+
+std::vector<Case> SceneCases() {
+  std::vector<Case> v;
+  const std::string& s = kSceneFile;
+  auto S = [](const std::string& name) { return C("scene_" + name).Synth(); };
+  v.push_back(S("missing").Do(RemovePath(s)).Names({s}));
+  v.push_back(S("empty").Do(WriteText(s, "")).Names({s}));
+  v.push_back(S("not_json").Do(WriteText(s, "scene: default\n")).Names({s}));
+  v.push_back(S("binary_garbage").Do(WriteText(s, Garbage())).Names({s}));
+  v.push_back(S("nested_100000_arrays").Do(WriteText(s, Nested(100000))).Names({s}));
+  v.push_back(
+      S("nested_in_emitters").Do(SetRaw(s, "/luminaire/emitters", Nested(100000))).Names({s}));
+  v.push_back(S("file_50mb").Do(Bloat(s, 50)).Names({s}));
+  v.push_back(S("is_a_folder").Do(MakeFolder(s)).Names({s}));
+  v.push_back(S("is_a_fifo").Do(MakeFifo(s)).Names({s}));
+  v.push_back(
+      S("schema_version_99").Do(SetJson(s, "/schema_version", 99)).Names({s, "schema_version"}));
+  for (const auto& [suffix, value] :
+       std::vector<std::pair<std::string, json>>{{"tiny", 1e-9},
+                                                 {"zero", 0},
+                                                 {"negative", -750},
+                                                 {"huge", 1e12},
+                                                 {"string", "far"},
+                                                 {"nan_string", "NaN"}})
+    v.push_back(S("distance_" + suffix)
+                    .Do(SetJson(s, "/setup/distance_mm", value))
+                    .Names({s, "setup.distance_mm"}));
+  v.push_back(S("distance_1e999").Do(SetRaw(s, "/setup/distance_mm", "1e999")).Names({s}));
+  for (const auto& [suffix, value] : std::vector<std::pair<std::string, json>>{
+           {"zero", 0}, {"negative", -1}, {"1e9", 1000000000}, {"fraction", 2.5}})
+    v.push_back(
+        S("grid_nu_" + suffix).Do(SetJson(s, "/setup/grid/nu", value)).Names({s, "setup.grid.nu"}));
+  v.push_back(S("grid_nv_zero").Do(SetJson(s, "/setup/grid/nv", 0)).Names({s, "setup.grid.nv"}));
+  for (const auto& [suffix, value] :
+       std::vector<std::pair<std::string, json>>{{"zero", 0}, {"negative", -5}, {"huge", 1e9}})
+    v.push_back(S("grid_spacing_" + suffix)
+                    .Do(SetJson(s, "/setup/grid/spacing_mm", value))
+                    .Names({s, "setup.grid.spacing_mm"}));
+  for (const auto& [suffix, value] :
+       std::vector<std::pair<std::string, json>>{{"zero", {0, 1200}},
+                                                 {"one_value", {1200}},
+                                                 {"negative", {1200, -1}},
+                                                 {"huge", {1e12, 1200}}})
+    v.push_back(S("screen_" + suffix)
+                    .Do(SetJson(s, "/setup/screen_mm", value))
+                    .Names({s, "setup.screen_mm"}));
+  for (const auto& [suffix, value] :
+       std::vector<std::pair<std::string, json>>{{"0", 0}, {"9", 9}, {"string", "x"}})
+    v.push_back(
+        S("k_max_" + suffix).Do(SetJson(s, "/filter/k_max", value)).Names({s, "filter.k_max"}));
+  v.push_back(S("emitters_empty")
+                  .Do(SetJson(s, "/luminaire/emitters", json::array()))
+                  .Names({s, "luminaire.emitters"}));
+  v.push_back(S("emitters_missing")
+                  .Do(EraseJson(s, "/luminaire/emitters"))
+                  .Names({s, "luminaire.emitters"}));
+  const std::string em = "luminaire.emitters[0]";
+  v.push_back(S("emitter_z_zero")
+                  .Do(SetJson(s, "/luminaire/emitters/0/position_mm/2", 0))
+                  .Names({s, em + ".position_mm"}));
+  v.push_back(S("emitter_z_positive")
+                  .Do(SetJson(s, "/luminaire/emitters/0/position_mm/2", 5))
+                  .Names({s, em + ".position_mm"}));
+  v.push_back(S("emitter_two_coordinates")
+                  .Do(SetJson(s, "/luminaire/emitters/0/position_mm", {1, 2}))
+                  .Names({s, em + ".position_mm"}));
+  v.push_back(S("emitter_far_away")
+                  .Do(SetJson(s, "/luminaire/emitters/0/position_mm", {0, 0, -1e12}))
+                  .Names({s, em + ".position_mm"}));
+  v.push_back(S("intensity_negative")
+                  .Do(SetJson(s, "/luminaire/emitters/0/intensity_w_sr/1", -0.9))
+                  .Names({s, em + ".intensity_w_sr"}));
+  v.push_back(S("intensity_huge")
+                  .Do(SetJson(s, "/luminaire/emitters/0/intensity_w_sr/0", 1e308))
+                  .Names({s, em + ".intensity_w_sr"}));
+  v.push_back(S("intensity_nan_string")
+                  .Do(SetJson(s, "/luminaire/emitters/0/intensity_w_sr/2", "NaN"))
+                  .Names({s, em + ".intensity_w_sr"}));
+  v.push_back(S("intensity_two_values")
+                  .Do(SetJson(s, "/luminaire/emitters/0/intensity_w_sr", {1.0, 0.9}))
+                  .Names({s, em + ".intensity_w_sr"}));
+  v.push_back(S("lobe_negative")
+                  .Do(SetJson(s, "/luminaire/emitters/0/lobe_exponent", -1))
+                  .Names({s, em + ".lobe_exponent"}));
+  v.push_back(S("lobe_huge")
+                  .Do(SetJson(s, "/luminaire/emitters/0/lobe_exponent", 1e308))
+                  .Names({s, em + ".lobe_exponent"}));
+  const std::string cam = "camera";
+  v.push_back(
+      S("camera_size_tiny").Do(SetJson(s, "/camera/size_px", {8, 6})).Names({s, "camera.size_px"}));
+  v.push_back(S("camera_size_huge")
+                  .Do(SetJson(s, "/camera/size_px", {100000, 100000}))
+                  .Names({s, "camera.size_px"}));
+  v.push_back(S("camera_size_one_value")
+                  .Do(SetJson(s, "/camera/size_px", {320}))
+                  .Names({s, "camera.size_px"}));
+  v.push_back(S("camera_size_fraction")
+                  .Do(SetJson(s, "/camera/size_px", {320.5, 240}))
+                  .Names({s, "camera.size_px"}));
+  v.push_back(
+      S("camera_focal_zero").Do(SetJson(s, "/camera/focal_px", 0)).Names({s, "camera.focal_px"}));
+  v.push_back(S("camera_focal_negative")
+                  .Do(SetJson(s, "/camera/focal_px", -280))
+                  .Names({s, "camera.focal_px"}));
+  v.push_back(S("camera_look_at_position")
+                  .Do(SetJson(s, "/camera/look_at_mm", {0, -200, 2400}))
+                  .Names({s, "camera.look_at_mm"}));
+  v.push_back(S("camera_on_screen_plane")
+                  .Do(SetJson(s, "/camera/position_mm", {0, -200, 750}))
+                  .Names({s, "camera.position_mm"}));
+  v.push_back(S("camera_exposure_zero")
+                  .Do(SetJson(s, "/camera/exposure", 0))
+                  .Names({s, "camera.exposure"}));
+  v.push_back(S("camera_scale_negative")
+                  .Do(SetJson(s, "/camera/radiometric_scale_w_m2", -1))
+                  .Names({s, "camera.radiometric_scale_w_m2"}));
+  v.push_back(S("board_square")
+                  .Do(SetJson(s, "/calibration", {{"squares", {14, 14}}}))
+                  .Names({s, "calibration"}));
+  v.push_back(S("board_two_squares")
+                  .Do(SetJson(s, "/calibration", {{"squares", {2, 13}}}))
+                  .Names({s, "calibration.squares"}));
+  v.push_back(S("board_larger_than_screen")
+                  .Do(SetJson(s, "/calibration", {{"square_mm", 500}}))
+                  .Names({s, "calibration"}));
+  v.push_back(S("board_square_mm_zero")
+                  .Do(SetJson(s, "/calibration", {{"square_mm", 0}}))
+                  .Names({s, "calibration.square_mm"}));
+  // The camera looks 5 m to the side: the board is not in its view.
+  v.push_back(
+      S("board_out_of_view").Do(SetJson(s, "/camera/look_at_mm", {5000, 0, 750})).Names({s}));
+  // Zoomed in on the middle of the board: only part of it is in view.
+  v.push_back(S("board_partly_out_of_view").Do(SetJson(s, "/camera/focal_px", 3000)).Names({s}));
+  v.push_back(S("effect_unknown")
+                  .Do(SetJson(s, "/effects", {{{"type", "lens_flare"}}}))
+                  .Names({s, "effects[0].type", "lens_flare"}));
+  v.push_back(S("effect_unknown_parameter")
+                  .Do(SetJson(s, "/effects", {{{"type", "quantization"}, {"gamma", 2.2}}}))
+                  .Names({s, "effects[0]", "gamma"}));
+  v.push_back(S("effect_type_missing")
+                  .Do(SetJson(s, "/effects", {{{"bit_depth", 16}}}))
+                  .Names({s, "effects[0].type"}));
+  v.push_back(S("effect_bit_depth_4")
+                  .Do(SetJson(s, "/effects", {{{"type", "quantization"}, {"bit_depth", 4}}}))
+                  .Names({s, "effects[0].bit_depth"}));
+  v.push_back(S("effect_full_well_zero")
+                  .Do(SetJson(s, "/effects", {{{"type", "sensor_noise"}, {"full_well_e", 0}}}))
+                  .Names({s, "effects[0].full_well_e"}));
+  v.push_back(S("effect_read_noise_negative")
+                  .Do(SetJson(s, "/effects", {{{"type", "sensor_noise"}, {"read_noise_e", -3}}}))
+                  .Names({s, "effects[0].read_noise_e"}));
+  v.push_back(S("effect_seed_negative")
+                  .Do(SetJson(s, "/effects", {{{"type", "sensor_noise"}, {"seed", -1}}}))
+                  .Names({s, "effects[0].seed"}));
+  v.push_back(
+      S("effects_not_array").Do(SetJson(s, "/effects", "quantization")).Names({s, "effects"}));
+  // Command line of synth.
+  auto A = [](const std::string& name, const std::string& extra) {
+    return C("synth_" + name).Synth(extra);
+  };
+  v.push_back(A("truth_resolution_zero", "--truth-resolution 0").Names({"--truth-resolution"}));
+  v.push_back(A("truth_resolution_huge", "--truth-resolution 99999").Names({"--truth-resolution"}));
+  v.push_back(A("interval_negative", "--interval -1").Names({"--interval"}));
+  v.push_back(A("interval_nan", "--interval nan").Names({"--interval"}));
+  v.push_back(A("photo_format_jpeg", "--photo-format jpeg").Names({"--photo-format"}));
+  v.push_back(A("threads_negative", "--threads -1").Names({"--threads"}));
+  v.push_back(A("threads_abc", "--threads abc").Names({"--threads"}));
+  // filter.
+  auto F = [](const std::string& name, const std::string& args) {
+    return C("filter_" + name).Filter(args);
+  };
+  v.push_back(F("k_max_0", "--k-max 0").Names({"--k-max"}));
+  v.push_back(F("k_max_9", "--k-max 9").Names({"--k-max"}));
+  v.push_back(F("k_max_x", "--k-max x").Names({"--k-max"}));
+  v.push_back(F("spacing_zero", "--spacing-mm 0").Names({"--spacing-mm"}));
+  v.push_back(F("spacing_negative", "--spacing-mm -1").Names({"--spacing-mm"}));
+  v.push_back(F("spacing_1e9", "--spacing-mm 1e9").Names({"--spacing-mm"}));
+  v.push_back(F("spacing_nan", "--spacing-mm nan").Names({"--spacing-mm"}));
+  v.push_back(F("dpi_tiny", "--dpi 1").Names({"--dpi"}));
+  v.push_back(F("dpi_huge", "--dpi 1e9").Names({"--dpi"}));
+  v.push_back(F("dpi_nan", "--dpi nan").Names({"--dpi"}));
+  v.push_back(F("dpi_zero", "--dpi 0").Names({"--dpi"}));
+  v.push_back(F("threads_100000", "--threads 100000").Names({"--threads"}));
+  return v;
+}
+
+std::vector<Case> CommandLineCases() {
+  std::vector<Case> v;
+  // reconstruct.
+  auto R = [](const std::string& name, const std::string& args) {
+    return C("reconstruct_" + name).ReconstructArgs("--dataset ds " + args);
+  };
+  for (const auto& value : std::vector<std::pair<std::string, std::string>>{{"0", "0"},
+                                                                            {"negative", "-5"},
+                                                                            {"3", "3"},
+                                                                            {"99999", "99999"},
+                                                                            {"abc", "abc"},
+                                                                            {"300x", "300x"}})
+    v.push_back(
+        R("resolution_" + value.first, "--resolution " + value.second).Names({"--resolution"}));
+  for (const auto& value : std::vector<std::pair<std::string, std::string>>{
+           {"negative", "-1"}, {"100000", "100000"}, {"abc", "abc"}})
+    v.push_back(R("threads_" + value.first, "--resolution 40 --threads " + value.second)
+                    .Names({"--threads"}));
+  for (const auto& value : std::vector<std::pair<std::string, std::string>>{
+           {"negative", "-1"}, {"nan", "nan"}, {"inf", "inf"}})
+    v.push_back(
+        R("lambda_" + value.first, "--resolution 40 --lambda " + value.second).Names({"--lambda"}));
+  v.push_back(R("samples_per_texel_negative", "--resolution 40 --samples-per-texel -1")
+                  .Names({"--samples-per-texel"}));
+  v.push_back(R("samples_per_texel_huge", "--resolution 40 --samples-per-texel 100000")
+                  .Names({"--samples-per-texel"}));
+  v.push_back(
+      R("poll_zero", "--resolution 40 --watch --poll 0 --idle-timeout 5").Names({"--poll"}));
+  v.push_back(
+      R("poll_negative", "--resolution 40 --watch --poll -1 --idle-timeout 5").Names({"--poll"}));
+  v.push_back(
+      R("poll_nan", "--resolution 40 --watch --poll nan --idle-timeout 5").Names({"--poll"}));
+  v.push_back(R("idle_timeout_negative", "--resolution 40 --watch --idle-timeout -5")
+                  .Names({"--idle-timeout"}));
+  v.push_back(C("reconstruct_dataset_not_found")
+                  .ReconstructArgs("--dataset nothere --resolution 40")
+                  .Names({"nothere/dataset.json"}));
+  // An existing slab of another resolution (§7.4): refused without --force.
+  v.push_back(C("reconstruct_existing_slab_other_resolution")
+                  .ReconstructArgs("--dataset ds --resolution 60")
+                  .From(Input::kSlab)
+                  .Names({"ds/slab"}));
+  // calibrate.
+  auto K = [](const std::string& name, const std::string& args) {
+    return C("calibrate_" + name).Calibrate(args);
+  };
+  v.push_back(K("threads_negative", "--threads -1").Names({"--threads"}));
+  v.push_back(K("threads_100000", "--threads 100000").Names({"--threads"}));
+  v.push_back(K("huber_zero", "--huber-px 0").Names({"--huber-px"}));
+  v.push_back(K("huber_nan", "--huber-px nan").Names({"--huber-px"}));
+  v.push_back(K("distortion_terms_3", "--distortion-terms 3").Names({"--distortion-terms"}));
+  v.push_back(
+      K("distortion_terms_negative", "--distortion-terms -1").Names({"--distortion-terms"}));
+  v.push_back(K("max_rms_negative", "--max-rms-px -1").Names({"--max-rms-px"}));
+  v.push_back(K("max_rms_nan", "--max-rms-px nan").Names({"--max-rms-px"}));
+  v.push_back(K("max_detection_zero", "--max-detection-px 0").Names({"--max-detection-px"}));
+  v.push_back(K("max_detection_negative", "--max-detection-px -5").Names({"--max-detection-px"}));
+  v.push_back(
+      C("calibrate_dataset_not_found").Calibrate().Do(RemovePath("ds")).Names({"ds/dataset.json"}));
+  // preview.
+  auto P = [](const std::string& name, const std::string& args) {
+    return C("preview_" + name).Preview("--slab ds/slab " + args);
+  };
+  const std::string plane = "--scene plane --out r.exr ";
+  for (const auto& value :
+       std::vector<std::pair<std::string, std::string>>{{"junk_suffix", "400x400junk"},
+                                                        {"zero", "0x0"},
+                                                        {"negative", "-1x5"},
+                                                        {"huge", "99999x99999"},
+                                                        {"no_height", "10x"},
+                                                        {"word", "big"},
+                                                        {"8193", "8193x8"}})
+    v.push_back(P("size_" + value.first, plane + "--size " + value.second).Names({"--size"}));
+  for (const auto& value : std::vector<std::pair<std::string, std::string>>{{"negative", "-5"},
+                                                                            {"nan", "nan"},
+                                                                            {"1e12", "1e12"},
+                                                                            {"inf", "inf"},
+                                                                            {"half_mm", "0.5"}})
+    v.push_back(
+        P("receiver_plane_" + value.first, plane + "--size 32x32 --receiver-plane " + value.second)
+            .Names({"--receiver-plane"}));
+  for (const auto& value : std::vector<std::pair<std::string, std::string>>{
+           {"negative", "-1"}, {"nan", "nan"}, {"1e12", "1e12"}})
+    v.push_back(P("extent_" + value.first, plane + "--size 32x32 --extent " + value.second)
+                    .Names({"--extent"}));
+  // 0 is the documented default of both (docs/design.md §4.4): a control that must succeed.
+  v.push_back(P("receiver_plane_0_is_default", plane + "--size 32x32 --receiver-plane 0")
+                  .Exit(0)
+                  .MayChange("r.exr"));
+  v.push_back(
+      P("extent_0_is_default", plane + "--size 32x32 --extent 0").Exit(0).MayChange("r.exr"));
+  const std::string crypt = "--scene crypt --out r.png --size 32x32 --shadow-size 64 ";
+  v.push_back(P("pose_three_values", crypt + "--luminaire-pose 1,2,3").Names({"--luminaire-pose"}));
+  v.push_back(P("pose_nan", crypt + "--luminaire-pose nan,0,0,0,0,0").Names({"--luminaire-pose"}));
+  v.push_back(
+      P("pose_inf_angle", crypt + "--luminaire-pose 0,0,0,0,inf,0").Names({"--luminaire-pose"}));
+  v.push_back(
+      P("pose_1e12", crypt + "--luminaire-pose 1e12,0,0,0,0,0").Names({"--luminaire-pose"}));
+  v.push_back(
+      P("pose_seven_values", crypt + "--luminaire-pose 0,0,0,0,0,0,0").Names({"--luminaire-pose"}));
+  v.push_back(P("shadow_size_1", "--scene crypt --out r.png --size 32x32 --shadow-size 1")
+                  .Names({"--shadow-size"}));
+  v.push_back(P("shadow_size_99999", "--scene crypt --out r.png --size 32x32 --shadow-size 99999")
+                  .Names({"--shadow-size"}));
+  v.push_back(P("shadow_size_abc", "--scene crypt --out r.png --size 32x32 --shadow-size abc")
+                  .Names({"--shadow-size"}));
+  v.push_back(P("out_bmp", "--scene plane --size 32x32 --out x.bmp").Names({"x.bmp"}));
+  v.push_back(P("out_no_extension", "--scene plane --size 32x32 --out image").Names({"image"}));
+  v.push_back(P("threads_negative", plane + "--size 32x32 --threads -1").Names({"--threads"}));
+  v.push_back(P("threads_100000", plane + "--size 32x32 --threads 100000").Names({"--threads"}));
+  v.push_back(P("threads_abc", plane + "--size 32x32 --threads abc").Names({"--threads"}));
+  v.push_back(P("poll_zero", plane + "--size 32x32 --watch --poll 0").Names({"--poll"}));
+  v.push_back(P("poll_negative", plane + "--size 32x32 --watch --poll -1").Names({"--poll"}));
+  v.push_back(P("bench_frames_zero", plane + "--size 32x32 --bench --bench-frames 0")
+                  .Names({"--bench-frames"}));
+  v.push_back(C("preview_slab_not_found")
+                  .Preview("--slab nothere " + plane + "--size 32x32")
+                  .Names({"nothere"}));
+  v.push_back(P("scene_file_not_found", "--scene nothere.obj --out r.png --size 32x32")
+                  .Names({"nothere.obj"}));
+  v.push_back(P("scene_file_garbage", "--scene ds/dataset.json --out r.png --size 32x32")
+                  .Names({"ds/dataset.json"}));
+  return v;
+}
+
+std::vector<Case> SlabCases() {
+  std::vector<Case> v;
+  const std::string& j = kSlabJson;
+  auto P = [](const std::string& name) { return C("slab_" + name).Preview(); };
+  v.push_back(P("json_missing").Do(RemovePath(j)).Names({j}));
+  v.push_back(P("json_empty").Do(WriteText(j, "")).Names({j}));
+  v.push_back(P("json_truncated").Do(Truncate(j, 0.5)).Names({j}));
+  v.push_back(P("json_garbage").Do(WriteText(j, Garbage())).Names({j}));
+  v.push_back(P("json_nested_100000").Do(WriteText(j, Nested(100000))).Names({j}));
+  v.push_back(P("json_file_50mb").Do(Bloat(j, 50)).Names({j}));
+  v.push_back(P("json_is_a_folder").Do(MakeFolder(j)).Names({j}));
+  v.push_back(P("json_is_a_fifo").Do(MakeFifo(j)).Names({j}));
+  v.push_back(
+      P("schema_version_99").Do(SetJson(j, "/schema_version", 99)).Names({j, "schema_version"}));
+  v.push_back(P("resolution_zero").Do(SetJson(j, "/resolution", {0, 40})).Names({j, "resolution"}));
+  v.push_back(
+      P("resolution_one_value").Do(SetJson(j, "/resolution", {40})).Names({j, "resolution"}));
+  v.push_back(
+      P("resolution_huge").Do(SetJson(j, "/resolution", {100000, 40})).Names({j, "resolution"}));
+  v.push_back(
+      P("resolution_not_files").Do(SetJson(j, "/resolution", {60, 60})).Names({"ds/slab/pos_"}));
+  v.push_back(P("units_lux").Do(SetJson(j, "/units", "lux")).Names({j, "units"}));
+  v.push_back(P("distance_zero").Do(SetJson(j, "/distance_mm", 0)).Names({j, "distance_mm"}));
+  v.push_back(
+      P("distance_nan_string").Do(SetJson(j, "/distance_mm", "NaN")).Names({j, "distance_mm"}));
+  v.push_back(P("grid_nu_zero").Do(SetJson(j, "/grid/nu", 0)).Names({j, "grid.nu"}));
+  v.push_back(P("grid_nu_1e9").Do(SetJson(j, "/grid/nu", 1000000000)).Names({j, "grid.nu"}));
+  v.push_back(P("window_zero").Do(SetJson(j, "/window_mm", {0, 1200})).Names({j, "window_mm"}));
+  v.push_back(P("filter_spacing_mismatch")
+                  .Do(SetJson(j, "/filter/spacing_mm", 6))
+                  .Names({j, "filter.spacing_mm"}));
+  v.push_back(
+      P("present_outside_grid").Do(SetJson(j, "/present", {{0, 0}, {5, 5}})).Names({j, "present"}));
+  v.push_back(P("present_string").Do(SetJson(j, "/present", "all")).Names({j, "present"}));
+  v.push_back(P("present_triplet").Do(SetJson(j, "/present", {{0, 0, 0}})).Names({j, "present"}));
+  const std::string e = "ds/slab/pos_1_0.exr";
+  v.push_back(P("exr_wrong_size").Do(ExrResize(e, 20, 20)).Names({e}));
+  v.push_back(
+      P("exr_nan").Do(ExrPoison(e, "R", std::numeric_limits<float>::quiet_NaN())).Names({e}));
+  v.push_back(
+      P("exr_inf").Do(ExrPoison(e, "G", std::numeric_limits<float>::infinity())).Names({e}));
+  v.push_back(P("exr_no_mask").Do(ExrDropChannel(e, "mask")).Names({e, "mask"}));
+  v.push_back(P("exr_truncated").Do(Truncate(e, 0.5)).Names({e}));
+  v.push_back(P("exr_empty_file").Do(WriteText(e, "")).Names({e}));
+  v.push_back(P("exr_text").Do(WriteText(e, "not an EXR\n")).Names({e}));
+  v.push_back(P("exr_is_a_folder").Do(MakeFolder(e)).Names({e}));
+  v.push_back(P("exr_is_a_fifo").Do(MakeFifo(e)).Names({e}));
+  v.push_back(P("exr_header_32768x32768")
+                  .Do(ExrHugeHeader(e, {"R", "G", "B", "mask"}, 32768, 32768))
+                  .Names({e}));
+  v.push_back(P("exr_position_attribute_mismatch")
+                  .Do(ExrSetInt(e, "lumislab.i", 0))
+                  .Names({e, "lumislab.i"}));
+  // --watch on a slab whose EXR is NaN: the same refusal, and no hang.
+  v.push_back(C("slab_exr_nan_watch")
+                  .Preview(kPreview + " --watch --poll 0.05")
+                  .Do(ExrPoison(e, "B", std::numeric_limits<float>::quiet_NaN()))
+                  .Names({e}));
+  return v;
+}
+
+// Refusals that must leave a previous output alone (--force), watchers that must not wait for
+// ever on a bad input, output paths, and what every tool's command line must refuse.
+std::vector<Case> MoreCases() {
+  std::vector<Case> v;
+  const std::string e = "ds/photos/pos_1_0_p.png";
+  // --force over complete outputs: a refusal leaves them byte-identical.
+  v.push_back(C("force_synth_bad_scene_keeps_dataset")
+                  .Synth()
+                  .Args("synth --scene scene.json --out ds --force")
+                  .From(Input::kSlab)
+                  .Do(SetJson(kSceneFile, "/setup/distance_mm", -750))
+                  .Names({kSceneFile, "setup.distance_mm"}));
+  v.push_back(C("force_calibrate_no_board_keeps_calibration")
+                  .Calibrate("--force")
+                  .From(Input::kCalibrated)
+                  .Do(CopyPath("ds/photos/pos_0_0_p.png", "ds/photos/calib_0.png"))
+                  .Names({"ds/photos/calib_0.png"}));
+  v.push_back(C("force_calibrate_truncated_board_keeps_calibration")
+                  .Calibrate("--force")
+                  .From(Input::kCalibrated)
+                  .Do(Truncate("ds/photos/calib_0.png", 0.5))
+                  .Names({"ds/photos/calib_0.png"}));
+  v.push_back(C("force_reconstruct_bad_dataset_keeps_slab")
+                  .Reconstruct("--force")
+                  .From(Input::kSlab)
+                  .Do(SetJson(kDs, "/setup/grid/nu", -3))
+                  .Names({kDs, "setup.grid.nu"}));
+  v.push_back(C("force_reconstruct_bad_calibration_keeps_slab")
+                  .Reconstruct("--force")
+                  .From(Input::kSlab)
+                  .Do(SetJson(kScr, "/screen_from_image", std::vector<double>(9, 0.0)))
+                  .Names({kScr, "screen_from_image"}));
+  // --watch: a bad input is refused, not waited on (each has an idle timeout as a backstop).
+  const std::string watch = "--dataset ds --resolution 40 --watch --poll 0.05 --idle-timeout 5";
+  v.push_back(
+      C("watch_reconstruct_dataset_fifo").ReconstructArgs(watch).Do(MakeFifo(kDs)).Names({kDs}));
+  v.push_back(C("watch_reconstruct_photo_fifo")
+                  .ReconstructArgs(watch)
+                  .Do(MakeFifo(e))
+                  .Names({e})
+                  .MayChange("ds/slab/")
+                  .MustNotExist("ds/slab/pos_1_0.exr"));
+  v.push_back(C("watch_reconstruct_truncated_photo")
+                  .ReconstructArgs(watch)
+                  .Do(Truncate(e, 0.5))
+                  .Names({e})
+                  .MayChange("ds/slab/")
+                  .MustNotExist("ds/slab/pos_1_0.exr"));
+  v.push_back(C("watch_reconstruct_screen_json_garbage")
+                  .ReconstructArgs(watch)
+                  .Do(WriteText(kScr, Garbage()))
+                  .Names({kScr}));
+  v.push_back(C("watch_preview_slab_json_fifo")
+                  .Preview(kPreview + " --watch --poll 0.05")
+                  .Do(MakeFifo(kSlabJson))
+                  .Names({kSlabJson}));
+  v.push_back(C("watch_preview_slab_json_garbage")
+                  .Preview(kPreview + " --watch --poll 0.05")
+                  .Do(WriteText(kSlabJson, Garbage()))
+                  .Names({kSlabJson}));
+  // Text that is not UTF-8 inside a JSON string.
+  v.push_back(C("dataset_invalid_utf8")
+                  .Reconstruct()
+                  .Do([](const std::string& dir) {
+                    std::string text = ReadBinaryFile(dir + "/" + kDs);
+                    const size_t at = text.find("photos/pos_0_0_p.png");
+                    text.replace(at, 6, std::string("ph\xff\xfe\xc3s", 6));
+                    WriteBinaryFile(dir + "/" + kDs, text);
+                  })
+                  .Names({kDs}));
+  // A dataset "folder" that is a file.
+  v.push_back(C("reconstruct_dataset_is_a_file")
+                  .ReconstructArgs("--dataset ds/dataset.json --resolution 40")
+                  .Names({"ds/dataset.json"}));
+  v.push_back(C("calibrate_dataset_is_a_file")
+                  .Calibrate()
+                  .Args("screen --dataset ds/dataset.json")
+                  .Names({"ds/dataset.json"}));
+  // Scene meshes for the preview (docs/design.md §4.4: a face naming a vertex the file lacks, or
+  // a non-finite vertex, is exit 2).
+  v.push_back(C("preview_mesh_face_out_of_range")
+                  .Preview("--slab ds/slab --scene bad.obj --out r.png --size 32x32")
+                  .Do(WriteText("bad.obj", "v 0 0 0\nv 1000 0 0\nv 0 1000 0\nf 1 2 7\n"))
+                  .Names({"bad.obj"}));
+  v.push_back(C("preview_mesh_nan_vertex")
+                  .Preview("--slab ds/slab --scene bad.obj --out r.png --size 32x32")
+                  .Do(WriteText("bad.obj", "v nan 0 0\nv 1000 0 0\nv 0 1000 0\nf 1 2 3\n"))
+                  .Names({"bad.obj"}));
+  v.push_back(C("preview_mesh_empty")
+                  .Preview("--slab ds/slab --scene bad.obj --out r.png --size 32x32")
+                  .Do(WriteText("bad.obj", ""))
+                  .Names({"bad.obj"}));
+  // An output folder that does not exist: an I/O error (exit 3) naming the output.
+  v.push_back(C("preview_out_folder_missing")
+                  .Preview("--slab ds/slab --scene plane --size 32x32 --out nodir/r.exr")
+                  .Exit(3)
+                  .Names({"nodir/r.exr"}));
+  // Unknown options and missing required ones (CLI11, exit 2, naming the option).
+  v.push_back(C("cli_synth_unknown_option").Synth("--bogus 1").Names({"--bogus"}));
+  v.push_back(C("cli_synth_scene_missing").Synth().Args("synth --out out").Names({"--scene"}));
+  v.push_back(C("cli_filter_out_missing").Filter("").Args("filter --k-max 1").Names({"--out"}));
+  v.push_back(C("cli_acquire_unknown_subcommand")
+                  .Synth()
+                  .Args("capture --scene scene.json --out out")
+                  .Names({"capture"}));
+  v.push_back(C("cli_calibrate_unknown_option").Calibrate("--bogus").Names({"--bogus"}));
+  v.push_back(C("cli_calibrate_dataset_missing").Calibrate().Args("screen").Names({"--dataset"}));
+  v.push_back(C("cli_reconstruct_unknown_option").Reconstruct("--bogus").Names({"--bogus"}));
+  v.push_back(
+      C("cli_reconstruct_dataset_missing").ReconstructArgs("--resolution 40").Names({"--dataset"}));
+  v.push_back(C("cli_preview_unknown_option").Preview(kPreview + " --bogus").Names({"--bogus"}));
+  v.push_back(C("cli_preview_slab_missing").Preview("--scene plane --out r.exr").Names({"--slab"}));
+  v.push_back(C("cli_preview_no_output").Preview("--slab ds/slab --scene plane").Names({"--out"}));
+  return v;
+}
+
+std::vector<Case> AllCases() {
+  std::vector<Case> all;
+  for (auto part : {DatasetCases(), ScreenCalibrationCases(), PhotoCases(), SceneCases(),
+                    CommandLineCases(), SlabCases(), MoreCases()})
+    all.insert(all.end(), part.begin(), part.end());
+  return all;
+}
+
+// ------------------------------------------------------------------------------------------
+// The check.
+
+bool Allowed(const std::string& path, const std::vector<std::string>& prefixes) {
+  for (const auto& p : prefixes)
+    if (path.compare(0, p.size(), p) == 0 || (p.back() == '/' && path + "/" == p)) return true;
+  return false;
+}
+
+const char* kCrashMarkers[] = {"terminate called", "Aborted",        "Segmentation fault",
+                               "core dumped",      "std::bad_alloc", "Assertion",
+                               "what():"};
+
+class Catalogue : public ::testing::TestWithParam<Case> {
+ protected:
+  void TearDown() override {
+    if (!dir_.empty() && !std::getenv("LUMISLAB_KEEP_CASES")) fs::remove_all(dir_);
+  }
+  std::string dir_;
+};
+
+TEST_P(Catalogue, Refuses) {
+  const Case& c = GetParam();
+  if (!fs::exists(std::string(LUMISLAB_BIN_DIR) + "/" + c.tool))
+    GTEST_SKIP() << c.tool << " is not built (LUMISLAB_BUILD_PREVIEW=OFF?)";
+  std::string error;
+  const std::string master = Masters::Get(c.input, &error);
+  ASSERT_TRUE(error.empty()) << "making the valid input failed:\n" << error;
+  dir_ = testing::FreshDir("catalogue_" + c.name + "_" + std::to_string(getpid()));
+  testing::WriteFile(dir_ + "/scene.json", ValidScene(true));
+  if (!master.empty()) {
+    fs::copy(master, dir_ + "/ds", fs::copy_options::recursive);
+    if (c.input == Input::kDataset) fs::remove_all(dir_ + "/ds/calib");
+    if (c.input != Input::kSlab) fs::remove_all(dir_ + "/ds/slab");
+  }
+  for (const auto& m : c.mutations) ASSERT_NO_THROW(m(dir_)) << "mutation failed";
+  const TreeSnapshot before = SnapshotTree(dir_);
+
+  const CommandResult r = RunToolIn(dir_, c.tool, c.args, kTimeoutS, kMemoryLimitKb);
+  std::vector<std::string> problems;
+
+  // Exit code (124: it hung; >= 128: a signal).
+  const bool warned = c.warning_ok && r.exit_code == 0;
+  if (warned) {
+    if (r.output.find("warning") == std::string::npos)
+      problems.push_back("exit 0 without a warning");
+  } else if (r.exit_code != c.exit_code) {
+    problems.push_back("exit code " + std::to_string(r.exit_code) + ", expected " +
+                       std::to_string(c.exit_code) +
+                       (r.exit_code == 124 ? " (timed out: a hang)" : "") +
+                       (r.exit_code > 128 ? " (killed by a signal: a crash)" : ""));
+  }
+  // The tool's answer, shown for passing cases too (ctest -V, or the test binary run directly).
+  std::printf("$ %s %s\n  -> exit %d\n%s", c.tool.c_str(), c.args.c_str(), r.exit_code,
+              r.output.c_str());
+  if (c.warning_ok) RecordProperty("outcome", warned ? "exit 0 with a warning" : "refused");
+  for (const char* marker : kCrashMarkers)
+    if (r.output.find(marker) != std::string::npos)
+      problems.push_back(std::string("crash marker \"") + marker + "\" in the output");
+  // One line names the file and the field (for a warning: the line that says it).
+  if (!c.mentions.empty()) {
+    bool found = false;
+    std::istringstream lines(r.output);
+    for (std::string line; std::getline(lines, line) && !found;) {
+      if (warned && line.find("warning") == std::string::npos) continue;
+      found = std::all_of(c.mentions.begin(), c.mentions.end(),
+                          [&](const std::string& m) { return line.find(m) != std::string::npos; });
+    }
+    std::string wanted;
+    for (const auto& m : c.mentions) wanted += " \"" + m + "\"";
+    if (!found) problems.push_back("no output line names all of" + wanted);
+  }
+  // Nothing changed but what the case allows; no temporary file anywhere.
+  const TreeSnapshot after = SnapshotTree(dir_);
+  for (const auto& d : testing::DiffSnapshots(before, after))
+    if (!Allowed(d.substr(0, d.find(": ")), c.may_change)) problems.push_back("changed: " + d);
+  for (const auto& t : testing::TemporaryPaths(after))
+    problems.push_back("temporary file left: " + t);
+  for (const auto& path : c.must_not_exist)
+    if (after.count(path)) problems.push_back("written although its input is bad: " + path);
+
+  std::string report;
+  for (const auto& p : problems) report += "  - " + p + "\n";
+  EXPECT_TRUE(problems.empty()) << c.name << ":\n"
+                                << report << "$ (cd " << dir_ << " && " << c.tool << " " << c.args
+                                << ")\n  -> exit " << r.exit_code << "\n"
+                                << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, Catalogue, ::testing::ValuesIn(AllCases()),
+                         [](const ::testing::TestParamInfo<Case>& param) {
+                           return param.param.name;
+                         });
+
+}  // namespace
+}  // namespace lumislab

@@ -10,6 +10,9 @@ packages=(
   libopencv-dev libceres-dev libgtest-dev
   libglfw3-dev libosmesa6-dev python3-glad libassimp-dev
   xvfb xauth x11-apps
+  # pipelines/test.sh's sanitizer and fuzz builds: clang 14, its sanitizer and libFuzzer
+  # run-times, llvm-symbolizer for the stack traces (fuzz/README.md)
+  clang libclang-rt-14-dev llvm
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -12,9 +12,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FUZZ_BEGIN
   const ScreenCalibration c = ScreenCalibration::Load(in + "/screen.json");
   const double w = c.image_width - 1, h = c.image_height - 1;
-  for (const Eigen::Vector2d& px : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0),
-                                    Eigen::Vector2d(0, h), Eigen::Vector2d(w, h),
-                                    Eigen::Vector2d(0.5 * w, 0.5 * h)}) {
+  for (const Eigen::Vector2d& px :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h),
+        Eigen::Vector2d(0.5 * w, 0.5 * h)}) {
     const Eigen::Vector2d mm = c.ScreenFromImage(px);
     (void)c.ImageFromScreen(mm);
     (void)c.Distort(c.Undistort(px));

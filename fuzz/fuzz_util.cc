@@ -59,8 +59,10 @@ void ReportError(const Error& e) {
 }
 
 void UnexpectedException(const char* what, const char* type) {
-  std::fprintf(stderr, "\n==lumislab-fuzz== FINDING: an exception that is not a lumislab::Error "
-                       "escaped the reader: %s: %s\n", type, what);
+  std::fprintf(stderr,
+               "\n==lumislab-fuzz== FINDING: an exception that is not a lumislab::Error "
+               "escaped the reader: %s: %s\n",
+               type, what);
   std::abort();
 }
 

@@ -106,7 +106,8 @@ void Datasets(const std::string& scratch) {
   // One position, linear transfer.
   Dataset one = SmallDataset();
   one.grid.nu = one.grid.nv = 1;
-  one.photos = {{0, 0, true, "photos/pos_0_0_p.exr", 1.0}, {0, 0, false, "photos/pos_0_0_n.exr", 1.0}};
+  one.photos = {{0, 0, true, "photos/pos_0_0_p.exr", 1.0},
+                {0, 0, false, "photos/pos_0_0_n.exr", 1.0}};
   one.photo_transfer = "linear";
   one.Save(scratch);
   Take(scratch + "/dataset.json", "fuzz_dataset", "one_position.json");

@@ -140,6 +140,7 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
 
 std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config) {
   const std::string json = config.slab_dir + "/slab.json";
+  if (config.watch && !std::filesystem::exists(json)) LogInfo("waiting for ", json);
   while (config.watch && !std::filesystem::exists(json)) {
     if (StopRequested()) return std::nullopt;
     std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));

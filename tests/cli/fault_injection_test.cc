@@ -85,49 +85,21 @@ struct Outcome {
   std::string output;   // stdout and stderr
 };
 
-// Runs build/bin/<tool> <args> in `cwd` (fork + exec, output into `log`); when kill_after_s >= 0
-// sends SIGKILL to that process (and only to it) once that many seconds have passed.
+// Runs build/bin/<tool> <args> in `cwd` (output into `log`); when kill_after_s >= 0 sends SIGKILL
+// to that process (and only to it) once that many seconds have passed.
 Outcome Spawn(const std::string& cwd, const std::string& tool, const std::vector<std::string>& args,
               const std::string& log, double kill_after_s = -1) {
-  const std::string path = std::string(LUMISLAB_BIN_DIR) + "/" + tool;
-  std::vector<std::string> words = {path};
-  words.insert(words.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  const int out = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  const int in = open("/dev/null", O_RDONLY);
+  testing::ToolProcess process(cwd, tool, args, log);
   Outcome outcome;
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid == 0) {  // child: async-signal-safe calls only, then exec
-    if (chdir(cwd.c_str()) != 0) _exit(126);
-    dup2(in, 0);
-    dup2(out, 1);
-    dup2(out, 2);
-    execv(path.c_str(), argv.data());
-    _exit(127);
+  if (!process.started()) return outcome;
+  const double first_stop = kill_after_s >= 0 ? std::min(kill_after_s, kRunTimeoutS) : kRunTimeoutS;
+  if (!process.WaitFor(first_stop)) {
+    outcome.killed = process.Signal(SIGKILL);
+    process.WaitFor(kRunTimeoutS);
   }
-  close(out);
-  close(in);
-  if (pid < 0) return outcome;
-  int status = 0;
-  bool signalled = false;
-  for (;;) {
-    const pid_t done = waitpid(pid, &status, WNOHANG);
-    if (done == pid) break;
-    const double t =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!signalled && ((kill_after_s >= 0 && t >= kill_after_s) || t >= kRunTimeoutS)) {
-      kill(pid, SIGKILL);
-      signalled = true;
-      outcome.killed = true;
-    }
-    std::this_thread::sleep_for(std::chrono::microseconds(500));
-  }
-  outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  outcome.killed = outcome.killed && WIFSIGNALED(status);
+  outcome.seconds = process.Elapsed();
+  outcome.exit_code = process.exit_code();
+  outcome.killed = outcome.killed && process.signalled();
   outcome.output = ReadBinaryFile(log);
   return outcome;
 }

@@ -1,14 +1,21 @@
 #include "test_util.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -28,7 +35,14 @@ CommandResult RunTool(const std::string& tool, const std::string& args) {
 }
 
 std::string FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lumislab_test_" + name);
+  // Named after the build too: the tests of two build folders (build/, build-asan/) may run at
+  // the same time.
+  const std::string build = LUMISLAB_BIN_DIR;
+  uint64_t hash = 1469598103934665603ull;
+  for (const char c : build) hash = (hash ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  std::ostringstream tag;
+  tag << std::hex << (hash & 0xffffff);
+  const fs::path dir = fs::temp_directory_path() / ("lumislab_test_" + tag.str() + "_" + name);
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir.string();
@@ -76,7 +90,22 @@ CommandResult RunToolIn(const std::string& cwd, const std::string& tool, const s
                         double timeout_s, long memory_kb) {
   std::ostringstream cmd;
   cmd << "cd " << ShellQuote(cwd) << " && ";
-  if (memory_kb > 0) cmd << "ulimit -v " << memory_kb << " && ";
+  if (memory_kb > 0) {
+#ifdef LUMISLAB_SANITIZED
+    // ASan reserves terabytes of address space for its shadow memory, so `ulimit -v` would stop
+    // every sanitized tool at start-up; its allocator enforces the same limit instead: an
+    // allocation larger than the limit, or a resident size above it, ends the tool with a report.
+    const long mb = memory_kb / 1024;
+    const char* asan = std::getenv("ASAN_OPTIONS");
+    cmd << "ASAN_OPTIONS="
+        << ShellQuote(std::string(asan ? asan : "") + (asan ? ":" : "") +
+                      "max_allocation_size_mb=" + std::to_string(mb) +
+                      ":hard_rss_limit_mb=" + std::to_string(mb))
+        << " && export ASAN_OPTIONS && ";
+#else
+    cmd << "ulimit -v " << memory_kb << " && ";
+#endif
+  }
   cmd << "exec timeout -k 5 " << timeout_s << " " << LUMISLAB_BIN_DIR << "/" << tool << " " << args
       << " </dev/null 2>&1";
   CommandResult result;
@@ -89,6 +118,67 @@ CommandResult RunToolIn(const std::string& cwd, const std::string& tool, const s
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
 }
+
+namespace {
+double NowS() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+ToolProcess::ToolProcess(const std::string& cwd, const std::string& tool,
+                         const std::vector<std::string>& args, const std::string& log) {
+  const std::string path = std::string(LUMISLAB_BIN_DIR) + "/" + tool;
+  std::vector<std::string> words = {path};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  const int out = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int in = open("/dev/null", O_RDONLY | O_CLOEXEC);
+  start_s_ = NowS();
+  if (out >= 0 && in >= 0) {
+    pid_ = fork();
+    if (pid_ == 0) {  // child: async-signal-safe calls only, then exec
+      if (chdir(cwd.c_str()) != 0) _exit(126);
+      dup2(in, 0);
+      dup2(out, 1);
+      dup2(out, 2);
+      execv(path.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+  if (out >= 0) close(out);
+  if (in >= 0) close(in);
+}
+
+ToolProcess::~ToolProcess() {
+  if (Running()) {
+    kill(pid_, SIGKILL);
+    WaitFor(10);
+  }
+}
+
+bool ToolProcess::Running() {
+  if (pid_ <= 0 || exit_code_ >= 0) return false;
+  int status = 0;
+  if (waitpid(pid_, &status, WNOHANG) != pid_) return true;
+  signalled_ = WIFSIGNALED(status);
+  exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return false;
+}
+
+bool ToolProcess::Signal(int signal) { return Running() && kill(pid_, signal) == 0; }
+
+bool ToolProcess::WaitFor(double timeout_s) {
+  const double deadline = NowS() + timeout_s;
+  while (Running()) {
+    if (NowS() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  return true;
+}
+
+double ToolProcess::Elapsed() const { return NowS() - start_s_; }
 
 namespace {
 // FNV-1a over the bytes of a regular file, with its size.

@@ -14,7 +14,7 @@ struct CommandResult {
 
 // Runs build/bin/<tool> with the given argument string (shell-quoted by the caller).
 CommandResult RunTool(const std::string& tool, const std::string& args);
-// A fresh, empty folder under the system temp folder, named after the test.
+// A fresh, empty folder under the system temp folder, named after the test and the build folder.
 std::string FreshDir(const std::string& name);
 void WriteFile(const std::string& path, const std::string& text);
 // Scene JSON of the default luminaire with the given grid, camera and effects (JSON fragments).
@@ -26,7 +26,8 @@ int CountTemporaryFiles(const std::string& dir);
 
 // Runs build/bin/<tool> <args> from the working folder `cwd` (so that relative paths in `args`
 // and in the tool's messages are relative to it), through `timeout` (exit 124 when it runs past
-// `timeout_s`) and, when `memory_kb` > 0, under `ulimit -v memory_kb`. stdin is /dev/null.
+// `timeout_s`) and, when `memory_kb` > 0, under `ulimit -v memory_kb` (in a sanitized build: ASan's
+// allocation and resident-size limits of the same size). stdin is /dev/null.
 CommandResult RunToolIn(const std::string& cwd, const std::string& tool, const std::string& args,
                         double timeout_s = 20, long memory_kb = 0);
 // Single-quotes `text` for sh.
@@ -41,6 +42,38 @@ TreeSnapshot SnapshotTree(const std::string& dir);
 std::vector<std::string> DiffSnapshots(const TreeSnapshot& before, const TreeSnapshot& after);
 // Paths in a snapshot one of whose components starts with '.' (temporary names, §7.5).
 std::vector<std::string> TemporaryPaths(const TreeSnapshot& snapshot);
+
+// A tool started in the background: fork + exec of build/bin/<tool> <args> in `cwd`, stdin
+// /dev/null, stdout and stderr into the file `log`. Only this process is ever signalled, by its
+// pid; the destructor kills (SIGKILL) and reaps it if it still runs.
+class ToolProcess {
+ public:
+  ToolProcess(const std::string& cwd, const std::string& tool, const std::vector<std::string>& args,
+              const std::string& log);
+  ~ToolProcess();
+  ToolProcess(const ToolProcess&) = delete;
+  ToolProcess& operator=(const ToolProcess&) = delete;
+
+  bool started() const { return pid_ > 0; }
+  // Reaps the process if it has ended; true while it runs.
+  bool Running();
+  // Sends `signal` if the process still runs; returns whether it was sent.
+  bool Signal(int signal);
+  // Waits up to `timeout_s` seconds (polling every 0.5 ms) for the process to end; returns
+  // whether it ended.
+  bool WaitFor(double timeout_s);
+  // Seconds since the start.
+  double Elapsed() const;
+  // Once ended: the exit code, or 128 + the signal that ended it; and whether a signal did.
+  int exit_code() const { return exit_code_; }
+  bool signalled() const { return signalled_; }
+
+ private:
+  int pid_ = -1;
+  int exit_code_ = -1;
+  bool signalled_ = false;
+  double start_s_ = 0;
+};
 
 std::string ReadBinaryFile(const std::string& path);  // "" when missing
 void WriteBinaryFile(const std::string& path, const std::string& bytes);

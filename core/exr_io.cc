@@ -14,6 +14,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 
 namespace lumislab {
 
@@ -60,8 +61,7 @@ void WriteExr(const std::string& path, const ImageF& image,
 
 ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_names,
                ExrAttributes* attributes) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw BadInput(path + ": file not found");
+  CheckInputFile(path, "EXR file");
   try {
     Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();

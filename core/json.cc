@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/input_file.h"
 
 namespace lumislab {
 namespace {
@@ -180,11 +181,8 @@ void JsonView::Fail(const std::string& expected) const {
 }
 
 JsonDocument JsonDocument::Load(const std::string& path) {
+  CheckInputFile(path, "JSON file");
   std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw BadInput(path + ": file not found");
-  if (!std::filesystem::is_regular_file(status))
-    throw BadInput(path + ": not a regular file (a folder, FIFO or device is not a JSON file)");
   const auto size = std::filesystem::file_size(path, ec);
   if (!ec && size > kMaxJsonBytes)
     throw InputError(path, "", "a JSON file of at most " + std::to_string(kMaxJsonBytes) + " bytes",

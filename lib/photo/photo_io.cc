@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
+#include "core/input_file.h"
 
 namespace lumislab {
 namespace {
@@ -21,14 +22,6 @@ float SrgbToLinear(float v) {
 double LinearToSrgb(double v) {
   v = std::clamp(v, 0.0, 1.0);
   return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-}
-
-void CheckRegularFile(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw BadInput(path + ": photo missing");
-  if (!std::filesystem::is_regular_file(status))
-    throw BadInput(path + ": not a regular file (a folder, FIFO or device is not a photo)");
 }
 
 cv::Mat DecodeWithOpenCv(const std::string& path) {
@@ -136,7 +129,7 @@ const char* PhotoFormatName(PhotoFormat format) {
 }
 
 PhotoFormat DetectPhotoFormat(const std::string& path) {
-  CheckRegularFile(path);
+  CheckInputFile(path, "photo");
   unsigned char magic[8] = {};
   std::ifstream in(path, std::ios::binary);
   in.read(reinterpret_cast<char*>(magic), sizeof magic);

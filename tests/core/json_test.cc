@@ -102,7 +102,7 @@ TEST(JsonTest, RefusesDeepLargeAndNonRegularInputs) {
             std::string::npos);
   EXPECT_NE(MessageOf([&] {
               JsonDocument::Load((dir / "missing.json").string());
-            }).find("missing.json: file not found"),
+            }).find("missing.json: JSON file not found"),
             std::string::npos);
   EXPECT_NE(MessageOf([] {
               JsonDocument::Parse("{\"a\": x}", "bad.json");

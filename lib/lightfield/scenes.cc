@@ -1,13 +1,7 @@
 #include "lib/lightfield/scenes.h"
 
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-
 #include <Eigen/Geometry>
-#include <assimp/Importer.hpp>
 #include <cmath>
-
-#include "core/error.h"
 
 namespace lumislab {
 namespace {
@@ -170,55 +164,6 @@ Mesh MakeReceiverPlane(double plane_z_mm, double extent_mm) {
   const float h = float(0.5 * extent_mm), z = float(plane_z_mm);
   // Normal -z (towards the luminaire): counter-clockwise seen from -z.
   m.AddQuad({-h, -h, z}, {-h, h, z}, {h, h, z}, {h, -h, z}, V(1, 1, 1));
-  return m;
-}
-
-Mesh LoadSceneFile(const std::string& path) {
-  Assimp::Importer importer;
-  const aiScene* scene =
-      // ValidateDataStructure runs before the other steps: they index vertices by the file's
-      // face indices, and a PLY face naming a vertex it lacks crashed them.
-      importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
-                                  aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
-                                  aiProcess_JoinIdenticalVertices);
-  if (!scene || !scene->mRootNode) {
-    throw BadInput(path + ": cannot read scene (" + importer.GetErrorString() + ")");
-  }
-  Mesh m;
-  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
-    const aiMesh* mesh = scene->mMeshes[k];
-    if (mesh == nullptr || mesh->mVertices == nullptr || mesh->mNormals == nullptr) continue;
-    V colour(0.7f, 0.7f, 0.7f);
-    aiColor4D diffuse;
-    if (mesh->mMaterialIndex < scene->mNumMaterials &&
-        scene->mMaterials[mesh->mMaterialIndex]->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) ==
-            AI_SUCCESS &&
-        std::isfinite(diffuse.r) && std::isfinite(diffuse.g) && std::isfinite(diffuse.b)) {
-      colour = V(diffuse.r, diffuse.g, diffuse.b);
-    }
-    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-      const aiFace& face = mesh->mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      // A file's face may name a vertex it does not have (a hostile PLY did): refuse it.
-      for (unsigned c = 0; c < 3; ++c)
-        if (face.mIndices[c] >= mesh->mNumVertices)
-          throw InputError(path, "mesh " + std::to_string(k) + " face " + std::to_string(f),
-                           "vertex indices below " + std::to_string(mesh->mNumVertices),
-                           std::to_string(face.mIndices[c]));
-      for (unsigned c = 0; c < 3; ++c) {
-        const aiVector3D& p = mesh->mVertices[face.mIndices[c]];
-        const aiVector3D n = mesh->mNormals[face.mIndices[c]];
-        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
-          throw InputError(
-              path, "mesh " + std::to_string(k) + " vertex " + std::to_string(face.mIndices[c]),
-              "finite coordinates", "NaN or Inf");
-        m.positions.emplace_back(p.x, p.y, p.z);
-        m.normals.emplace_back(n.x, n.y, n.z);
-        m.albedo.push_back(colour);
-      }
-    }
-  }
-  if (m.positions.empty()) throw BadInput(path + ": the scene has no triangles");
   return m;
 }
 

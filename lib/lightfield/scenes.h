@@ -29,7 +29,13 @@ Mesh MakeCrypt();     // ~500 triangles
 Mesh MakeCloister();  // ~8000 triangles
 // The receiver plane z = plane_z of the luminaire frame, square of side extent, normal -z.
 Mesh MakeReceiverPlane(double plane_z_mm, double extent_mm);
-// OBJ / glTF / PLY / ... through Assimp; BadInput when it cannot be read.
-Mesh LoadSceneFile(const std::string& path);
+// OBJ / glTF / PLY / ... through Assimp, in a child process (lib/lightfield/scene_file.cc): the
+// flattened triangles. BadInput naming the file when it is not a regular file, the importer
+// refuses it, crashes on it or runs past `timeout_s` (then it is killed), or the scene has no
+// triangles, a non-finite vertex, a face naming a missing vertex or more than
+// kMaxSceneTriangles triangles; Failure when StopRequested() ends the wait.
+constexpr size_t kMaxSceneTriangles = 10'000'000;
+constexpr double kSceneImportTimeoutS = 120;
+Mesh LoadSceneFile(const std::string& path, double timeout_s = kSceneImportTimeoutS);
 
 }  // namespace lumislab

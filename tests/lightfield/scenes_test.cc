@@ -3,9 +3,11 @@
 #include "lib/lightfield/scenes.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -166,6 +168,47 @@ TEST_F(LightFieldSceneFiles, RefusesAFaceIndexOutOfRange) {
                              "property list uchar int vertex_indices\nend_header\n"
                              "0 0 0\n1 0 0\n0 1 0\n3 0 1 99999\n"));
   ExpectBadInputNaming(Write("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"));
+}
+
+// Assimp 5.2 loops forever on a PLY cut short: the pre-check refuses it at once, naming the part.
+TEST_F(LightFieldSceneFiles, RefusesAPlyCutShortAtOnce) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const std::string cases[][2] = {
+      {"no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"},
+      {"short_body.ply", header + std::string(20, '\0')},  // 3 * 12 + 1 bytes needed
+      {"ascii_short.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n0 0 0\n1 0 0\n"},
+      {"bad_type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty vec3 p\nend_header\n"},
+      {"no_vertex.ply", "ply\nformat ascii 1.0\nelement face 0\nend_header\n"}};
+  for (const auto& [name, text] : cases) {
+    const auto start = std::chrono::steady_clock::now();
+    ExpectBadInputNaming(Write(name, text));
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10)
+        << name << " was not refused before the import";
+  }
+}
+
+// The import runs in a child with a time limit: past it the child is killed and the error names
+// the file (a limit of 0 s is always past). A FIFO is refused before anything opens it.
+TEST_F(LightFieldSceneFiles, TimeLimitAndFifo) {
+  const std::string quad = Write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n");
+  try {
+    LoadSceneFile(quad, 0.0);
+    ADD_FAILURE() << "loaded within 0 s";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+    EXPECT_NE(std::string(e.what()).find(quad + ": reading the scene took longer than"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(LoadSceneFile(quad).triangles(), 2u);  // and within the default limit it loads
+  const std::string fifo = (dir_ / "scene.obj").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  ExpectBadInputNaming(fifo);
 }
 
 }  // namespace

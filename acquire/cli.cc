@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "acquire/filter_print.h"
+#include "acquire/import.h"
 #include "acquire/synth.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
@@ -46,6 +47,52 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
                 "print the scene as JSON (the built-in one for --scene default) and exit");
   AddCommonOptions(cmd, common);
   return cmd;
+}
+
+CLI::App* AddImportCommand(CLI::App& app, ImportOptions* o, CommonOptions* common) {
+  CLI::App* cmd = app.add_subcommand(
+      "import",
+      "a folder of camera photos + a setup file -> dataset.json naming the photos where they are "
+      "(nothing is copied)");
+  cmd->add_option("--photos", o->photos_dir, "the camera's folder of photos")->required();
+  cmd->add_option("--setup", o->setup_file,
+                  "setup file: dataset.json without photos (setup, filter, radiometry, "
+                  "calibration; calibration.photo relative to --photos)")
+      ->required();
+  cmd->add_option("--out", o->out_dir, "dataset folder to write")->required();
+  cmd->add_option("--manifest", o->manifest, "CSV, one row per photo: i,j,slide,file[,exposure]");
+  cmd->add_option("--pattern", o->pattern,
+                  "file-name template, e.g. pos_{i}_{j}_{slide}_{exposure}.jpg ({bracket}: "
+                  "index in the slide's bracket)");
+  cmd->add_option("--order", o->order,
+                  "name: the photos' name order is the capture order (scan positions, slide p "
+                  "then n, each bracket)");
+  cmd->add_option("--scan", o->scan, "--order: rows, serpentine or columns")->capture_default_str();
+  cmd->add_option("--exposures", o->exposures,
+                  "--order: the relative exposures of each slide's bracket, in capture order")
+      ->delimiter(',');
+  cmd->add_option("--exposure", o->exposure,
+                  "relative exposure of every photo that has none of its own")
+      ->check(FiniteIn(1e-9, 1e9));
+  cmd->add_flag("--force", o->force, "write dataset.json again if it exists");
+  AddCommonOptions(cmd, common);
+  return cmd;
+}
+
+int RunImportCommand(ImportOptions o) {
+  o.out_dir = TrimTrailingSlashes(o.out_dir);
+  o.photos_dir = TrimTrailingSlashes(o.photos_dir);
+  LogInfo("parameters: photos=", o.photos_dir, " setup=", o.setup_file, " out=", o.out_dir,
+          " manifest=", o.manifest, " pattern=", o.pattern, " order=", o.order, " scan=", o.scan,
+          " force=", o.force ? "yes" : "no");
+  const ImportReport r = RunImport(o);
+  if (r.skipped) return 0;
+  if (!r.unused.empty())
+    LogWarning(r.unused.size(), " file(s) of ", o.photos_dir,
+               " are not in the dataset (first: ", r.unused.front(), ")");
+  LogInfo("imported ", r.photos, " photos, ", r.brackets, " exposure(s) per slide");
+  std::printf("dataset: %s\n", o.out_dir.c_str());
+  return 0;
 }
 
 CLI::App* AddFilterCommand(CLI::App& app, FilterPrintOptions* o, CommonOptions* common) {
@@ -107,7 +154,9 @@ int RunSynthCommand(SynthOptions synth, int threads) {
 }  // namespace
 
 int RunAcquire(int argc, char** argv) {
-  CLI::App app{"lumislab-acquire: synthetic capture of a luminaire and filter-slide printing"};
+  CLI::App app{
+      "lumislab-acquire: synthetic capture of a luminaire, import of a camera's photos, and "
+      "filter-slide printing"};
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);
@@ -115,9 +164,12 @@ int RunAcquire(int argc, char** argv) {
   FilterPrintOptions filter;
   CLI::App* synth_cmd = AddSynthCommand(app, &synth, &common);
   CLI::App* filter_cmd = AddFilterCommand(app, &filter, &common);
+  ImportOptions import;
+  CLI::App* import_cmd = AddImportCommand(app, &import, &common);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("acquire", common);
   if (filter_cmd->parsed()) return RunFilter(filter);
+  if (import_cmd->parsed()) return RunImportCommand(import);
   if (synth_cmd->parsed() && synth.print_scene) return PrintScene(synth.options.scene);
   return RunSynthCommand(synth.options, threads);
 }

@@ -125,9 +125,9 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std:
 bool DatasetComplete(const std::string& dir) {
   try {
     const Dataset ds = Dataset::Load(dir);
-    if (!fs::exists(ds.Path(ds.calibration.photo))) return false;
+    if (!fs::exists(ds.PhotoPath(ds.calibration.photo))) return false;
     for (const auto& p : ds.photos)
-      if (!fs::exists(ds.Path(p.file))) return false;
+      if (!fs::exists(ds.PhotoPath(p.file))) return false;
     if (!fs::exists(dir + "/truth/camera.json")) return false;
     return SlabInfo::Load(dir + "/truth").Complete();
   } catch (const Error&) {

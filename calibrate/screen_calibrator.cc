@@ -241,7 +241,7 @@ ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibrator
                                   ScreenCalibrationReport* report) {
   if (dataset.calibration.photo.empty())
     throw InputError(dataset.Path("dataset.json"), "calibration.photo", "a photo file", "\"\"");
-  const std::string path = dataset.Path(dataset.calibration.photo);
+  const std::string path = dataset.PhotoPath(dataset.calibration.photo);
   const cv::Mat photo = LinearGray(DecodePhoto(path, CalibrationPhotoSpec(dataset)));
   ScreenCalibration c = CalibrateScreenPhoto(photo, dataset.calibration, path, options, report);
   c.photo = dataset.calibration.photo;  // relative to the dataset folder

@@ -102,6 +102,12 @@ std::string PhotoFileName(int i, int j, bool positive, const std::string& ext,
   return name + "." + ext;
 }
 
+std::string Dataset::PhotoPath(const std::string& file) const {
+  if (photo_folder.empty()) return Path(file);
+  if (photo_folder[0] == '/') return photo_folder + "/" + file;
+  return Path(photo_folder + "/" + file);
+}
+
 std::vector<PhotoEntry> Dataset::PhotosOf(int i, int j) const {
   std::vector<PhotoEntry> out;
   for (const auto& p : photos)
@@ -110,8 +116,11 @@ std::vector<PhotoEntry> Dataset::PhotosOf(int i, int j) const {
 }
 
 Dataset Dataset::Load(const std::string& dir) {
-  const std::string file = dir + "/dataset.json";
-  const JsonDocument doc = JsonDocument::Load(file);
+  return Parse(JsonDocument::Load(dir + "/dataset.json"), dir);
+}
+
+Dataset Dataset::Parse(const JsonDocument& doc, const std::string& dir, bool with_photos) {
+  const std::string& file = doc.file();
   doc.CheckSchemaVersion(kDatasetSchemaVersion);
   const JsonView root = doc.root();
   Dataset ds;
@@ -138,10 +147,16 @@ Dataset Dataset::Load(const std::string& dir) {
   ds.white_level = radiometry.Has("white_level") ? radiometry["white_level"].NumberIn(0.5, 1e6) : 1;
   if (!(ds.white_level > ds.black_level)) radiometry["white_level"].Fail("a level > black_level");
 
+  if (root.Has("photo_folder")) {
+    ds.photo_folder = root["photo_folder"].String();
+    if (ds.photo_folder.empty() || ds.photo_folder.size() > 4096 ||
+        ds.photo_folder.find('\0') != std::string::npos)
+      root["photo_folder"].Fail("a folder path (absolute or relative to the dataset folder)");
+  }
   const JsonView calib = root["calibration"];
   ds.calibration.photo = calib["photo"].String();
   if (!IsRelativeInside(ds.calibration.photo))
-    calib["photo"].Fail("a path relative to the dataset folder");
+    calib["photo"].Fail("a path relative to the photo folder, without \"..\"");
   const JsonView target = calib["target"];
   target["type"].OneOf({"checkerboard"});
   ds.calibration.squares_x = target["squares"][0].IntIn(kMinBoardSquares, kMaxBoardSquares);
@@ -153,6 +168,7 @@ Dataset Dataset::Load(const std::string& dir) {
   ds.calibration.origin_mm = {origin[0], origin[1]};
   ds.calibration.Check(file, "calibration.target");
 
+  if (!with_photos) return ds;
   const JsonView photos = root["photos"];
   std::set<std::tuple<int, int, bool>> slides;
   for (size_t k = 0; k < photos.Size(); ++k) {
@@ -162,7 +178,8 @@ Dataset Dataset::Load(const std::string& dir) {
     e.j = p["j"].IntIn(0, ds.grid.nv - 1);
     e.positive = p["slide"].OneOf({"p", "n"}) == "p";
     e.file = p["file"].String();
-    if (!IsRelativeInside(e.file)) p["file"].Fail("a path relative to the dataset folder");
+    if (!IsRelativeInside(e.file))
+      p["file"].Fail("a path relative to the photo folder, without \"..\"");
     e.exposure = p.Has("exposure") ? p["exposure"].NumberIn(1e-9, 1e9) : 1.0;
     slides.insert({e.i, e.j, e.positive});
     // The same photo twice, or two photos of one slide at one exposure, would be merged as if
@@ -187,8 +204,13 @@ Dataset Dataset::Load(const std::string& dir) {
 }
 
 void Dataset::Save(const std::string& out_dir) const {
+  WriteJsonAtomically(out_dir + "/dataset.json", ToJson());
+}
+
+nlohmann::json Dataset::ToJson() const {
   nlohmann::json j;
-  j["schema_version"] = kDatasetSchemaVersion;
+  j["schema_version"] = photo_folder.empty() ? 2 : kDatasetSchemaVersion;
+  if (!photo_folder.empty()) j["photo_folder"] = photo_folder;
   j["synthetic"] = synthetic;
   j["setup"] = {{"distance_mm", distance_mm},
                 {"grid", GridJson(grid)},
@@ -213,7 +235,7 @@ void Dataset::Save(const std::string& out_dir) const {
                     {"file", p.file},
                     {"exposure", p.exposure}});
   j["photos"] = list;
-  WriteJsonAtomically(out_dir + "/dataset.json", j);
+  return j;
 }
 
 }  // namespace lumislab

@@ -16,8 +16,10 @@
 namespace lumislab {
 
 // 2 added radiometry.transfer, black_level and white_level (version 1 files read with their
-// defaults; a version-1 reader refuses version 2 instead of misreading the photos).
-constexpr int kDatasetSchemaVersion = 2;
+// defaults; a version-1 reader refuses version 2 instead of misreading the photos). 3 added
+// photo_folder (photos referenced where a camera wrote them); a dataset without one is still
+// written as version 2.
+constexpr int kDatasetSchemaVersion = 3;
 
 struct FilterInfo {
   std::string basis = "bell";
@@ -93,12 +95,22 @@ struct Dataset {
   double black_level = 0;
   double white_level = 1;
   CalibrationTarget calibration;
+  // Where the photo files (the slide photos and the calibration photo) are: "" for the dataset
+  // folder itself, else a folder absolute or relative to the dataset folder (`acquire import`
+  // references a camera's folder instead of copying it). Photo names are relative to it.
+  std::string photo_folder;
   std::vector<PhotoEntry> photos;
   bool synthetic = false;
 
   static Dataset Load(const std::string& dir);  // validates, errors name dataset.json and field
-  void Save(const std::string& dir) const;      // atomic
+  // The dataset a parsed JSON document describes, for the folder `dir`; errors name the
+  // document's file. `with_photos` false reads a setup file (dataset.json without photos).
+  static Dataset Parse(const JsonDocument& doc, const std::string& dir, bool with_photos = true);
+  void Save(const std::string& dir) const;  // atomic
+  nlohmann::json ToJson() const;            // what Save writes
   std::string Path(const std::string& relative) const { return dir + "/" + relative; }
+  // A photo's path: `file` (a PhotoEntry's or the calibration photo's) under photo_folder.
+  std::string PhotoPath(const std::string& file) const;
   // Photos of one position (both slides, all exposures), in file order.
   std::vector<PhotoEntry> PhotosOf(int i, int j) const;
   SlabLayout Layout(int resolution) const {

@@ -63,6 +63,7 @@ class JsonDocument {
   static JsonDocument Load(const std::string& path);
   static JsonDocument Parse(const std::string& text, const std::string& name);
   JsonView root() const { return JsonView(json_.get(), file_, ""); }
+  const std::string& file() const { return *file_; }
   const nlohmann::json& raw() const { return *json_; }
   // Checks "schema_version" is present and <= max_supported.
   void CheckSchemaVersion(int max_supported) const;

@@ -11,7 +11,7 @@
 namespace lumislab {
 
 DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry) {
-  return {entry, DecodePhoto(dataset.Path(entry.file), PhotoSpecOf(dataset, entry))};
+  return {entry, DecodePhoto(dataset.PhotoPath(entry.file), PhotoSpecOf(dataset, entry))};
 }
 
 void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,

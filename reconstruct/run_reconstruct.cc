@@ -43,7 +43,7 @@ std::string Name(const Position& p) {
 bool PhotosReady(const Dataset& dataset, int i, int j) {
   bool has_p = false, has_n = false;
   for (const auto& e : dataset.PhotosOf(i, j)) {
-    if (!fs::exists(dataset.Path(e.file))) return false;
+    if (!fs::exists(dataset.PhotoPath(e.file))) return false;
     (e.positive ? has_p : has_n) = true;
   }
   return has_p && has_n;
@@ -56,8 +56,9 @@ void CheckPhotosExist(const Dataset& dataset, const std::vector<Position>& todo)
       throw InputError(dataset.Path("dataset.json"), "photos", "photos for every grid position",
                        "none for position " + Name({i, j}));
     for (const auto& e : entries)
-      if (!fs::exists(dataset.Path(e.file)))
-        throw BadInput(dataset.Path(e.file) + ": photo missing (listed in dataset.json photos)");
+      if (!fs::exists(dataset.PhotoPath(e.file)))
+        throw BadInput(dataset.PhotoPath(e.file) +
+                       ": photo missing (listed in dataset.json photos)");
   }
 }
 

@@ -243,14 +243,16 @@ TEST_F(IoTest, DatasetRoundTripAndValidation) {
   expect_error("\"file\": \"photos/pos_2_1_n.exr\"", "\"file\": \"/etc/passwd\"",
                "photos[11].file");
   expect_error("\"photo\": \"photos/calib_0.png\"", "\"photo\": \"../calib_0.png\"",
-               "calibration.photo: expected a path relative to the dataset folder");
+               "calibration.photo: expected a path relative to the photo folder");
   // The slides are Phi~ / peak: a peak that does not belong to the coefficients is refused.
   expect_error("\"peak\": ", "\"peak\": 1.5e0, \"was_peak\": ", "filter.peak: expected max |Phi~|");
   // A square board is refused when the dataset is read, not only by calibrate.
   expect_error("\"squares\": [", "\"squares\": [13, 13], \"was\": [",
                "calibration.target.squares: expected squares_x != squares_y");
   // A newer schema is refused, not misread.
-  expect_error("\"schema_version\": 2", "\"schema_version\": 3", "schema_version");
+  expect_error("\"schema_version\": 2", "\"schema_version\": 4", "schema_version");
+  expect_error("\"schema_version\": 2", "\"schema_version\": 3, \"photo_folder\": \"\"",
+               "photo_folder: expected a folder path");
 }
 
 // Old files stay readable: a version-1 dataset.json reads with the version-2 defaults.

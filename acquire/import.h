@@ -1,0 +1,50 @@
+// lumislab-acquire import: a folder of camera photos and a setup file become a dataset
+// (docs/design.md §5.7). The photos stay where the camera wrote them: dataset.json names their
+// folder (photo_folder) and each file in it; nothing is copied or modified.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/dataset.h"
+
+namespace lumislab {
+
+struct ImportOptions {
+  std::string photos_dir;  // the camera's folder
+  std::string setup_file;  // dataset.json without photos; calibration.photo relative to photos_dir
+  std::string out_dir;     // the dataset folder to write (dataset.json)
+  // Exactly one way of telling which photo is which:
+  std::string manifest;  // CSV, one row per photo: i,j,slide,file[,exposure]
+  std::string pattern;   // file-name template: {i} {j} {slide}, optional {exposure} and {bracket}
+  std::string order;     // "name": the photos' name order is the capture order
+  // With `order`: how the grid was scanned, and the exposures of each slide's bracket, in the
+  // order they were taken (relative exposures; one value: no brackets).
+  std::string scan = "rows";  // rows | serpentine | columns
+  std::vector<double> exposures;
+  // The relative exposure of a photo nothing else gives one for (manifest rows without an
+  // exposure, patterns without {exposure}); without it such a photo is an error.
+  std::optional<double> exposure;
+  bool force = false;  // rewrite an existing dataset.json
+
+  void Check() const;  // BadInput naming the option
+};
+
+struct ImportReport {
+  bool skipped = false;             // dataset.json existed (no --force)
+  int photos = 0;                   // slide photos listed
+  int brackets = 1;                 // exposures per slide
+  std::vector<std::string> unused;  // image files in the folder that no photo entry names
+};
+
+// Builds dataset.json for the photos: every named file must be a regular file holding an image
+// (PNG, JPEG, TIFF or EXR by its content), every grid position must have both slides, and every
+// slide the same number of exposures; BadInput naming the file, line or position otherwise.
+ImportReport RunImport(const ImportOptions& options);
+
+// The grid position of the k-th photo position of a scan (rows: i fastest; serpentine: rows,
+// every other one reversed; columns: j fastest).
+std::pair<int, int> ScanPosition(const SamplingGrid& grid, const std::string& scan, int k);
+
+}  // namespace lumislab

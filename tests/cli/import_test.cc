@@ -1,0 +1,207 @@
+// lumislab-acquire import (docs/design.md §5.7): a synthetic capture is turned into what a camera
+// leaves behind (a folder of IMG_0001.PNG ... in capture order, the board photo, no
+// dataset.json) plus a setup file; import, calibrate and reconstruct must then give exactly the
+// slab of the original dataset, the camera's folder must stay untouched, and every way of
+// naming the photos (name order, manifest, pattern) must give the same dataset. Bad folders and
+// descriptions exit 2 naming the file, line or position, and write nothing.
+#include "acquire/import.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/dataset.h"
+#include "core/slab_compare.h"
+#include "test_util.h"
+
+namespace fs = std::filesystem;
+
+namespace lumislab {
+namespace {
+
+using testing::ReadBinaryFile;
+using testing::RunToolIn;
+using testing::SnapshotTree;
+
+class Import : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = testing::FreshDir(std::string("import_") +
+                              ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    testing::WriteFile(root_ + "/scene.json",
+                       testing::SceneJson(3, 2,
+                                          R"({"size_px": [320, 240], "focal_px": 280,
+                               "position_mm": [0, -200, 2400], "look_at_mm": [0, 0, 750]})",
+                                          R"([{"type": "quantization", "bit_depth": 16}])"));
+    Ok("lumislab-acquire", "synth --scene scene.json --out original --truth-resolution 40");
+    // The camera's folder: the slide photos renamed in capture order (rows, p then n).
+    const Dataset ds = Dataset::Load(root_ + "/original");
+    fs::create_directories(root_ + "/camera");
+    int k = 1;
+    for (int j = 0; j < ds.grid.nv; ++j)
+      for (int i = 0; i < ds.grid.nu; ++i)
+        for (const bool positive : {true, false})
+          for (const auto& e : ds.PhotosOf(i, j))
+            if (e.positive == positive) {
+              names_.push_back(Copy(ds.PhotoPath(e.file), k++));
+              manifest_ += std::to_string(i) + "," + std::to_string(j) + "," +
+                           (positive ? "p" : "n") + "," + names_.back() + ",1\n";
+            }
+    fs::copy_file(ds.PhotoPath(ds.calibration.photo), root_ + "/camera/BOARD.PNG");
+    nlohmann::json setup = nlohmann::json::parse(ReadBinaryFile(root_ + "/original/dataset.json"));
+    setup.erase("photos");
+    setup.erase("synthetic");
+    setup["calibration"]["photo"] = "BOARD.PNG";
+    testing::WriteFile(root_ + "/setup.json", setup.dump(2));
+    testing::WriteFile(root_ + "/captures.csv", "i,j,slide,file,exposure\n" + manifest_);
+  }
+  std::string Copy(const std::string& from, int k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "IMG_%04d.PNG", k);
+    fs::copy_file(from, root_ + "/camera/" + name);
+    return name;
+  }
+  void Ok(const std::string& tool, const std::string& args) {
+    const auto r = RunToolIn(root_, tool, args, 120);
+    ASSERT_EQ(r.exit_code, 0) << tool << " " << args << "\n" << r.output;
+  }
+  // Import refused: exit 2, the message names `names`, and nothing was written.
+  void Refused(const std::string& args, const std::vector<std::string>& names) {
+    const auto before = SnapshotTree(root_);
+    const std::string setup =
+        args.find("--setup") == std::string::npos ? " --setup setup.json" : "";
+    const auto r =
+        RunToolIn(root_, "lumislab-acquire", "import --photos camera --out ds " + args + setup, 60);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    for (const auto& n : names)
+      EXPECT_NE(r.output.find(n), std::string::npos) << n << "\n" << r.output;
+    EXPECT_EQ(testing::DiffSnapshots(before, SnapshotTree(root_)), std::vector<std::string>{})
+        << args;
+  }
+  std::string root_, manifest_;
+  std::vector<std::string> names_;
+};
+
+TEST_F(Import, CameraFolderGivesTheOriginalSlab) {
+  const auto camera_before = SnapshotTree(root_ + "/camera");
+  Ok("lumislab-acquire",
+     "import --photos camera --setup setup.json --out ds --order name "
+     "--exposure 1");
+  // Nothing copied: the dataset folder holds dataset.json alone; it names the camera's folder.
+  EXPECT_EQ(testing::CountFinalFiles(root_ + "/ds"), 1);
+  const Dataset ds = Dataset::Load(root_ + "/ds");
+  EXPECT_EQ(ds.photo_folder, "../camera");
+  EXPECT_EQ(ds.photos.size(), 12u);
+  Ok("lumislab-calibrate", "screen --dataset ds");
+  Ok("lumislab-reconstruct", "--dataset ds --resolution 40");
+  Ok("lumislab-calibrate", "screen --dataset original");
+  Ok("lumislab-reconstruct", "--dataset original --resolution 40");
+  const SlabComparison c = CompareSlabs(root_ + "/ds/slab", root_ + "/original/slab", 0.0);
+  EXPECT_EQ(c.positions.size(), 6u);
+  EXPECT_LE(c.max_relative_l2, 1e-7);
+  EXPECT_EQ(testing::DiffSnapshots(camera_before, SnapshotTree(root_ + "/camera")),
+            std::vector<std::string>{});
+  // A second run skips; --force writes the same file again.
+  const std::string json = ReadBinaryFile(root_ + "/ds/dataset.json");
+  Ok("lumislab-acquire",
+     "import --photos camera --setup setup.json --out ds --order name "
+     "--exposure 1 --force");
+  EXPECT_EQ(ReadBinaryFile(root_ + "/ds/dataset.json"), json);
+}
+
+TEST_F(Import, ManifestPatternAndOrderAgree) {
+  Ok("lumislab-acquire",
+     "import --photos camera --setup setup.json --out by_order --order name "
+     "--exposures 1");
+  Ok("lumislab-acquire",
+     "import --photos camera --setup setup.json --out by_manifest --manifest captures.csv");
+  // The pattern needs names that carry the position: a second folder named so.
+  fs::create_directories(root_ + "/named");
+  const Dataset by_order = Dataset::Load(root_ + "/by_order");
+  for (const auto& e : by_order.photos)
+    fs::copy_file(by_order.PhotoPath(e.file), root_ + "/named/pos" + std::to_string(e.i) + "-" +
+                                                  std::to_string(e.j) + "_" +
+                                                  (e.positive ? "P" : "N") + "_x1.png");
+  fs::copy_file(root_ + "/camera/BOARD.PNG", root_ + "/named/BOARD.PNG");
+  Ok("lumislab-acquire",
+     "import --photos named --setup setup.json --out by_pattern "
+     "--pattern pos{i}-{j}_{slide}_x{exposure}.png");
+  const Dataset by_manifest = Dataset::Load(root_ + "/by_manifest");
+  const Dataset by_pattern = Dataset::Load(root_ + "/by_pattern");
+  ASSERT_EQ(by_manifest.photos.size(), by_order.photos.size());
+  ASSERT_EQ(by_pattern.photos.size(), by_order.photos.size());
+  for (size_t k = 0; k < by_order.photos.size(); ++k) {
+    const PhotoEntry &a = by_order.photos[k], &b = by_manifest.photos[k], &c = by_pattern.photos[k];
+    EXPECT_EQ(a.file, b.file);
+    EXPECT_EQ(ReadBinaryFile(by_order.PhotoPath(a.file)),
+              ReadBinaryFile(by_pattern.PhotoPath(c.file)));
+    for (const PhotoEntry* e : {&b, &c}) {
+      EXPECT_EQ(std::make_tuple(a.i, a.j, a.positive, a.exposure),
+                std::make_tuple(e->i, e->j, e->positive, e->exposure))
+          << a.file;
+    }
+  }
+}
+
+TEST(ImportScan, ScanOrders) {
+  SamplingGrid grid;
+  grid.nu = 3;
+  grid.nv = 2;
+  const std::vector<std::pair<int, int>> rows = {{0, 0}, {1, 0}, {2, 0}, {0, 1}, {1, 1}, {2, 1}};
+  const std::vector<std::pair<int, int>> serpentine = {{0, 0}, {1, 0}, {2, 0},
+                                                       {2, 1}, {1, 1}, {0, 1}};
+  const std::vector<std::pair<int, int>> columns = {{0, 0}, {0, 1}, {1, 0}, {1, 1}, {2, 0}, {2, 1}};
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(ScanPosition(grid, "rows", k), rows[size_t(k)]);
+    EXPECT_EQ(ScanPosition(grid, "serpentine", k), serpentine[size_t(k)]);
+    EXPECT_EQ(ScanPosition(grid, "columns", k), columns[size_t(k)]);
+  }
+}
+
+TEST_F(Import, BadFoldersAndDescriptionsAreRefused) {
+  // A photo missing from the folder: the count and the first missing position.
+  fs::rename(root_ + "/camera/" + names_.back(), root_ + "/" + names_.back());
+  Refused("--order name --exposure 1", {"camera", "photos", "position (2, 1)"});
+  fs::rename(root_ + "/" + names_.back(), root_ + "/camera/" + names_.back());
+  // A file that is not an image, where a photo should be.
+  testing::WriteFile(root_ + "/camera/" + names_[3], "not an image\n");
+  Refused("--manifest captures.csv", {"camera/" + names_[3]});
+  Refused("--order name --exposure 1", {"camera/" + names_[3]});
+  fs::copy_file(root_ + "/camera/" + names_[2], root_ + "/camera/" + names_[3],
+                fs::copy_options::overwrite_existing);
+  // Manifest rows: a bad slide, a position outside the grid, a missing slide, a row twice.
+  testing::WriteFile(root_ + "/bad.csv", "0,0,q," + names_[0] + ",1\n");
+  Refused("--manifest bad.csv", {"bad.csv", "line 1, column slide"});
+  testing::WriteFile(root_ + "/bad.csv", "5,0,p," + names_[0] + ",1\n");
+  Refused("--manifest bad.csv", {"bad.csv: line 1", "position"});
+  testing::WriteFile(root_ + "/bad.csv",
+                     manifest_.substr(0, manifest_.rfind('\n', manifest_.size() - 2) + 1));
+  Refused("--manifest bad.csv", {"camera", "slide n", "position (2, 1)"});
+  testing::WriteFile(root_ + "/bad.csv", manifest_ + manifest_.substr(0, manifest_.find('\n') + 1));
+  Refused("--manifest bad.csv",
+          {"bad.csv: line 13", names_[0] + ", named before by bad.csv: line 1"});
+  // No exposure anywhere.
+  testing::WriteFile(root_ + "/bad.csv", "0,0,p," + names_[0] + "\n");
+  Refused("--manifest bad.csv", {"bad.csv: line 1", "no exposure"});
+  Refused("--order name", {names_[0], "no exposure"});
+  // Incomplete brackets: two exposures per slide announced, the folder holds one.
+  Refused("--order name --exposures 1,4", {"camera", "24 photos"});
+  // The options themselves.
+  Refused("--order name --manifest captures.csv --exposure 1", {"exactly one of"});
+  Refused("--pattern IMG_{i}.PNG --exposure 1", {"--pattern", "{j}"});
+  Refused("--order time --exposure 1", {"--order"});
+  Refused("--order name --scan spiral --exposure 1", {"--scan"});
+  // The setup file and the board photo.
+  Refused("--order name --exposure 1 --setup nothere.json", {"nothere.json"});
+  nlohmann::json setup = nlohmann::json::parse(ReadBinaryFile(root_ + "/setup.json"));
+  setup["calibration"]["photo"] = "NOBOARD.PNG";
+  testing::WriteFile(root_ + "/setup2.json", setup.dump());
+  Refused("--order name --exposure 1 --setup setup2.json", {"camera/NOBOARD.PNG"});
+}
+
+}  // namespace
+}  // namespace lumislab

@@ -11,6 +11,7 @@
 #include <memory>
 #include <numeric>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "core/atomic_file.h"
@@ -36,15 +37,15 @@ int IgnoreTiffMessage(TIFF*, void*, const char*, const char*, va_list) { return 
 template <typename T>
 void SetArray(TIFF* tif, uint32_t tag, const std::vector<T>& values) {
   const TIFFField* field = TIFFFieldWithTag(tif, tag);
-  LUMISLAB_CHECK(field, "WriteDng: libtiff does not know tag " + std::to_string(tag));
+  LUMISLAB_CHECK(field, "TIFF writer: libtiff does not know tag " + std::to_string(tag));
   const int ok = TIFFFieldPassCount(field)
                      ? TIFFSetField(tif, tag, int(values.size()), values.data())
                      : TIFFSetField(tif, tag, values.data());
-  LUMISLAB_CHECK(ok, "WriteDng: libtiff refused tag " + std::to_string(tag));
+  LUMISLAB_CHECK(ok, "TIFF writer: libtiff refused tag " + std::to_string(tag));
 }
 void SetReals(TIFF* tif, uint32_t tag, const std::vector<double>& values) {
   const TIFFField* field = TIFFFieldWithTag(tif, tag);
-  LUMISLAB_CHECK(field, "WriteDng: libtiff does not know tag " + std::to_string(tag));
+  LUMISLAB_CHECK(field, "TIFF writer: libtiff does not know tag " + std::to_string(tag));
   if (TIFFFieldSetGetSize(field) == 4)
     SetArray(tif, tag, std::vector<float>(values.begin(), values.end()));
   else
@@ -53,7 +54,7 @@ void SetReals(TIFF* tif, uint32_t tag, const std::vector<double>& values) {
 template <typename... A>
 void Set(TIFF* tif, uint32_t tag, A... values) {
   LUMISLAB_CHECK(TIFFSetField(tif, tag, values...),
-                 "WriteDng: libtiff refused tag " + std::to_string(tag));
+                 "TIFF writer: libtiff refused tag " + std::to_string(tag));
 }
 
 bool HasExifDirectory(const PhotoExif& e) {
@@ -63,7 +64,8 @@ bool HasExifDirectory(const PhotoExif& e) {
 // The EXIF directory, written before IFD0 (libtiff appends it, unlinked; IFD0 then points to
 // it through ExifIFD). Returns its offset.
 uint64_t WriteExifDirectory(TIFF* tif, const PhotoExif& e) {
-  LUMISLAB_CHECK(TIFFCreateEXIFDirectory(tif) == 0, "WriteDng: cannot create the EXIF directory");
+  LUMISLAB_CHECK(TIFFCreateEXIFDirectory(tif) == 0,
+                 "TIFF writer: cannot create the EXIF directory");
   SetArray(tif, EXIFTAG_EXIFVERSION, std::vector<uint8_t>{'0', '2', '3', '0'});
   if (e.exposure_time) Set(tif, EXIFTAG_EXPOSURETIME, *e.exposure_time);
   if (e.f_number) Set(tif, EXIFTAG_FNUMBER, *e.f_number);
@@ -71,21 +73,37 @@ uint64_t WriteExifDirectory(TIFF* tif, const PhotoExif& e) {
   if (e.lens_model) Set(tif, EXIFTAG_LENSMODEL, e.lens_model->c_str());
   if (e.date_time) Set(tif, EXIFTAG_DATETIMEORIGINAL, e.date_time->c_str());
   uint64_t offset = 0;
-  if (!TIFFWriteCustomDirectory(tif, &offset)) throw Failure("WriteDng: cannot write EXIF");
+  if (!TIFFWriteCustomDirectory(tif, &offset)) throw Failure("TIFF writer: cannot write EXIF");
   TIFFFreeDirectory(tif);
   TIFFCreateDirectory(tif);  // back to a main IFD
   return offset;
 }
 
-void WriteDngFile(const std::string& tmp, const cv::Mat& mosaic, const DngInfo& info,
-                  std::string& error) {
+using TiffFile = std::unique_ptr<TIFF, void (*)(TIFF*)>;
+
+// Creates `tmp` for writing, libtiff's errors going into `error` (closed when the handle goes).
+TiffFile CreateTiff(const std::string& tmp, std::string& error) {
   std::unique_ptr<TIFFOpenOptions, void (*)(TIFFOpenOptions*)> options(TIFFOpenOptionsAlloc(),
                                                                        TIFFOpenOptionsFree);
   TIFFOpenOptionsSetErrorHandlerExtR(options.get(), &CollectTiffMessage, &error);
   TIFFOpenOptionsSetWarningHandlerExtR(options.get(), &IgnoreTiffMessage, nullptr);
-  std::unique_ptr<TIFF, void (*)(TIFF*)> file(TIFFOpenExt(tmp.c_str(), "w", options.get()),
-                                              TIFFClose);
-  if (!file) throw IoError(tmp, "cannot create the DNG: " + error);
+  TiffFile file(TIFFOpenExt(tmp.c_str(), "w", options.get()), TIFFClose);
+  if (!file) throw IoError(tmp, "cannot create the file: " + error);
+  return file;
+}
+
+// Make, model and date-time in IFD0, and the pointer to the EXIF directory.
+void SetCameraTags(TIFF* tif, const PhotoExif& e, uint64_t exif_offset) {
+  Set(tif, TIFFTAG_SOFTWARE, "lumislab");
+  if (e.make) Set(tif, TIFFTAG_MAKE, e.make->c_str());
+  if (e.model) Set(tif, TIFFTAG_MODEL, e.model->c_str());
+  if (e.date_time) Set(tif, TIFFTAG_DATETIME, e.date_time->c_str());
+  if (exif_offset) Set(tif, TIFFTAG_EXIFIFD, exif_offset);
+}
+
+void WriteDngFile(const std::string& tmp, const cv::Mat& mosaic, const DngInfo& info,
+                  std::string& error) {
+  const TiffFile file = CreateTiff(tmp, error);
   TIFF* tif = file.get();
   const PhotoExif& e = info.exif;
   const uint64_t exif_offset = HasExifDirectory(e) ? WriteExifDirectory(tif, e) : 0;
@@ -100,10 +118,7 @@ void WriteDngFile(const std::string& tmp, const cv::Mat& mosaic, const DngInfo& 
   Set(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
   Set(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
   Set(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
-  Set(tif, TIFFTAG_SOFTWARE, "lumislab");
-  if (e.make) Set(tif, TIFFTAG_MAKE, e.make->c_str());
-  if (e.model) Set(tif, TIFFTAG_MODEL, e.model->c_str());
-  if (e.date_time) Set(tif, TIFFTAG_DATETIME, e.date_time->c_str());
+  SetCameraTags(tif, e, exif_offset);
   SetArray(tif, TIFFTAG_CFAREPEATPATTERNDIM, std::vector<uint16_t>{2, 2});
   SetArray(tif, TIFFTAG_CFAPATTERN, std::vector<uint8_t>{0, 1, 1, 2});  // R G / G B
   SetArray(tif, TIFFTAG_DNGVERSION, std::vector<uint8_t>{1, 4, 0, 0});
@@ -119,7 +134,6 @@ void WriteDngFile(const std::string& tmp, const cv::Mat& mosaic, const DngInfo& 
   Set(tif, TIFFTAG_CALIBRATIONILLUMINANT1, 21);  // D65
   const auto& n = info.as_shot_neutral;
   SetReals(tif, TIFFTAG_ASSHOTNEUTRAL, {n[0], n[1], n[2]});
-  if (exif_offset) Set(tif, TIFFTAG_EXIFIFD, exif_offset);
 
   std::vector<uint16_t> row(size_t(mosaic.cols));
   for (int y = 0; y < mosaic.rows; ++y) {
@@ -128,6 +142,33 @@ void WriteDngFile(const std::string& tmp, const cv::Mat& mosaic, const DngInfo& 
       throw IoError(tmp, "cannot write the DNG: " + error);
   }
   if (!TIFFWriteDirectory(tif)) throw IoError(tmp, "cannot write the DNG: " + error);
+}
+
+void WriteTiffFile(const std::string& tmp, const cv::Mat& image, const PhotoExif& exif,
+                   std::string& error) {
+  const TiffFile file = CreateTiff(tmp, error);
+  TIFF* tif = file.get();
+  const uint64_t exif_offset = HasExifDirectory(exif) ? WriteExifDirectory(tif, exif) : 0;
+  const int channels = image.channels();
+  Set(tif, TIFFTAG_IMAGEWIDTH, uint32_t(image.cols));
+  Set(tif, TIFFTAG_IMAGELENGTH, uint32_t(image.rows));
+  Set(tif, TIFFTAG_BITSPERSAMPLE, int(image.elemSize1() * 8));
+  Set(tif, TIFFTAG_SAMPLESPERPIXEL, channels);
+  Set(tif, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
+  Set(tif, TIFFTAG_PHOTOMETRIC, channels == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
+  Set(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+  Set(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
+  Set(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
+  SetCameraTags(tif, exif, exif_offset);
+  cv::Mat rgb;  // TIFF stores R, G, B (a new buffer: the caller's image stays as it is)
+  if (channels == 3)
+    cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
+  else
+    rgb = image;
+  for (int y = 0; y < rgb.rows; ++y)
+    if (TIFFWriteScanline(tif, rgb.ptr(y), uint32_t(y), 0) < 0)
+      throw IoError(tmp, "cannot write the TIFF: " + error);
+  if (!TIFFWriteDirectory(tif)) throw IoError(tmp, "cannot write the TIFF: " + error);
 }
 
 // ---- EXIF for JPEG through libexif ----
@@ -208,6 +249,17 @@ void WriteDng(const std::string& path, const cv::Mat& mosaic, const DngInfo& inf
     std::string error;
     WriteDngFile(tmp, mosaic, info, error);  // TIFFClose when it returns or throws
     if (!error.empty()) throw IoError(path, "cannot write the DNG: " + error);
+  });
+}
+
+void WriteTiff(const std::string& path, const cv::Mat& image, const PhotoExif& exif) {
+  LUMISLAB_CHECK((image.depth() == CV_8U || image.depth() == CV_16U) &&
+                     (image.channels() == 1 || image.channels() == 3) && !image.empty(),
+                 "WriteTiff: an 8-bit or 16-bit image of 1 or 3 channels");
+  WriteAtomically(path, [&](const std::string& tmp) {
+    std::string error;
+    WriteTiffFile(tmp, image, exif, error);
+    if (!error.empty()) throw IoError(path, "cannot write the TIFF: " + error);
   });
 }
 

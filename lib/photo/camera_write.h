@@ -1,6 +1,6 @@
-// Files as a real camera writes them, for the synthetic capture: a DNG of the raw Bayer mosaic
-// and a JPEG with EXIF, so that every correction (black level, white level, white balance,
-// demosaic, exposure from EXIF) is tested against known truth. Both are written under a
+// Files as a real camera writes them, for the synthetic capture: a DNG of the raw Bayer mosaic,
+// a JPEG or TIFF with EXIF, so that every correction (black level, white level, white balance,
+// demosaic, exposure from EXIF) is tested against known truth. Each is written under a
 // temporary name and renamed into place (core/atomic_file.h); a failure is IoError.
 #pragma once
 
@@ -26,6 +26,11 @@ struct DngInfo {
 // ColorMatrix1 (raw RGB taken as XYZ: no colour science, only so readers accept the file),
 // AsShotNeutral and the EXIF.
 void WriteDng(const std::string& path, const cv::Mat& mosaic, const DngInfo& info);
+
+// Writes an 8-bit or 16-bit image (1 or 3 channels, OpenCV's BGR order) as an uncompressed TIFF
+// with make, model and date-time in IFD0 and the rest of `exif` in an EXIF directory, as a
+// camera's TIFF output (read back by DecodePhoto through OpenCV).
+void WriteTiff(const std::string& path, const cv::Mat& image, const PhotoExif& exif);
 
 // Writes an 8-bit BGR image (CV_8UC3) as a JPEG at `quality` (1 .. 100) through OpenCV, with an
 // EXIF APP1 segment (exposure time, f-number, ISO, make, model, lens, date-time; the fields

@@ -91,6 +91,20 @@ TEST(Exif, JpegRoundTrip) {
   std::cout << "JPEG q90: max code difference " << max_diff << "\n";
 }
 
+TEST(Exif, Tiff16RoundTrip) {
+  const std::string dir = ScratchDir();
+  const std::string path = dir + "/shot.tif";
+  cv::Mat bgr16;
+  Gradient().convertTo(bgr16, CV_16UC3, 257);
+  WriteTiff(path, bgr16, Shot());
+  ExpectShot(ReadPhotoExif(path), /*lens=*/true);
+  // A camera's TIFF names its maker but holds RGB, not a mosaic: OpenCV decodes it.
+  EXPECT_EQ(DetectPhotoFormat(path), PhotoFormat::kTiff);
+  const Photo photo = DecodePhoto(path);
+  ASSERT_EQ(photo.pixels.type(), CV_16UC3);
+  EXPECT_EQ(cv::norm(photo.pixels, bgr16, cv::NORM_INF), 0);  // lossless, same channel order
+}
+
 TEST(Exif, JpegWithoutExifHasNoFields) {
   const std::string dir = ScratchDir();
   const std::string path = dir + "/plain.jpg";

@@ -9,6 +9,8 @@ packages=(
   libeigen3-dev nlohmann-json3-dev libcli11-dev libopenexr-dev
   libopencv-dev libceres-dev libgtest-dev
   libglfw3-dev libosmesa6-dev python3-glad libassimp-dev
+  # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), DNG and TIFF writing (libtiff)
+  libraw-dev libexif-dev libtiff-dev
   xvfb xauth x11-apps
   # pipelines/test.sh's sanitizer and fuzz builds: clang 14, its sanitizer and libFuzzer
   # run-times, llvm-symbolizer for the stack traces (fuzz/README.md)

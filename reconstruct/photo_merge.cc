@@ -113,16 +113,16 @@ bool FusedDifference(const Photo& plus, double gain_p, const Photo& minus, doubl
 
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain, int downsample) {
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
-  // Fast path: one linear photo per slide without black level, same 16-bit or float 3-channel
-  // type, nothing saturated. Averaging is linear, so averaging first and merging after gives the
-  // same numbers.
+  // Fast path: one linear photo per slide without black level or white balance, same 16-bit or
+  // float 3-channel type, nothing saturated. Averaging is linear, so averaging first and merging
+  // after gives the same numbers.
   if (photos.size() == 2 && photos[0].entry.positive != photos[1].entry.positive) {
     const Photo& p = (photos[0].entry.positive ? photos[0] : photos[1]).photo;
     const Photo& n = (photos[0].entry.positive ? photos[1] : photos[0]).photo;
     const int type = p.pixels.type();
     const bool linear = p.transfer == Transfer::kLinear && n.transfer == Transfer::kLinear &&
-                        p.Offset() == 0 && n.Offset() == 0 &&
-                        p.SaturationCode() == n.SaturationCode();
+                        p.Offset() == 0 && n.Offset() == 0 && p.UnityWhiteBalance() &&
+                        n.UnityWhiteBalance() && p.SaturationCode() == n.SaturationCode();
     if (linear && type == n.pixels.type() && (type == CV_16UC3 || type == CV_32FC3) &&
         n.pixels.size() == p.pixels.size()) {
       MergedPosition out;

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/input_file.h"
+#include "lib/photo/raw_decode.h"
 
 namespace lumislab {
 namespace {
@@ -78,6 +79,46 @@ void CheckPng(const std::string& path) {
   }
 }
 
+// Which of DNGVersion (50706) and Make (271) the first IFD of a TIFF container holds. Reads the
+// IFD's entries only (at most 4096); a cut or odd IFD counts as holding neither, and the
+// decoder then reports what is wrong with the file.
+struct TiffTags {
+  bool dng_version = false, make = false;
+};
+TiffTags ScanFirstIfd(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[8];
+  TiffTags tags;
+  if (!in.read(reinterpret_cast<char*>(header), 8)) return tags;
+  const bool big = header[0] == 'M';
+  auto get = [&](const unsigned char* b, int n) {
+    uint32_t v = 0;
+    for (int k = 0; k < n; ++k) v |= uint32_t(b[big ? k : n - 1 - k]) << (8 * (n - 1 - k));
+    return v;
+  };
+  unsigned char count_bytes[2];
+  in.seekg(std::streamoff(get(header + 4, 4)));
+  if (!in.read(reinterpret_cast<char*>(count_bytes), 2)) return tags;
+  const uint32_t count = std::min<uint32_t>(get(count_bytes, 2), 4096);
+  for (uint32_t k = 0; k < count; ++k) {
+    unsigned char entry[12];
+    if (!in.read(reinterpret_cast<char*>(entry), 12)) break;
+    const uint32_t tag = get(entry, 2);
+    tags.dng_version |= tag == 50706;
+    tags.make |= tag == 271;
+  }
+  return tags;
+}
+
+// Camera RAW containers other than TIFF that LibRaw is asked about (ORF, RW2, RAF, CR3). Only
+// these: LibRaw also identifies headerless RAWs by their file size alone, which garbage can
+// match.
+bool RawMagic(const unsigned char* m) {
+  return std::memcmp(m, "IIRO", 4) == 0 || std::memcmp(m, "IIRS", 4) == 0 ||
+         std::memcmp(m, "MMOR", 4) == 0 || std::memcmp(m, "IIU\0", 4) == 0 ||
+         std::memcmp(m, "FUJIFILM", 8) == 0 || std::memcmp(m + 4, "ftypcrx ", 8) == 0;
+}
+
 }  // namespace
 
 void PhotoSpec::Check(const std::string& where) const {
@@ -124,22 +165,30 @@ const char* PhotoFormatName(PhotoFormat format) {
       return "TIFF";
     case PhotoFormat::kExr:
       return "EXR";
+    case PhotoFormat::kRaw:
+      return "camera RAW";
   }
   return "?";
 }
 
 PhotoFormat DetectPhotoFormat(const std::string& path) {
   CheckInputFile(path, "photo");
-  unsigned char magic[8] = {};
+  unsigned char magic[12] = {};
   std::ifstream in(path, std::ios::binary);
   in.read(reinterpret_cast<char*>(magic), sizeof magic);
   if (!in && in.gcount() < 4) throw BadInput(path + ": not a photo (file too short)");
   if (std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0) return PhotoFormat::kPng;
   if (magic[0] == 0xff && magic[1] == 0xd8 && magic[2] == 0xff) return PhotoFormat::kJpeg;
-  if (std::memcmp(magic, "II*\0", 4) == 0 || std::memcmp(magic, "MM\0*", 4) == 0)
+  if (std::memcmp(magic, "II*\0", 4) == 0 || std::memcmp(magic, "MM\0*", 4) == 0) {
+    const TiffTags tags = ScanFirstIfd(path);
+    const bool cr2 = magic[8] == 'C' && magic[9] == 'R';
+    if (tags.dng_version || cr2 || (tags.make && LibRawIdentifiesRaw(path)))
+      return PhotoFormat::kRaw;
     return PhotoFormat::kTiff;
+  }
   if (std::memcmp(magic, "\x76\x2f\x31\x01", 4) == 0) return PhotoFormat::kExr;
-  throw BadInput(path + ": not a photo lumislab reads (PNG, JPEG, TIFF or OpenEXR)");
+  if (RawMagic(magic) && LibRawIdentifiesRaw(path)) return PhotoFormat::kRaw;
+  throw BadInput(path + ": not a photo lumislab reads (PNG, JPEG, TIFF, OpenEXR or camera RAW)");
 }
 
 double Photo::CodeMax() const {
@@ -151,6 +200,10 @@ double Photo::CodeMax() const {
     default:
       return 1.0;
   }
+}
+
+bool Photo::UnityWhiteBalance() const {
+  return white_balance[0] == 1 && white_balance[1] == 1 && white_balance[2] == 1;
 }
 
 double Photo::Gain() const {
@@ -180,6 +233,12 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
     photo.pixels =
         cv::Mat(rgb.height, rgb.width, CV_32FC3, const_cast<float*>(rgb.data.data())).clone();
     photo.rgb_order = true;
+  } else if (photo.format == PhotoFormat::kRaw) {
+    RawImage raw = DecodeRaw(path, spec.raw_half_size);
+    photo.pixels = raw.rgb;
+    photo.rgb_order = true;
+    if (spec.raw_white_balance == RawWhiteBalance::kAsShot)
+      photo.white_balance = raw.as_shot_white_balance;
   } else {
     if (photo.format == PhotoFormat::kPng) CheckPng(path);
     photo.pixels = DecodeWithOpenCv(path);
@@ -187,6 +246,7 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
   photo.transfer = spec.transfer != Transfer::kAuto ? spec.transfer
                    : photo.pixels.depth() == CV_8U  ? Transfer::kSrgb
                                                     : Transfer::kLinear;
+  if (photo.format == PhotoFormat::kRaw) photo.transfer = Transfer::kLinear;  // sensor values
   return photo;
 }
 
@@ -201,6 +261,7 @@ LinearReader::LinearReader(const Photo& photo) : photo_(photo) {
   inv_range_exposure_ =
       float(1.0 / ((photo.spec.white_level - photo.spec.black_level) * photo.spec.exposure));
   saturation_ = float(photo.spec.saturation_level);
+  for (int c = 0; c < 3; ++c) white_balance_[c] = photo.white_balance[c];
 }
 
 float LinearReader::Value(float curve_value) const {
@@ -222,7 +283,7 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
       v = curve8_[m.ptr<uint8_t>(y)[size_t(x) * channels_ + offsets[c]]];
     }
     clipped[c] = !(v < saturation_);  // NaN counts as clipped
-    rgb[c] = Value(v);
+    rgb[c] = Value(v) * white_balance_[c];
   }
 }
 

@@ -1,6 +1,8 @@
 // The one photo decoder of lumislab: every stage that reads a camera photo reads it here
 // (docs/design.md §5). It owns
 //   - format detection from the file's content (the extension is not trusted),
+//   - camera RAW and DNG through LibRaw (lib/photo/raw_decode.h): linear sensor values with the
+//     file's black and white level, white balance unity or as shot, full or half size,
 //   - the transfer curve: 8-bit photos are camera output and linearised through the sRGB curve
 //     unless told otherwise, 16-bit and float photos are linear,
 //   - black and white level: linear = (curve(code / code_max) - black) / (white - black),
@@ -11,6 +13,7 @@
 // through one place.
 #pragma once
 
+#include <array>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -19,10 +22,18 @@
 
 namespace lumislab {
 
-enum class PhotoFormat { kPng, kJpeg, kTiff, kExr };
+// kRaw: a camera RAW or DNG (LibRaw). A TIFF container is a DNG when its first IFD holds the
+// DNGVersion tag; a TIFF without it is a camera RAW (NEF, ARW, PEF, ...) when it names a camera
+// maker and LibRaw identifies a Bayer mosaic in it, since OpenCV's TIFF reader would decode
+// only its small preview. Anything else in a TIFF container is a plain TIFF for OpenCV.
+enum class PhotoFormat { kPng, kJpeg, kTiff, kExr, kRaw };
 // Largest photo decoded (pixels; a 100-megapixel camera fits), checked from the header.
 constexpr long long kMaxPhotoPixels = 1LL << 27;
 enum class Transfer { kAuto, kLinear, kSrgb };
+// White balance of a camera RAW: kUnity keeps the sensor's channels as they are (the
+// photometric default: one radiometric scale calibrates them), kAsShot applies the camera's
+// recorded multipliers (DNG AsShotNeutral, LibRaw's cam_mul), normalised so that green = 1.
+enum class RawWhiteBalance { kUnity, kAsShot };
 
 // How to interpret a photo's codes (dataset.json radiometry and the photo's exposure).
 struct PhotoSpec {
@@ -31,6 +42,10 @@ struct PhotoSpec {
   double white_level = 1;
   double saturation_level = 1;  // curve(code / code_max) at or above this is clipped
   double exposure = 1;          // relative exposure t ISO / N^2 (any consistent unit)
+  // Camera RAW only. A RAW decodes to values in which the file's white level is 1 (black and
+  // white level above then apply on top, defaults leave them alone).
+  RawWhiteBalance raw_white_balance = RawWhiteBalance::kUnity;
+  bool raw_half_size = false;  // one pixel per 2x2 Bayer quad (exact) instead of a demosaic
   void Check(const std::string& where) const;  // BadInput naming `where` and the field
 };
 
@@ -38,15 +53,20 @@ struct Photo {
   std::string path;
   PhotoFormat format = PhotoFormat::kPng;
   // As stored: CV_8U or CV_16U with 1 or 3 channels (BGR order, as OpenCV decodes), or CV_32FC3
-  // in RGB order (EXR channels R, G, B).
+  // in RGB order (EXR channels R, G, B; camera RAW with white level 1).
   cv::Mat pixels;
   bool rgb_order = false;
   Transfer transfer = Transfer::kLinear;  // resolved: never kAuto
   PhotoSpec spec;
+  // Per-channel multipliers (R, G, B) LinearReader applies after the clipping test, so that a
+  // channel is clipped where the sensor was, whatever the white balance (RAW kAsShot).
+  std::array<float, 3> white_balance = {1, 1, 1};
 
   double CodeMax() const;  // 255, 65535 or 1 (float)
   // For a linear transfer: linear value = code * Gain() - Offset(). (Fast paths that work on
-  // the stored codes use these; everything else uses LinearReader.)
+  // the stored codes use these, and only when UnityWhiteBalance(); everything else uses
+  // LinearReader.)
+  bool UnityWhiteBalance() const;
   double Gain() const;
   double Offset() const;
   // Smallest stored code that counts as clipped (linear transfer).
@@ -78,6 +98,7 @@ class LinearReader {
   int r_, b_;  // offsets of red and blue in a pixel
   float curve8_[256];
   float inv_max_, black_, inv_range_exposure_, saturation_;
+  float white_balance_[3];  // R, G, B
 };
 
 // The whole photo as linear, exposure-normalised Rec. 709 luminance (CV_32FC1); BadInput when a

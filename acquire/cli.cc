@@ -65,8 +65,8 @@ CLI::App* AddImportCommand(CLI::App& app, ImportOptions* o, CommonOptions* commo
                   "file-name template, e.g. pos_{i}_{j}_{slide}_{exposure}.jpg ({bracket}: "
                   "index in the slide's bracket)");
   cmd->add_option("--order", o->order,
-                  "name: the photos' name order is the capture order (scan positions, slide p "
-                  "then n, each bracket)");
+                  "name or capture (EXIF time): the order the photos were taken in (scan "
+                  "positions, slide p then n, each bracket)");
   cmd->add_option("--scan", o->scan, "--order: rows, serpentine or columns")->capture_default_str();
   cmd->add_option("--exposures", o->exposures,
                   "--order: the relative exposures of each slide's bracket, in capture order")

@@ -15,6 +15,7 @@
 #include "core/input_file.h"
 #include "core/json.h"
 #include "core/log.h"
+#include "lib/photo/exif.h"
 #include "lib/photo/photo_io.h"
 
 namespace fs = std::filesystem;
@@ -178,8 +179,30 @@ std::vector<Named> FromPattern(const std::string& pattern, const std::vector<std
   return out;
 }
 
-// Name order is capture order: position by position in the scan, slide p then n, each slide's
-// bracket in the given order.
+// The files sorted by the time their EXIF gives (DateTimeOriginal, to the second; equal times,
+// as in a fast bracket, keep name order). A photo without one is refused: its place is unknown.
+std::vector<std::string> ByCaptureTime(const std::string& dir,
+                                       const std::vector<std::string>& files) {
+  std::vector<std::pair<std::string, std::string>> timed;
+  for (const std::string& f : files) {
+    const std::string path = dir + "/" + f;
+    CheckInputFile(path, "photo");
+    DetectPhotoFormat(path);
+    const PhotoExif exif = ReadPhotoExif(path);
+    if (!exif.date_time)
+      throw InputError(path, "EXIF DateTimeOriginal", "a capture time (--order capture)",
+                       "nothing (missing); use --order name or a manifest");
+    timed.emplace_back(*exif.date_time, f);
+  }
+  std::stable_sort(timed.begin(), timed.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::string> out;
+  for (const auto& t : timed) out.push_back(t.second);
+  return out;
+}
+
+// The files in the order of the capture (their name order, or their EXIF time order): position
+// by position in the scan, slide p then n, each slide's bracket in the given order.
 std::vector<Named> FromOrder(const ImportOptions& o, const SamplingGrid& grid,
                              const std::vector<std::string>& files) {
   const size_t per_slide = std::max<size_t>(1, o.exposures.size());
@@ -213,12 +236,47 @@ std::vector<Named> FromOrder(const ImportOptions& o, const SamplingGrid& grid,
   return out;
 }
 
+// One camera, one lens, one ISO for the whole capture, as far as the photos' EXIF tells: the
+// first photo that states a field sets it, and a photo that states another value is refused.
+class SameCamera {
+ public:
+  void Check(const std::string& path, const PhotoExif& exif) {
+    Field(path, "EXIF camera make", exif.make, make_);
+    Field(path, "EXIF camera model", exif.model, model_);
+    Field(path, "EXIF lens model", exif.lens_model, lens_);
+    Field(path, "EXIF ISO", exif.iso ? std::optional<std::string>(Number(*exif.iso)) : std::nullopt,
+          iso_);
+  }
+
+ private:
+  static std::string Number(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+  static void Field(const std::string& path, const std::string& field,
+                    const std::optional<std::string>& value,
+                    std::optional<std::pair<std::string, std::string>>& first) {
+    if (!value) return;
+    if (!first) {
+      first = std::make_pair(*value, path);
+    } else if (first->first != *value) {
+      throw InputError(
+          path, field,
+          "\"" + first->first + "\" as in " + first->second + " (one camera for the whole capture)",
+          "\"" + *value + "\"");
+    }
+  }
+  std::optional<std::pair<std::string, std::string>> make_, model_, lens_, iso_;
+};
+
 // The named photos as dataset entries, with every check a lab wants before a long run.
 std::vector<PhotoEntry> ToEntries(const std::vector<Named>& named, const ImportOptions& o,
                                   const SamplingGrid& grid) {
   std::vector<PhotoEntry> entries;
   std::map<std::tuple<int, int, bool>, int> per_slide;
   std::map<std::string, std::string> where_of_file;
+  SameCamera camera;
   std::map<std::tuple<int, int, bool, double>, std::string> where_of_slide;
   for (const Named& n : named) {
     if (n.i >= grid.nu || n.j >= grid.nv)
@@ -229,6 +287,8 @@ std::vector<PhotoEntry> ToEntries(const std::vector<Named>& named, const ImportO
     const std::string path = o.photos_dir + "/" + n.file;
     CheckInputFile(path, "photo");
     DetectPhotoFormat(path);  // an image by its content, or BadInput naming the file
+    const PhotoExif exif = ReadPhotoExif(path);
+    camera.Check(path, exif);
     PhotoEntry e;
     e.i = n.i;
     e.j = n.j;
@@ -236,12 +296,18 @@ std::vector<PhotoEntry> ToEntries(const std::vector<Named>& named, const ImportO
     e.file = n.file;
     if (n.exposure) {
       e.exposure = *n.exposure;
+    } else if (const auto relative = exif.RelativeExposure()) {
+      if (!(*relative >= kMinExposure && *relative <= kMaxExposure))
+        throw InputError(path, "EXIF exposure t ISO / N^2", "a value in [1e-9, 1e9]",
+                         std::to_string(*relative));
+      e.exposure = *relative;
     } else if (o.exposure) {
       e.exposure = *o.exposure;
     } else {
       throw BadInput(n.where +
-                     ": no exposure for this photo (give it in the manifest, the "
-                     "pattern's {exposure}, --exposures, or --exposure for all)");
+                     ": no exposure for this photo (no EXIF exposure time, f-number and ISO; give "
+                     "it in the manifest, the pattern's {exposure}, --exposures, or --exposure "
+                     "for all)");
     }
     // The same photo twice, or two photos of one slide at one exposure, would be merged as if
     // they were different measurements.
@@ -291,7 +357,8 @@ void ImportOptions::Check() const {
   if (ways != 1)
     throw BadInput("import: give exactly one of --manifest, --pattern and --order (got " +
                    std::to_string(ways) + ")");
-  if (!order.empty() && order != "name") throw InputError("--order", "", "name", order);
+  if (!order.empty() && order != "name" && order != "capture")
+    throw InputError("--order", "", "name or capture", order);
   if (scan != "rows" && scan != "serpentine" && scan != "columns")
     throw InputError("--scan", "", "rows, serpentine or columns", scan);
   if (order.empty() && !exposures.empty())
@@ -330,6 +397,7 @@ ImportReport RunImport(const ImportOptions& o) {
   for (const std::string& f : FolderFiles(o.photos_dir))
     if (f != ds.calibration.photo) files.push_back(f);
 
+  if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files);
   std::vector<Named> named = !o.manifest.empty()  ? FromManifest(o.manifest)
                              : !o.pattern.empty() ? FromPattern(o.pattern, files)
                                                   : FromOrder(o, ds.grid, files);

@@ -18,13 +18,15 @@ struct ImportOptions {
   // Exactly one way of telling which photo is which:
   std::string manifest;  // CSV, one row per photo: i,j,slide,file[,exposure]
   std::string pattern;   // file-name template: {i} {j} {slide}, optional {exposure} and {bracket}
-  std::string order;     // "name": the photos' name order is the capture order
+  // "name": the photos' name order is the capture order; "capture": their EXIF capture time is.
+  std::string order;
   // With `order`: how the grid was scanned, and the exposures of each slide's bracket, in the
   // order they were taken (relative exposures; one value: no brackets).
   std::string scan = "rows";  // rows | serpentine | columns
   std::vector<double> exposures;
-  // The relative exposure of a photo nothing else gives one for (manifest rows without an
-  // exposure, patterns without {exposure}); without it such a photo is an error.
+  // The relative exposure of a photo nothing else gives one for (no manifest exposure, pattern
+  // {exposure} or --exposures, and no EXIF exposure time, f-number and ISO); without it such a
+  // photo is an error.
   std::optional<double> exposure;
   bool force = false;  // rewrite an existing dataset.json
 

@@ -274,7 +274,19 @@ void WriteJpeg(const std::string& path, const cv::Mat& bgr8, int quality, const 
     throw IoError(path, std::string("cannot encode the JPEG: ") + e.what());
   }
   LUMISLAB_CHECK(jpeg.size() > 4 && jpeg[0] == 0xff && jpeg[1] == 0xd8, "WriteJpeg: no SOI");
-  // A camera writes SOI, then APP1 EXIF; libjpeg's JFIF APP0 segment is dropped.
+  // A camera writes SOI, then APP1 EXIF; libjpeg's JFIF APP0 segment is dropped. Without a field
+  // to write, the JPEG is written as OpenCV encoded it (an empty EXIF block reads as corrupt).
+  const bool any = exif.exposure_time || exif.f_number || exif.iso || exif.make || exif.model ||
+                   exif.lens_model || exif.date_time;
+  if (!any) {
+    WriteAtomically(path, [&](const std::string& tmp) {
+      std::ofstream file(tmp, std::ios::binary);
+      file.write(reinterpret_cast<const char*>(jpeg.data()), std::streamsize(jpeg.size()));
+      file.close();
+      if (!file) throw IoError(path, "cannot write the JPEG");
+    });
+    return;
+  }
   size_t rest = 2;
   if (jpeg[2] == 0xff && jpeg[3] == 0xe0 && jpeg.size() > 11 &&
       std::memcmp(&jpeg[6], "JFIF\0", 5) == 0)

@@ -8,14 +8,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
 #include "core/dataset.h"
 #include "core/slab_compare.h"
+#include "lib/photo/camera_write.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -145,6 +148,70 @@ TEST_F(Import, ManifestPatternAndOrderAgree) {
           << a.file;
     }
   }
+}
+
+// A camera's JPEGs with EXIF: --order capture follows the EXIF time (the names are shuffled so
+// that name order is wrong), the exposure is t ISO / N^2 from EXIF, a photo of another camera
+// model is refused naming it, and --order capture without a time is refused.
+TEST_F(Import, ExifGivesOrderExposureAndCamera) {
+  const Dataset ds = Dataset::Load(root_ + "/original");
+  fs::create_directories(root_ + "/jpeg");
+  PhotoExif exif;
+  exif.exposure_time = 1.0 / 30;
+  exif.f_number = 8;
+  exif.iso = 200;
+  exif.make = "Lumislab";
+  exif.model = "Synthetic 1";
+  std::vector<std::string> jpegs;
+  for (size_t k = 0; k < names_.size(); ++k) {
+    const cv::Mat png = cv::imread(root_ + "/camera/" + names_[k], cv::IMREAD_UNCHANGED);
+    cv::Mat bgr8;
+    png.convertTo(bgr8, CV_8U, 1.0 / 257);
+    char name[32], time[64];
+    std::snprintf(name, sizeof name, "DSC_%04zu.JPG", names_.size() - k);  // reversed
+    std::snprintf(time, sizeof time, "2026:11:30 10:%02zu:00", k);
+    exif.date_time = time;
+    WriteJpeg(root_ + "/jpeg/" + name, bgr8, 95, exif);
+    jpegs.push_back(name);
+  }
+  fs::copy_file(root_ + "/camera/BOARD.PNG", root_ + "/jpeg/BOARD.PNG");
+  Ok("lumislab-acquire", "import --photos jpeg --setup setup.json --out ds --order capture");
+  const Dataset imported = Dataset::Load(root_ + "/ds");
+  ASSERT_EQ(imported.photos.size(), names_.size());
+  for (const PhotoEntry& e : imported.photos) {
+    EXPECT_NEAR(e.exposure, (1.0 / 30) * 200 / 64, 1e-9) << e.file;
+    // The k-th photo taken is jpegs[k]; its place in the capture is that of names_[k].
+    const size_t k = size_t(std::find(jpegs.begin(), jpegs.end(), e.file) - jpegs.begin());
+    ASSERT_LT(k, names_.size());
+    EXPECT_EQ(e.positive, k % 2 == 0) << e.file;
+    EXPECT_EQ(std::make_pair(e.i, e.j), ScanPosition(ds.grid, "rows", int(k / 2))) << e.file;
+  }
+  // Name order is not the capture order: the same photos by name land elsewhere.
+  Ok("lumislab-acquire", "import --photos jpeg --setup setup.json --out by_name --order name");
+  const Dataset by_name = Dataset::Load(root_ + "/by_name");
+  size_t differ = 0;
+  for (size_t k = 0; k < names_.size(); ++k)
+    differ += by_name.photos[k].file != imported.photos[k].file;
+  EXPECT_EQ(differ, names_.size());
+
+  // Another camera model among them.
+  exif.model = "Synthetic 2";
+  const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(20, 20, 20));
+  WriteJpeg(root_ + "/jpeg/" + jpegs[5], grey, 95, exif);
+  const auto r = RunToolIn(root_, "lumislab-acquire",
+                           "import --photos jpeg --setup setup.json --out ds2 --order capture", 60);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("jpeg/" + jpegs[5] + ": EXIF camera model: expected \"Synthetic 1\""),
+            std::string::npos)
+      << r.output;
+  // No capture time.
+  WriteJpeg(root_ + "/jpeg/" + jpegs[5], grey, 95, PhotoExif{});
+  const auto t = RunToolIn(root_, "lumislab-acquire",
+                           "import --photos jpeg --setup setup.json --out ds2 --order capture", 60);
+  EXPECT_EQ(t.exit_code, 2) << t.output;
+  EXPECT_NE(t.output.find("jpeg/" + jpegs[5] + ": EXIF DateTimeOriginal"), std::string::npos)
+      << t.output;
+  EXPECT_FALSE(fs::exists(root_ + "/ds2/dataset.json"));
 }
 
 TEST(ImportScan, ScanOrders) {

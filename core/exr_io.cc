@@ -10,7 +10,9 @@
 #include <ImfStringAttribute.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -59,9 +61,66 @@ void WriteExr(const std::string& path, const ImageF& image,
   });
 }
 
+namespace {
+
+// OpenEXR allocates each header attribute at the size the file states before reading it, so a
+// 1 KB file claiming a 2 GB attribute costs 2 GB (found by fuzz_slab_position). The header is
+// walked here first: magic, version, then per part the attributes (name, type, int32 size,
+// value) up to the empty name; every size must fit in what is left of the file. Throws
+// BadInput naming the file and what is wrong; `strict` false returns false instead.
+bool CheckExrHeader(const std::string& path, bool strict) {
+  auto fail = [&](const std::string& what) -> bool {
+    if (strict) throw BadInput(path + ": not a readable EXR file: header: " + what);
+    return false;
+  };
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const std::streamoff file_size = in.tellg();
+  in.seekg(0);
+  unsigned char start[8];
+  if (!in.read(reinterpret_cast<char*>(start), 8)) return fail("shorter than 8 bytes");
+  if (!(start[0] == 0x76 && start[1] == 0x2f && start[2] == 0x31 && start[3] == 0x01))
+    return fail("no EXR magic number");
+  const bool multipart = start[5] & 0x10;  // version flags, bit 12
+  auto read_string = [&](std::string* out) {
+    out->clear();
+    for (char c; in.get(c);) {
+      if (c == '\0') return true;
+      if (out->size() >= 255) return false;
+      *out += c;
+    }
+    return false;
+  };
+  for (int part = 0;; ++part) {
+    std::string name, type;
+    int attributes = 0;
+    for (;; ++attributes) {
+      if (!read_string(&name)) return fail("an attribute name that does not end");
+      if (name.empty()) break;  // end of this part's header
+      if (!read_string(&type)) return fail("attribute " + name + ": a type that does not end");
+      unsigned char size_bytes[4];
+      if (!in.read(reinterpret_cast<char*>(size_bytes), 4))
+        return fail("attribute " + name + ": no size");
+      const int64_t size = int32_t(uint32_t(size_bytes[0]) | uint32_t(size_bytes[1]) << 8 |
+                                   uint32_t(size_bytes[2]) << 16 | uint32_t(size_bytes[3]) << 24);
+      if (size < 0 || size > file_size - in.tellg())
+        return fail("attribute " + name + ": size " + std::to_string(size) +
+                    " bytes, more than the file holds");
+      in.seekg(size, std::ios::cur);
+    }
+    // A single part ends with its header; multipart headers end with an empty one.
+    if (!multipart || attributes == 0) break;
+    if (part > 4096) return fail("more than 4096 parts");
+  }
+  return true;
+}
+
+}  // namespace
+
 ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_names,
                ExrAttributes* attributes) {
   CheckInputFile(path, "EXR file");
+  CheckExrHeader(path, true);
   try {
     Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();
@@ -106,7 +165,7 @@ ImageF ReadExr(const std::string& path, const std::vector<std::string>& channel_
 
 bool ExrComplete(const std::string& path, int width, int height) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  if (!std::filesystem::is_regular_file(path, ec) || !CheckExrHeader(path, false)) return false;
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i dw = file.header().dataWindow();
@@ -124,6 +183,8 @@ bool ExrComplete(const std::string& path, int width, int height) {
 }
 
 std::vector<std::string> ExrChannelNames(const std::string& path) {
+  CheckInputFile(path, "EXR file");
+  CheckExrHeader(path, true);
   try {
     Imf::InputFile file(path.c_str());
     std::vector<std::string> names;

@@ -5,8 +5,11 @@
 #include <ImfOutputFile.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 
 #include "core/atomic_file.h"
 #include "core/dataset.h"
@@ -179,6 +182,40 @@ TEST_F(IoTest, ExrHeaderClaimingAHugeImageIsRefusedBeforeAllocating) {
         << e.what();
   }
   EXPECT_FALSE(ExrComplete(path, 32768, 32768));
+}
+
+// OpenEXR allocates a header attribute at the size the file states: a small file claiming a
+// 2 GB attribute is refused before OpenEXR reads it (found by fuzz_slab_position).
+TEST_F(IoTest, ExrAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
+  const std::string path = (dir_ / "attribute.exr").string();
+  ExrAttributes attributes;
+  attributes.strings["probe"] = "x";
+  WriteExr(path, ImageF(4, 3, 1), {"Y"}, attributes);
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const size_t at = bytes.find(std::string("probe\0string\0", 13));
+  ASSERT_NE(at, std::string::npos);
+  for (int k = 0; k < 4; ++k) bytes[at + 13 + size_t(k)] = k == 3 ? '\x7f' : '\xf0';  // ~2.1 GB
+  std::ofstream(path, std::ios::binary) << bytes;
+  const auto start = std::chrono::steady_clock::now();
+  for (const auto& read : std::vector<std::function<void()>>{[&] { ReadExr(path, {"Y"}); },
+                                                             [&] { ExrChannelNames(path); }}) {
+    try {
+      read();
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.exit_code(), 2);
+      EXPECT_NE(std::string(e.what()).find("attribute.exr: not a readable EXR file: header: "
+                                           "attribute probe: size"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_FALSE(ExrComplete(path, 4, 3));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
 }
 
 TEST_F(IoTest, TemporaryNamesFitAndOrphansOfDeadProcessesAreRemoved) {

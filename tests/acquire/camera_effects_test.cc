@@ -323,6 +323,26 @@ TEST(StageErrorEffect, SeededBoundedOffsetsMoveTheRenderNotTheTruth) {
             FileBytes(dir + "/clean/photos/pos_2_1_p.exr"));
 }
 
+// All the effects in one scene (the fuzzer's seed): a dataset that loads, with 3 JPEG photos per
+// slide at exposures 1/4, 1, 4, the black level recorded and the photos the same for a rerun.
+TEST(CameraEffects, AllTogetherMakeAValidReproducibleDataset) {
+  const SynthScene scene =
+      LoadScene(LUMISLAB_SOURCE_DIR "/fuzz/corpus/fuzz_scene/camera_effects.json");
+  ASSERT_EQ(scene.effects.size(), 8u);
+  const std::string dir = FreshDir("all_effects");
+  RunSynth(scene, SmallOptions(dir + "/a"));
+  RunSynth(scene, SmallOptions(dir + "/b"));
+  const Dataset ds = Dataset::Load(dir + "/a");
+  ASSERT_EQ(ds.photos.size(), 2u * 2 * 2 * 3);
+  EXPECT_DOUBLE_EQ(ds.black_level, 0.02);
+  for (size_t k = 0; k < ds.photos.size(); ++k) {
+    const PhotoEntry& p = ds.photos[k];
+    EXPECT_DOUBLE_EQ(p.exposure, std::exp2(2.0 * (int(k % 3) - 1))) << p.file;
+    EXPECT_EQ(DetectPhotoFormat(ds.Path(p.file)), PhotoFormat::kJpeg) << p.file;
+    EXPECT_EQ(FileBytes(ds.Path(p.file)), FileBytes(dir + "/b/" + p.file)) << p.file;
+  }
+}
+
 // Every parameter out of its range, a parameter the effect does not know, and the effects that
 // may be listed once: exit 2 (InputError) naming the scene file and the field.
 TEST(EffectParameters, OutOfRangeRefusedNamingTheField) {

@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include "core/grid.h"
 #include "core/image.h"
 #include "core/json.h"
 #include "lib/synthetic/camera.h"
@@ -29,7 +28,6 @@ struct EffectSetting {
   double distance_mm = 0;  // screen plane z = d, lab frame
   double screen_w_mm = 0;  // physical screen, centred on the optical axis
   double screen_h_mm = 0;
-  SamplingGrid grid;
 };
 
 class Effect {

@@ -136,7 +136,6 @@ void ParseEffects(const JsonView& effects, SynthScene* scene) {
   setting.distance_mm = scene->distance_mm;
   setting.screen_w_mm = scene->screen_w_mm;
   setting.screen_h_mm = scene->screen_h_mm;
-  setting.grid = scene->grid;
   for (size_t k = 0; k < effects.Size(); ++k) {
     auto effect = MakeEffect(effects[k], setting);
     const std::string type = effect->Type();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <thread>
 #include <vector>
@@ -27,6 +28,7 @@ constexpr double kTargetPeakValue = 0.85;
 constexpr int kPrePassStride = 7;  // pixels of the pre-pass: every 7th one that sees the screen
 
 PhotoEncoding SlidePhotoEncoding(const SynthScene& scene, const SynthOptions& options) {
+  if (scene.Response()) return PhotoEncoding::kCurve8Jpeg;    // the camera's 8-bit output
   if (scene.Quantized()) return PhotoEncoding::kLinear16Png;  // the codes of the effect
   if (options.photo_format == "float")
     return options.compress_float ? PhotoEncoding::kFloatExrPiz : PhotoEncoding::kFloatExr;
@@ -63,17 +65,38 @@ double ChooseRadiometricScale(const SynthScene& scene, int threads) {
   return max_e / kTargetPeakValue;
 }
 
-void ApplyEffects(const SynthScene& scene, int photo_index, ImageF* photo) {
-  for (const auto& effect : scene.effects) effect->Apply(*photo, {photo_index});
+void ApplyEffects(const SynthScene& scene, const PhotoContext& context, ImageF* photo) {
+  for (const auto& effect : scene.effects) effect->Apply(*photo, context);
 }
 
+ImageF ExposedPhoto(const SynthScene& scene, const ImageF& render, int stop_index) {
+  ImageF photo = render;
+  if (!scene.Brackets()) return photo;
+  // The render is linear in the exposure: scaling it is the photo at camera.exposure x 2^stop
+  // (exact for whole stops).
+  const float factor = float(std::exp2(scene.Brackets()->stops()[stop_index]));
+  for (float& v : photo.data) v *= factor;
+  return photo;
+}
+
+namespace {
+
+PhotoContext ContextOf(const SynthScene& scene, int i, int j, bool positive, int stop_index) {
+  PhotoContext context;
+  context.photo_index = PhotoIndex(scene, i, j, positive, stop_index);
+  context.exposure = scene.camera.exposure * std::exp2(scene.Stops()[stop_index]);
+  return context;
+}
+
+}  // namespace
+
 ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale, int i, int j,
-                  bool positive) {
+                  bool positive, int stop_index) {
   ImageF plus, minus;
   RenderPosition(scene, view, i, j, scale, &plus, &minus);
-  ImageF& photo = positive ? plus : minus;
-  ApplyEffects(scene, PhotoIndex(scene, i, j, positive), &photo);
-  return std::move(photo);
+  ImageF photo = ExposedPhoto(scene, positive ? plus : minus, stop_index);
+  ApplyEffects(scene, ContextOf(scene, i, j, positive, stop_index), &photo);
+  return photo;
 }
 
 namespace {
@@ -98,6 +121,8 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std:
   const ScreenView view = ScreenView::Of(scene);
   const double scale = *dataset.radiometric_scale;
   const int count = scene.grid.count();
+  const int stops = int(scene.Stops().size());
+  const int jpeg_quality = scene.Response() ? scene.Response()->quality() : 95;
   Progress progress("acquire", count);
   std::atomic<int> written{0};
   auto capture = [&](int q) {
@@ -106,13 +131,19 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std:
     if (StopRequested()) return;
     ImageF plus, minus;
     RenderPosition(scene, view, i, j, scale, &plus, &minus);
-    for (bool positive : {true, false}) {
-      ImageF& photo = positive ? plus : minus;
-      const int index = PhotoIndex(scene, i, j, positive);
-      ApplyEffects(scene, index, &photo);
-      WritePhoto(dir + "/" + dataset.photos[index].file, photo, encoding);
-      ++written;
-    }
+    for (bool positive : {true, false})
+      for (int stop = 0; stop < stops; ++stop) {
+        // Without brackets the render itself is the photo (no copy); with them each stop
+        // starts from its own scaled copy.
+        ImageF& render = positive ? plus : minus;
+        ImageF exposed = scene.Brackets() ? ExposedPhoto(scene, render, stop) : ImageF();
+        ImageF& photo = scene.Brackets() ? exposed : render;
+        const PhotoContext context = ContextOf(scene, i, j, positive, stop);
+        ApplyEffects(scene, context, &photo);
+        WritePhoto(dir + "/" + dataset.photos[context.photo_index].file, photo, encoding,
+                   jpeg_quality);
+        ++written;
+      }
     progress.Advance();
   };
   ParallelFor(count, options.interval_s >= 0 ? 1 : threads, capture);
@@ -155,6 +186,7 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
   dataset.Save(dir);
   WriteCalibrationPhoto(scene, dir + "/" + scene.calibration.photo, threads);
   WriteTruthCamera(scene, dir + "/truth/camera.json");
+  if (scene.Response()) WriteTruthResponse(*scene.Response(), dir + "/truth/response.json");
   WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
                  dir + "/truth", threads);
   return CapturePositions(scene, dataset, dir, options, encoding, threads);
@@ -179,9 +211,10 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
   const PhotoEncoding encoding = SlidePhotoEncoding(scene, options);
   LogInfo("scene ", scene.source, ": ", scene.grid.nu, "x", scene.grid.nv, " positions, ",
           scene.camera.width, "x", scene.camera.height, " px photos (",
-          encoding == PhotoEncoding::kLinear16Png ? "16-bit PNG"
-          : encoding == PhotoEncoding::kHalfExr   ? "half-float EXR"
-                                                  : "float EXR",
+          encoding == PhotoEncoding::kCurve8Jpeg    ? "8-bit JPEG"
+          : encoding == PhotoEncoding::kLinear16Png ? "16-bit PNG"
+          : encoding == PhotoEncoding::kHalfExr     ? "half-float EXR"
+                                                    : "float EXR",
           "), radiometric scale ", report.radiometric_scale, " W/m^2 per unit, ",
           scene.effects.size(), " effect(s)");
   if (options.interval_s >= 0) {  // live: readers follow the files where they will stay

@@ -39,11 +39,15 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options);
 // photos at about 0.85, or the scene camera's explicit one.
 double ChooseRadiometricScale(const SynthScene& scene, int threads);
 
-// Applies the scene's effects, in list order, to photo `photo_index` (see PhotoIndex).
-void ApplyEffects(const SynthScene& scene, int photo_index, ImageF* photo);
-// The finished photo of one slide as stored: render + effects. Exposed for tests.
+// Applies the scene's effects, in list order, to the photo of `context` (photo_index as in
+// PhotoIndex, the photo's exposure).
+void ApplyEffects(const SynthScene& scene, const PhotoContext& context, ImageF* photo);
+// The photo of a slide at stop `stop_index` of the scene's bracket (0 without brackets) before
+// the effects: `render` (at camera.exposure) times 2^stop; the render itself without brackets.
+ImageF ExposedPhoto(const SynthScene& scene, const ImageF& render, int stop_index);
+// The finished photo of one slide as stored: render, exposure, effects. Exposed for tests.
 ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale, int i, int j,
-                  bool positive);
+                  bool positive, int stop_index = 0);
 
 // True when `dir` holds a dataset.json whose photos, calibration photo and truth all exist.
 bool DatasetComplete(const std::string& dir);

@@ -9,11 +9,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FUZZ_BEGIN
   const lumislab::SynthScene scene = lumislab::ParseScene(text, "fuzz-scene.json");
   const lumislab::Dataset skeleton = lumislab::DatasetSkeleton(scene);
-  // The photo list is 2 entries per position (up to 2e6 for a 1000 x 1000 grid, which the
-  // format allows): listed for grids that keep one run fast.
+  // The photo list is 2 entries per position and bracket stop (up to 1.8e7 for a 1000 x 1000
+  // grid and 9 stops, which the format allows): listed for grids that keep one run fast.
   if (scene.grid.count() <= 10000) {
     const auto photos = lumislab::PhotoList(scene);
-    if (photos.size() != size_t(2 * scene.grid.count()))
+    if (photos.size() != size_t(2 * scene.grid.count()) * scene.Stops().size())
       lumislab::fuzz::Finding("PhotoList: wrong number of photos");
   }
   lumislab::ImageF rgb(4, 3, 3, 0.5f);

@@ -62,9 +62,33 @@ ImageF Gradient(int w, int h, int channels) {
   return im;
 }
 
+// Every camera effect of issue 8 in one scene, in the order a camera meets them.
+const char* kCameraEffectsScene = R"({
+  "schema_version": 1,
+  "setup": { "distance_mm": 400, "grid": {"nu": 2, "nv": 2, "spacing_mm": 4},
+             "screen_mm": [800, 600] },
+  "luminaire": { "emitters": [
+    {"position_mm": [0.5, -1, -15], "intensity_w_sr": [2.0, 1.5, 1.0], "lobe_exponent": 4} ] },
+  "camera": { "size_px": [640, 480], "focal_px": 600, "position_mm": [50, -200, 1500],
+              "look_at_mm": [0, 0, 400] },
+  "calibration": { "squares": [9, 7], "square_mm": 60 },
+  "effects": [ {"type": "stage_error", "max_mm": 0.3, "seed": 1},
+               {"type": "screen_gain", "amplitude": 0.1, "blobs": 3, "size_mm": 200, "seed": 2},
+               {"type": "ambient", "level": 0.02},
+               {"type": "vignetting", "k1": -0.1, "k2": 0.02, "cos4": true},
+               {"type": "dark", "black_level": 0.02, "dark_current": 0.01, "hot_fraction": 0.001,
+                "hot_current": 0.5, "seed": 3},
+               {"type": "sensor_noise", "seed": 4},
+               {"type": "brackets", "stops": [-2, 0, 2]},
+               {"type": "response", "curve": "gamma", "gamma": 2.2, "shoulder": 0.5,
+                "quality": 90} ]
+}
+)";
+
 void Scenes() {
   Put("fuzz_scene", "default.json", DefaultSceneJson());
   Put("fuzz_scene", "small_effects.json", kSmallScene);
+  Put("fuzz_scene", "camera_effects.json", kCameraEffectsScene);
   Put("fuzz_scene", "minimal.json", R"({"schema_version": 1,
  "setup": {"distance_mm": 750, "grid": {"nu": 1, "nv": 1, "spacing_mm": 5}, "screen_mm": [1200, 1200]},
  "luminaire": {"emitters": [{"position_mm": [0, 0, -10], "intensity_w_sr": [1, 1, 1], "lobe_exponent": 0}]},

@@ -303,11 +303,11 @@ cv::Mat LinearGray(const Photo& photo) {
   return gray;
 }
 
-void WriteImageFile(const std::string& path, const cv::Mat& image) {
+void WriteImageFile(const std::string& path, const cv::Mat& image, const std::vector<int>& params) {
   WriteAtomically(path, [&](const std::string& tmp) {
     bool ok = false;
     try {
-      ok = cv::imwrite(tmp, image);
+      ok = cv::imwrite(tmp, image, params);
     } catch (const cv::Exception& e) {
       throw IoError(path, std::string("cannot encode the image: ") + e.what());
     }
@@ -315,7 +315,8 @@ void WriteImageFile(const std::string& path, const cv::Mat& image) {
   });
 }
 
-void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding) {
+void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding,
+                int jpeg_quality) {
   LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "WritePhoto: 1 or 3 channels");
   if (encoding == PhotoEncoding::kHalfExr || encoding == PhotoEncoding::kFloatExr ||
       encoding == PhotoEncoding::kFloatExrPiz) {
@@ -331,8 +332,10 @@ void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding enc
     return;
   }
   const bool srgb = encoding == PhotoEncoding::kSrgb8Png;
-  const int type = srgb ? CV_8UC(linear.channels) : CV_16UC(linear.channels);
-  const double max = srgb ? 255.0 : 65535.0;
+  const bool jpeg = encoding == PhotoEncoding::kCurve8Jpeg;
+  const bool eight_bit = srgb || jpeg;
+  const int type = eight_bit ? CV_8UC(linear.channels) : CV_16UC(linear.channels);
+  const double max = eight_bit ? 255.0 : 65535.0;
   cv::Mat out(linear.height, linear.width, type);
   for (int y = 0; y < linear.height; ++y)
     for (int x = 0; x < linear.width; ++x)
@@ -340,12 +343,15 @@ void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding enc
         const double v = linear.at(x, y, c);
         const double code = std::round((srgb ? LinearToSrgb(v) : std::clamp(v, 0.0, 1.0)) * max);
         const int oc = linear.channels == 3 ? 2 - c : 0;  // OpenCV stores BGR
-        if (srgb)
+        if (eight_bit)
           out.ptr<uint8_t>(y)[x * linear.channels + oc] = uint8_t(code);
         else
           out.ptr<uint16_t>(y)[x * linear.channels + oc] = uint16_t(code);
       }
-  WriteImageFile(path, out);
+  if (jpeg)
+    WriteImageFile(path, out, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+  else
+    WriteImageFile(path, out);
 }
 
 }  // namespace lumislab

@@ -16,6 +16,7 @@
 #include <array>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "core/dataset.h"
 #include "core/image.h"
@@ -106,8 +107,10 @@ class LinearReader {
 cv::Mat LinearGray(const Photo& photo);
 
 // Writes `image` (8-bit or 16-bit, 1 or 3 channels in OpenCV's BGR order) as PNG (or any format
-// OpenCV writes, by extension) under a temporary name, then renames it into place.
-void WriteImageFile(const std::string& path, const cv::Mat& image);
+// OpenCV writes, by extension) under a temporary name, then renames it into place. `params` are
+// cv::imwrite's (e.g. IMWRITE_JPEG_QUALITY, q).
+void WriteImageFile(const std::string& path, const cv::Mat& image,
+                    const std::vector<int>& params = {});
 
 // How the synthetic camera stores a photo of normalised linear RGB values (ImageF, 3 channels).
 enum class PhotoEncoding {
@@ -116,7 +119,11 @@ enum class PhotoEncoding {
   kHalfExr,      // half-float EXR, RLE (lossless for half; ~5e-4 relative precision)
   kFloatExr,     // 32-bit float EXR, uncompressed
   kFloatExrPiz,  // 32-bit float EXR, PIZ
+  // Not linear: the values are a camera response's output in [0, 1] (the synthetic `response`
+  // effect), written as round(v * 255) in an 8-bit JPEG at `jpeg_quality`.
+  kCurve8Jpeg,
 };
-void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding);
+void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding,
+                int jpeg_quality = 95);
 
 }  // namespace lumislab

@@ -31,7 +31,8 @@ void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int 
   *minus = ImageF(view.width, view.height, 3);
   const DualFilter filter = scene.Filter();
   const double peak = filter.Peak2D();
-  const Eigen::Vector2d c = scene.grid.Centre(i, j);
+  // Where the stage put the luminaire: the nominal centre plus a listed stage_error's offset.
+  const Eigen::Vector2d c = scene.grid.Centre(i, j) + scene.StageOffsetMm(i, j);
   const double gain = scene.camera.exposure / radiometric_scale;
   Eigen::Vector3d e_plus, e_minus;
   for (size_t k = 0; k < view.pixels.size(); ++k) {

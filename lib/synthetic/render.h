@@ -22,7 +22,8 @@ struct ScreenView {
 };
 
 // Photos of position (i, j) through T+ and T- before any effect: normalised linear RGB values
-// v = E / radiometric_scale * exposure (3 channels, RGB order).
+// v = E / radiometric_scale * exposure (3 channels, RGB order), with the luminaire at the grid
+// centre plus scene.StageOffsetMm(i, j).
 void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int j,
                     double radiometric_scale, ImageF* plus, ImageF* minus);
 // Largest slide irradiance (W/m^2, any channel, either slide) over all positions, sampling every

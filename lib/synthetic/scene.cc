@@ -127,10 +127,59 @@ void ParseCalibration(const JsonView& root, SynthScene* scene) {
   CheckBoardInView(*scene);
 }
 
+// The effects, built with the scene's camera and screen. brackets, response and dark are
+// listed at most once (each sets something of the whole dataset: its photos, their format, its
+// black level), and response (8-bit JPEG) excludes quantization (16-bit PNG).
+void ParseEffects(const JsonView& effects, SynthScene* scene) {
+  EffectSetting setting;
+  setting.camera = scene->camera;
+  setting.distance_mm = scene->distance_mm;
+  setting.screen_w_mm = scene->screen_w_mm;
+  setting.screen_h_mm = scene->screen_h_mm;
+  for (size_t k = 0; k < effects.Size(); ++k) {
+    auto effect = MakeEffect(effects[k], setting);
+    const std::string type = effect->Type();
+    for (const auto& other : scene->effects) {
+      if (other->Type() == type && (type == "brackets" || type == "response" || type == "dark"))
+        effects[k]["type"].Fail("a type listed once (" + type + " is listed before)");
+      const bool formats = (type == "response" && other->Type() == "quantization") ||
+                           (type == "quantization" && other->Type() == "response");
+      if (formats)
+        effects[k]["type"].Fail("not both response (8-bit JPEG) and quantization (16-bit PNG)");
+    }
+    scene->effects.push_back(std::move(effect));
+  }
+}
+
+template <typename T>
+const T* FindEffect(const SynthScene& scene) {
+  for (const auto& e : scene.effects)
+    if (const T* found = dynamic_cast<const T*>(e.get())) return found;
+  return nullptr;
+}
+
 }  // namespace
 
 bool SynthScene::Quantized() const {
   return std::any_of(effects.begin(), effects.end(), [](const auto& e) { return e->Quantizes(); });
+}
+
+const BracketsEffect* SynthScene::Brackets() const { return FindEffect<BracketsEffect>(*this); }
+const ResponseEffect* SynthScene::Response() const { return FindEffect<ResponseEffect>(*this); }
+const DarkEffect* SynthScene::Dark() const { return FindEffect<DarkEffect>(*this); }
+
+std::string SynthScene::PhotoExtension() const {
+  return Response() ? "jpg" : Quantized() ? "png" : "exr";
+}
+
+std::vector<double> SynthScene::Stops() const {
+  return Brackets() ? Brackets()->stops() : std::vector<double>{0.0};
+}
+
+Eigen::Vector2d SynthScene::StageOffsetMm(int i, int j) const {
+  Eigen::Vector2d offset(0, 0);
+  for (const auto& e : effects) offset += e->StageOffsetMm(i, j);
+  return offset;
 }
 
 SynthScene ParseScene(const std::string& json_text, const std::string& name) {
@@ -146,10 +195,7 @@ SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   ParseLuminaire(root, &scene);
   ParseCamera(root, &scene);
   ParseCalibration(root, &scene);
-  if (root.Has("effects")) {
-    const JsonView effects = root["effects"];
-    for (size_t k = 0; k < effects.Size(); ++k) scene.effects.push_back(MakeEffect(effects[k]));
-  }
+  if (root.Has("effects")) ParseEffects(root["effects"], &scene);
   return scene;
 }
 
@@ -174,6 +220,15 @@ Dataset DatasetSkeleton(const SynthScene& scene) {
   ds.screen_h_mm = scene.screen_h_mm;
   ds.filter = FilterInfo::Of(scene.Filter(), scene.grid.spacing_mm);
   ds.saturation_level = 1.0;
+  if (const DarkEffect* dark = scene.Dark()) {
+    // The dark step adds the black level to the render's values without scaling them: value 1
+    // of the render is code 1 + black, so white_level = 1 + black decodes the render exactly.
+    ds.black_level = dark->black_level();
+    ds.white_level = 1 + dark->black_level();
+  }
+  // An sRGB response is what the decoder's "srgb" transfer inverts; the other curves are
+  // recorded in truth/response.json only.
+  if (scene.Response() && scene.Response()->curve() == "srgb") ds.photo_transfer = "srgb";
   ds.calibration = scene.calibration;
   ds.synthetic = true;
   return ds;
@@ -182,16 +237,22 @@ Dataset DatasetSkeleton(const SynthScene& scene) {
 std::vector<PhotoEntry> PhotoList(const SynthScene& scene) {
   std::vector<PhotoEntry> list;
   const std::string ext = scene.PhotoExtension();
+  const bool bracketed = scene.Brackets() != nullptr;
+  const std::vector<double> stops = scene.Stops();
   for (int j = 0; j < scene.grid.nv; ++j)
     for (int i = 0; i < scene.grid.nu; ++i)
       for (bool positive : {true, false})
-        list.push_back({i, j, positive, "photos/" + PhotoFileName(i, j, positive, ext),
-                        scene.camera.exposure});
+        for (double stop : stops) {
+          const std::string tag = bracketed ? BracketsEffect::Tag(stop) : "";
+          list.push_back({i, j, positive, "photos/" + PhotoFileName(i, j, positive, ext, tag),
+                          scene.camera.exposure * std::exp2(stop)});
+        }
   return list;
 }
 
-int PhotoIndex(const SynthScene& scene, int i, int j, bool positive) {
-  return 2 * scene.grid.Index(i, j) + (positive ? 0 : 1);
+int PhotoIndex(const SynthScene& scene, int i, int j, bool positive, int stop_index) {
+  const int stops = scene.Brackets() ? int(scene.Brackets()->stops().size()) : 1;
+  return (2 * scene.grid.Index(i, j) + (positive ? 0 : 1)) * stops + stop_index;
 }
 
 }  // namespace lumislab

@@ -29,11 +29,17 @@ struct SynthScene {
   std::vector<std::shared_ptr<const Effect>> effects;  // in the order listed
 
   DualFilter Filter() const { return DualFilter::Truncated(k_max); }
-  bool Quantized() const;             // photos are 16-bit PNG (else float EXR)
-  std::string PhotoExtension() const  // "png" or "exr"
-  {
-    return Quantized() ? "png" : "exr";
-  }
+  bool Quantized() const;  // photos are 16-bit PNG (else float EXR, or JPEG with a response)
+  // The listed effect of that type, or null (each is listed at most once).
+  const BracketsEffect* Brackets() const;
+  const ResponseEffect* Response() const;
+  const DarkEffect* Dark() const;
+  std::string PhotoExtension() const;  // "jpg" (response), "png" (quantization) or "exr"
+  // The stops of each slide's exposure series: those of `brackets`, else {0}.
+  std::vector<double> Stops() const;
+  // Sum of the listed effects' stage offsets at position (i, j) (mm, lab frame; 0 without
+  // stage_error).
+  Eigen::Vector2d StageOffsetMm(int i, int j) const;
 };
 
 // "default" or a scene file; errors name the file and the field (exit 2).
@@ -45,9 +51,10 @@ std::string DefaultSceneJson();  // the built-in scene as a scene file
 
 // dataset.json without photos or radiometric scale: setup, filter, calibration, synthetic.
 Dataset DatasetSkeleton(const SynthScene& scene);
-// The full photo list (for every position j-major, i, then slides p, n); photo k of the list
-// is the k passed to the effects.
+// The full photo list (for every position j-major, i, then slides p, n, then the stops of a
+// bracket); photo k of the list is the k passed to the effects. A bracket's photos carry the
+// exposure camera.exposure x 2^stop and the stop's tag in their file name.
 std::vector<PhotoEntry> PhotoList(const SynthScene& scene);
-int PhotoIndex(const SynthScene& scene, int i, int j, bool positive);
+int PhotoIndex(const SynthScene& scene, int i, int j, bool positive, int stop_index = 0);
 
 }  // namespace lumislab

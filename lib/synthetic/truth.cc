@@ -81,4 +81,19 @@ void WriteTruthCamera(const SynthScene& scene, const std::string& path) {
   WriteJsonAtomically(path, j);
 }
 
+void WriteTruthResponse(const ResponseEffect& response, const std::string& path) {
+  nlohmann::json j;
+  j["schema_version"] = 1;
+  j["curve"] = response.curve();
+  if (response.curve() == "gamma") {
+    j["gamma"] = response.gamma();
+    j["shoulder"] = response.shoulder();
+  }
+  j["jpeg_quality"] = response.quality();
+  nlohmann::json table = nlohmann::json::array();
+  for (int k = 0; k < 256; ++k) table.push_back(response.Inverse(k / 255.0));
+  j["linear_of_code"] = table;
+  WriteJsonAtomically(path, j);
+}
+
 }  // namespace lumislab

@@ -32,4 +32,9 @@ SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution);
 // plane (screen_from_image: pixel -> lab mm, row-major, and its inverse).
 void WriteTruthCamera(const SynthScene& scene, const std::string& path);
 
+// truth/response.json (scenes with a `response` effect): the camera curve's parameters and, for
+// each 8-bit code k, the linear value it stands for (the curve's inverse at k / 255), so that a
+// test can hand a decoder the true curve.
+void WriteTruthResponse(const ResponseEffect& response, const std::string& path);
+
 }  // namespace lumislab

@@ -39,6 +39,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "test_util.h"
@@ -1078,6 +1079,26 @@ std::vector<Case> SceneCases() {
                   .Names({s, "effects[0].seed"}));
   v.push_back(
       S("effects_not_array").Do(SetJson(s, "/effects", "quantization")).Names({s, "effects"}));
+  // The camera effects of issue 8: one parameter out of range each, and the once-only ones twice.
+  const std::vector<std::tuple<std::string, json, std::string>> ranged = {
+      {"vignetting_k1", {{"type", "vignetting"}, {"k1", 2}}, "effects[0].k1"},
+      {"screen_gain_amplitude",
+       {{"type", "screen_gain"}, {"amplitude", 0.5}},
+       "effects[0].amplitude"},
+      {"ambient_negative", {{"type", "ambient"}, {"level", -0.1}}, "effects[0].level"},
+      {"dark_black_level", {{"type", "dark"}, {"black_level", 0.9}}, "effects[0].black_level"},
+      {"brackets_stop", {{"type", "brackets"}, {"stops", {0, 12}}}, "effects[0].stops[1]"},
+      {"response_quality", {{"type", "response"}, {"quality", 0}}, "effects[0].quality"},
+      {"stage_error_max", {{"type", "stage_error"}, {"max_mm", 50}}, "effects[0].max_mm"},
+  };
+  for (const auto& [name, effect, field] : ranged)
+    v.push_back(
+        S("effect_" + name).Do(SetJson(s, "/effects", json::array({effect}))).Names({s, field}));
+  v.push_back(S("effect_brackets_twice")
+                  .Do(SetJson(s, "/effects",
+                              {{{"type", "brackets"}, {"stops", {0}}},
+                               {{"type", "brackets"}, {"stops", {1}}}}))
+                  .Names({s, "effects[1].type"}));
   // Command line of synth.
   auto A = [](const std::string& name, const std::string& extra) {
     return C("synth_" + name).Synth(extra);

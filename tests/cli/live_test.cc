@@ -26,15 +26,7 @@ using testing::RunTool;
 using testing::SceneJson;
 using testing::WriteFile;
 
-// Polls `done` every 20 ms until it holds or `seconds` pass; returns whether it held.
-bool WaitUntil(const std::function<bool()>& done, double seconds) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return true;
-}
+using testing::WaitUntil;
 
 // Moves the photos of (i, j) from `from` into `to` the way a capture writes them: a temporary
 // name in the same folder, then a rename.

@@ -48,14 +48,7 @@ constexpr double kStopLimitS = 1.0;
 #endif
 constexpr double kSetupTimeoutS = 120;  // any wait for a tool to reach the state under test
 
-bool WaitUntil(const std::function<bool()>& done, double seconds) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return true;
-}
+using testing::WaitUntil;
 
 // Sends `signal` and returns the seconds until the process ended (kSetupTimeoutS when it did
 // not; the process is then killed by its destructor).

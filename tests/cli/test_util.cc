@@ -180,6 +180,15 @@ bool ToolProcess::WaitFor(double timeout_s) {
 
 double ToolProcess::Elapsed() const { return NowS() - start_s_; }
 
+bool WaitUntil(const std::function<bool()>& done, double seconds) {
+  const double deadline = NowS() + seconds;
+  while (!done()) {
+    if (NowS() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
 namespace {
 // FNV-1a over the bytes of a regular file, with its size.
 std::string HashFile(const fs::path& path) {

@@ -1,6 +1,7 @@
 // Helpers for tests that run the lumislab executables.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -74,6 +75,9 @@ class ToolProcess {
   bool signalled_ = false;
   double start_s_ = 0;
 };
+
+// Polls `done` every 5 ms until it holds or `seconds` pass; returns whether it held.
+bool WaitUntil(const std::function<bool()>& done, double seconds);
 
 std::string ReadBinaryFile(const std::string& path);  // "" when missing
 void WriteBinaryFile(const std::string& path, const std::string& bytes);

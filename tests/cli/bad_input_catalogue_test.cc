@@ -1528,6 +1528,18 @@ TEST_P(Catalogue, Refuses) {
                                 << r.output;
 }
 
+// The table covers the four tools, each with cases of its own; prints the counts.
+TEST(CatalogueTable, CoversTheFourTools) {
+  std::map<std::string, int> by_tool;
+  const std::vector<Case> all = AllCases();
+  for (const Case& c : all) ++by_tool[c.tool];
+  for (const auto& [tool, n] : by_tool) std::printf("%s: %d cases\n", tool.c_str(), n);
+  EXPECT_GE(all.size(), 100u);
+  for (const char* tool :
+       {"lumislab-acquire", "lumislab-calibrate", "lumislab-reconstruct", "lumislab-preview"})
+    EXPECT_GE(by_tool[tool], 10) << tool;
+}
+
 INSTANTIATE_TEST_SUITE_P(Cli, Catalogue, ::testing::ValuesIn(AllCases()),
                          [](const ::testing::TestParamInfo<Case>& param) {
                            return param.param.name;

@@ -65,9 +65,26 @@ namespace {
 
 // OpenEXR allocates each header attribute at the size the file states before reading it, so a
 // 1 KB file claiming a 2 GB attribute costs 2 GB (found by fuzz_slab_position). The header is
-// walked here first: magic, version, then per part the attributes (name, type, int32 size,
-// value) up to the empty name; every size must fit in what is left of the file. Throws
-// BadInput naming the file and what is wrong; `strict` false returns false instead.
+// walked here first, the way OpenEXR reads it: magic, version, then per part the attributes
+// (name, type, int32 size, value) up to the empty name. Names and type names must end within
+// OpenEXR's limit (31 bytes, 255 with the long-names flag); every size must fit in what is left
+// of the file; and since OpenEXR reads a known type by its own rules, not by the stated size
+// (fixed-size types their bytes, a channel list up to its empty name, a preview image its
+// width x height pixels), the stated size must be exactly what that reading takes, so that
+// OpenEXR and this walk never part ways. Throws BadInput naming the file and what is wrong;
+// `strict` false returns false instead.
+int FixedAttributeSize(const std::string& type) {
+  static const std::pair<const char*, int> kFixed[] = {
+      {"int", 4},         {"float", 4},     {"double", 8},   {"box2i", 16},         {"box2f", 16},
+      {"v2i", 8},         {"v2f", 8},       {"v2d", 16},     {"v3i", 12},           {"v3f", 12},
+      {"v3d", 24},        {"m33f", 36},     {"m33d", 72},    {"m44f", 64},          {"m44d", 128},
+      {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},   {"deepImageState", 1}, {"rational", 8},
+      {"tiledesc", 9},    {"timecode", 8},  {"keycode", 28}, {"chromaticities", 32}};
+  for (const auto& [name, size] : kFixed)
+    if (type == name) return size;
+  return -1;
+}
+
 bool CheckExrHeader(const std::string& path, bool strict) {
   auto fail = [&](const std::string& what) -> bool {
     if (strict) throw BadInput(path + ": not a readable EXR file: header: " + what);
@@ -81,32 +98,68 @@ bool CheckExrHeader(const std::string& path, bool strict) {
   if (!in.read(reinterpret_cast<char*>(start), 8)) return fail("shorter than 8 bytes");
   if (!(start[0] == 0x76 && start[1] == 0x2f && start[2] == 0x31 && start[3] == 0x01))
     return fail("no EXR magic number");
-  const bool multipart = start[5] & 0x10;  // version flags, bit 12
-  auto read_string = [&](std::string* out) {
+  const bool long_names = start[5] & 0x04;  // version flags, bit 10
+  const bool multipart = start[5] & 0x10;   // bit 12
+  const size_t max_name = long_names ? 255 : 31;
+  auto read_string = [&](std::string* out, size_t max = 0) {
     out->clear();
     for (char c; in.get(c);) {
       if (c == '\0') return true;
-      if (out->size() >= 255) return false;
+      if (out->size() >= (max ? max : max_name)) return false;
       *out += c;
     }
     return false;
+  };
+  auto read_int = [&](int64_t* v) {
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    *v =
+        int32_t(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
+    return true;
   };
   for (int part = 0;; ++part) {
     std::string name, type;
     int attributes = 0;
     for (;; ++attributes) {
-      if (!read_string(&name)) return fail("an attribute name that does not end");
+      if (!read_string(&name)) return fail("an attribute name that does not end in time");
       if (name.empty()) break;  // end of this part's header
-      if (!read_string(&type)) return fail("attribute " + name + ": a type that does not end");
-      unsigned char size_bytes[4];
-      if (!in.read(reinterpret_cast<char*>(size_bytes), 4))
-        return fail("attribute " + name + ": no size");
-      const int64_t size = int32_t(uint32_t(size_bytes[0]) | uint32_t(size_bytes[1]) << 8 |
-                                   uint32_t(size_bytes[2]) << 16 | uint32_t(size_bytes[3]) << 24);
-      if (size < 0 || size > file_size - in.tellg())
-        return fail("attribute " + name + ": size " + std::to_string(size) +
-                    " bytes, more than the file holds");
-      in.seekg(size, std::ios::cur);
+      const std::string what = "attribute " + name.substr(0, 31) + ": ";
+      if (!read_string(&type)) return fail(what + "a type name that does not end in time");
+      int64_t size = 0;
+      if (!read_int(&size)) return fail(what + "no size");
+      const std::streamoff value_start = in.tellg();
+      if (size < 0 || size > file_size - value_start)
+        return fail(what + "size " + std::to_string(size) + " bytes, more than the file holds");
+      const int fixed = FixedAttributeSize(type);
+      if (fixed >= 0 && size != fixed)
+        return fail(what + "a " + type + " of " + std::to_string(fixed) + " bytes, stated as " +
+                    std::to_string(size));
+      if (type == "chlist") {  // channels up to an empty name, 16 bytes after each name
+        std::string channel;
+        do {
+          if (!read_string(&channel, 255)) return fail(what + "a channel name that does not end");
+          if (!channel.empty()) in.seekg(16, std::ios::cur);
+        } while (!channel.empty() && in && in.tellg() - value_start <= size);
+        if (!in || in.tellg() - value_start != size)
+          return fail(what + "a channel list that does not fill its " + std::to_string(size) +
+                      " bytes");
+      } else if (type == "preview") {  // width, height, then width x height RGBA bytes
+        int64_t width = 0, height = 0;
+        if (size < 8 || !read_int(&width) || !read_int(&height) || width < 0 || height < 0 ||
+            8 + 4 * width * height != size)
+          return fail(what + "a preview image whose pixels are not its " + std::to_string(size) +
+                      " bytes");
+      } else if (type == "stringvector") {  // strings of int32 length each, within the size
+        int64_t read = 0;
+        while (read < size) {
+          int64_t length = 0;
+          if (!read_int(&length) || length < 0 || read + 4 + length > size)
+            return fail(what + "a string longer than the attribute");
+          in.seekg(length, std::ios::cur);
+          read += 4 + length;
+        }
+      }
+      in.seekg(value_start + size);
     }
     // A single part ends with its header; multipart headers end with an empty one.
     if (!multipart || attributes == 0) break;

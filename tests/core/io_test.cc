@@ -218,6 +218,27 @@ TEST_F(IoTest, ExrAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
 }
 
+// Found by fuzz_slab_position in CI: a channel list running past its stated size makes OpenEXR
+// read the rest of the header from another place than the size says, where a string attribute
+// claims 1.7 GB. The header walk reads a channel list as OpenEXR does and refuses it.
+TEST_F(IoTest, ExrChannelListRunningPastItsSizeIsRefused) {
+  const std::string path =
+      std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/hostile/exr_chlist_overrun.exr";
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    ExrChannelNames(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_NE(std::string(e.what()).find("exr_chlist_overrun.exr: not a readable EXR file: "
+                                         "header: attribute channels: a channel "),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(ExrComplete(path, 8, 6));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
+}
+
 TEST_F(IoTest, TemporaryNamesFitAndOrphansOfDeadProcessesAreRemoved) {
   // A legal 254-byte name still gets a temporary name within the 255-byte limit.
   const std::string name = std::string(250, 'a') + ".exr";

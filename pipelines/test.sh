@@ -5,8 +5,9 @@
 #                  build-asan/, and ctest over the same tests (fuzz/sanitizers/ holds the run-time
 #                  options and the third-party suppressions)
 #   3. fuzz:       the libFuzzer targets of fuzz/ built into build-fuzz/, each run for
-#                  LUMISLAB_FUZZ_SECONDS (default 15) on its seed corpus, mutating (fuzz/run.sh;
-#                  0 replays every seed once without mutating)
+#                  LUMISLAB_FUZZ_SECONDS (default 15) on its seed corpus, mutating from a fixed
+#                  seed (-seed=1; LUMISLAB_FUZZ_ARGS overrides) so that a finding in CI replays
+#                  on another machine (fuzz/run.sh; 0 s replays every seed once)
 # Every stage runs even when an earlier one failed; each prints a summary line, and the script
 # exits non-zero when any stage failed (a build error, a failed test, a sanitizer report or a fuzz
 # finding). CI runs all three. Developers may skip a stage: LUMISLAB_SKIP_TESTS=1,
@@ -66,7 +67,7 @@ fuzz_stage() {
     -DLUMISLAB_BUILD_STAGES=OFF -DLUMISLAB_BUILD_PREVIEW=OFF -DLUMISLAB_BUILD_TESTS=OFF \
     -DLUMISLAB_BUILD_BENCH=OFF >/dev/null &&
     cmake --build build-fuzz -j "$jobs" --target lumislab_fuzzers &&
-    fuzz/run.sh "$fuzz_seconds" build-fuzz
+    LUMISLAB_FUZZ_ARGS="${LUMISLAB_FUZZ_ARGS:--seed=1}" fuzz/run.sh "$fuzz_seconds" build-fuzz
 }
 
 if [ "${LUMISLAB_SKIP_TESTS:-0}" = 1 ]; then

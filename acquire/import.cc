@@ -179,16 +179,33 @@ std::vector<Named> FromPattern(const std::string& pattern, const std::vector<std
   return out;
 }
 
+// Each photo is checked once (a regular file, an image by its content, BadInput naming it
+// otherwise) and its EXIF read once, however many steps ask for it.
+class PhotoHeaders {
+ public:
+  const PhotoExif& Of(const std::string& path) {
+    auto it = exif_.find(path);
+    if (it == exif_.end()) {
+      CheckInputFile(path, "photo");
+      DetectPhotoFormat(path);
+      it = exif_.emplace(path, ReadPhotoExif(path)).first;
+    }
+    return it->second;
+  }
+
+ private:
+  std::map<std::string, PhotoExif> exif_;
+};
+
 // The files sorted by the time their EXIF gives (DateTimeOriginal, to the second; equal times,
 // as in a fast bracket, keep name order). A photo without one is refused: its place is unknown.
 std::vector<std::string> ByCaptureTime(const std::string& dir,
-                                       const std::vector<std::string>& files) {
+                                       const std::vector<std::string>& files,
+                                       PhotoHeaders& headers) {
   std::vector<std::pair<std::string, std::string>> timed;
   for (const std::string& f : files) {
     const std::string path = dir + "/" + f;
-    CheckInputFile(path, "photo");
-    DetectPhotoFormat(path);
-    const PhotoExif exif = ReadPhotoExif(path);
+    const PhotoExif& exif = headers.Of(path);
     if (!exif.date_time)
       throw InputError(path, "EXIF DateTimeOriginal", "a capture time (--order capture)",
                        "nothing (missing); use --order name or a manifest");
@@ -272,7 +289,7 @@ class SameCamera {
 
 // The named photos as dataset entries, with every check a lab wants before a long run.
 std::vector<PhotoEntry> ToEntries(const std::vector<Named>& named, const ImportOptions& o,
-                                  const SamplingGrid& grid) {
+                                  const SamplingGrid& grid, PhotoHeaders& headers) {
   std::vector<PhotoEntry> entries;
   std::map<std::tuple<int, int, bool>, int> per_slide;
   std::map<std::string, std::string> where_of_file;
@@ -285,9 +302,7 @@ std::vector<PhotoEntry> ToEntries(const std::vector<Named>& named, const ImportO
                            " (the setup's grid)",
                        "(" + std::to_string(n.i) + ", " + std::to_string(n.j) + ")");
     const std::string path = o.photos_dir + "/" + n.file;
-    CheckInputFile(path, "photo");
-    DetectPhotoFormat(path);  // an image by its content, or BadInput naming the file
-    const PhotoExif exif = ReadPhotoExif(path);
+    const PhotoExif& exif = headers.Of(path);
     camera.Check(path, exif);
     PhotoEntry e;
     e.i = n.i;
@@ -397,11 +412,12 @@ ImportReport RunImport(const ImportOptions& o) {
   for (const std::string& f : FolderFiles(o.photos_dir))
     if (f != ds.calibration.photo) files.push_back(f);
 
-  if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files);
+  PhotoHeaders headers;
+  if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files, headers);
   std::vector<Named> named = !o.manifest.empty()  ? FromManifest(o.manifest)
                              : !o.pattern.empty() ? FromPattern(o.pattern, files)
                                                   : FromOrder(o, ds.grid, files);
-  ds.photos = ToEntries(named, o, ds.grid);
+  ds.photos = ToEntries(named, o, ds.grid, headers);
   std::set<std::string> used;
   for (const auto& e : ds.photos) used.insert(e.file);
   for (const std::string& f : files)

@@ -58,6 +58,9 @@ void CleanUp(std::initializer_list<std::string> datasets) {
 }
 
 TEST(EndToEnd, DefaultSceneNoiseFreeMatchesTruth) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "full-size accuracy run: the Release build's (the sanitized build runs the "
+                    "smaller end-to-end tests)";
   const std::string ds = RunPipeline("e2e_default", "");
   const SlabComparison c = CompareSlabs(ds + "/slab", ds + "/truth");
   std::printf("default scene, noise-free: %s\n", c.Summary().c_str());
@@ -71,6 +74,9 @@ TEST(EndToEnd, DefaultSceneNoiseFreeMatchesTruth) {
 
 // The photo of an oblique camera is resampled much more unevenly; the slab must be as good.
 TEST(EndToEnd, ObliqueViewAsAccurateAsFrontal) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "full-size accuracy run: the Release build's (the sanitized build runs the "
+                    "smaller end-to-end tests)";
   const std::string frontal = RunPipeline("e2e_frontal", SceneJson(3, 3, kFrontalCamera, "[]"));
   const std::string oblique = RunPipeline("e2e_oblique", SceneJson(3, 3, kObliqueCamera, "[]"));
   const SlabComparison f = CompareSlabs(frontal + "/slab", frontal + "/truth");
@@ -140,6 +146,9 @@ double PredictedNoiseFloor(const std::string& noisy, const std::string& clean) {
 }
 
 TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "full-size accuracy run: the Release build's (the sanitized build runs the "
+                    "smaller end-to-end tests)";
   const std::string clean = RunPipeline("e2e_clean", SceneJson(3, 3, kFrontalCamera, "[]"));
   const std::string noisy = RunPipeline("e2e_noisy", SceneJson(3, 3, kFrontalCamera, kNoise));
   const SlabComparison c = CompareSlabs(noisy + "/slab", noisy + "/truth");

@@ -86,6 +86,13 @@ std::string ShellQuote(const std::string& text) {
   return out + "'";
 }
 
+bool InSanitizerSample(const std::string& name, int every) {
+  if (!kSanitized || every <= 1) return true;
+  uint32_t h = 2166136261u;
+  for (const unsigned char c : name) h = (h ^ c) * 16777619u;
+  return h % uint32_t(every) == 0;
+}
+
 CommandResult RunToolIn(const std::string& cwd, const std::string& tool, const std::string& args,
                         double timeout_s, long memory_kb) {
   std::ostringstream cmd;

@@ -8,6 +8,18 @@
 
 namespace lumislab::testing {
 
+// The sanitized build (ASan + UBSan: the tools run several times slower) runs the expensive,
+// repetitive CLI tests in part, so that CI stays within its time; the Release build runs them
+// whole. Memory errors are a property of code paths, and the sample keeps every kind of path.
+#ifdef LUMISLAB_SANITIZED
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+// True outside the sanitized build; inside it, for 1 case in `every`, chosen by a hash of the
+// case's name (FNV-1a), so that the sample stays the same when other cases are added.
+bool InSanitizerSample(const std::string& name, int every);
+
 struct CommandResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together

@@ -29,6 +29,10 @@ struct ImportOptions {
   // photo is an error.
   std::optional<double> exposure;
   bool force = false;  // rewrite an existing dataset.json
+  // Positions without both slides (all exposures) are left out and listed in dataset.json's
+  // missing_positions instead of refusing the folder (with --order: the photos after the last
+  // one are missing; a gap in the middle shifts every later photo and cannot be told).
+  bool partial = false;
 
   void Check() const;  // BadInput naming the option
 };
@@ -38,11 +42,13 @@ struct ImportReport {
   int photos = 0;                   // slide photos listed
   int brackets = 1;                 // exposures per slide
   std::vector<std::string> unused;  // image files in the folder that no photo entry names
+  std::vector<std::pair<int, int>> missing;  // --partial: the positions left out
 };
 
 // Builds dataset.json for the photos: every named file must be a regular file holding an image
-// (PNG, JPEG, TIFF or EXR by its content), every grid position must have both slides, and every
-// slide the same number of exposures; BadInput naming the file, line or position otherwise.
+// (PNG, JPEG, TIFF, EXR or RAW by its content), every grid position must have both slides (or,
+// with `partial`, be listed as missing), and every slide the same number of exposures; BadInput
+// naming the file, line or position otherwise.
 ImportReport RunImport(const ImportOptions& options);
 
 // The grid position of the k-th photo position of a scan (rows: i fastest; serpentine: rows,

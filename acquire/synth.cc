@@ -101,18 +101,6 @@ ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale,
 
 namespace {
 
-// Sleeps `seconds` in short slices so that a stop signal ends the pause at once; false when
-// stopped.
-bool PauseUnlessStopped(double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!StopRequested()) {
-    const std::chrono::duration<double> left = end - std::chrono::steady_clock::now();
-    if (left.count() <= 0) return true;
-    std::this_thread::sleep_for(std::min(left, std::chrono::duration<double>(0.05)));
-  }
-  return false;
-}
-
 // Renders, applies the effects to and writes the photos of every position: in order with a
 // pause for a live acquisition, else on `threads` threads. A stop signal ends it after the
 // positions in hand (each written whole). Returns the number of photos written.

@@ -261,7 +261,8 @@ void CaptureList::Add(const NamedPhoto& n) {
   SameCamera(path, "EXIF camera make", exif.make);
   SameCamera(path, "EXIF camera model", exif.model);
   SameCamera(path, "EXIF lens model", exif.lens_model);
-  SameCamera(path, "EXIF ISO", exif.iso ? std::optional<std::string>(Number(*exif.iso)) : std::nullopt);
+  SameCamera(path, "EXIF ISO",
+             exif.iso ? std::optional<std::string>(Number(*exif.iso)) : std::nullopt);
   PhotoEntry e;
   e.i = n.i;
   e.j = n.j;

@@ -6,8 +6,8 @@
 
 #include "acquire/filter_print.h"
 #include "acquire/import.h"
-#include "acquire/watch.h"
 #include "acquire/synth.h"
+#include "acquire/watch.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
 #include "core/error.h"
@@ -150,17 +150,19 @@ int RunWatchCommand(WatchOptions w) {
           " manifest=", o.manifest, " pattern=", o.pattern, " order=", o.order, " scan=", o.scan,
           " settle=", w.settle_s, " s poll=", w.poll_s, " s idle_timeout=", w.idle_timeout_s,
           " s brackets=", w.brackets, " force=", o.force ? "yes" : "no");
-  const StopSignalScope stop_signals;  // Ctrl-C: dataset.json stays as the last complete position left it
+  const StopSignalScope
+      stop_signals;  // Ctrl-C: dataset.json stays as the last complete position left it
   const WatchReport r = RunWatch(w);
   if (r.skipped) return 0;
   if (!r.unused.empty())
     LogWarning(r.unused.size(), " file(s) of ", o.photos_dir,
                " are not in the dataset (first: ", r.unused.front(), ")");
   if (!r.complete) {
-    LogWarning(r.stopped ? "interrupted" : "no new file for " + std::to_string(w.idle_timeout_s) + " s",
-               ": the dataset is partial (", r.missing.size(), " position(s) missing",
-               r.missing.empty() ? ", and the board photo" : "",
-               "); run the same command again to go on watching");
+    LogWarning(
+        r.stopped ? "interrupted" : "no new file for " + std::to_string(w.idle_timeout_s) + " s",
+        ": the dataset is partial (", r.missing.size(), " position(s) missing",
+        r.missing.empty() ? ", and the board photo" : "",
+        "); run the same command again to go on watching");
     return 1;
   }
   LogInfo("complete: ", r.photos, " photos");

@@ -143,7 +143,7 @@ ImportReport RunImport(const ImportOptions& o) {
 
   CaptureList list(o, ds.grid);
   if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files, list.headers());
-  const std::vector<NamedPhoto> named = !o.manifest.empty() ? ManifestPhotos(o.manifest)
+  const std::vector<NamedPhoto> named = !o.manifest.empty()  ? ManifestPhotos(o.manifest)
                                         : !o.pattern.empty() ? FromPattern(o.pattern, files)
                                                              : FromOrder(o, ds.grid, files);
   for (const NamedPhoto& n : named) list.Add(n);

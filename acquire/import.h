@@ -38,10 +38,10 @@ struct ImportOptions {
 };
 
 struct ImportReport {
-  bool skipped = false;             // dataset.json existed (no --force)
-  int photos = 0;                   // slide photos listed
-  int brackets = 1;                 // exposures per slide
-  std::vector<std::string> unused;  // image files in the folder that no photo entry names
+  bool skipped = false;                      // dataset.json existed (no --force)
+  int photos = 0;                            // slide photos listed
+  int brackets = 1;                          // exposures per slide
+  std::vector<std::string> unused;           // image files in the folder that no photo entry names
   std::vector<std::pair<int, int>> missing;  // --partial: the positions left out
 };
 

@@ -163,7 +163,8 @@ class Watcher {
       throw InputError(n.where, "photos",
                        std::to_string(per_slide_) + " photo(s) through slide " +
                            (n.positive ? "p" : "n") + " at position (" + std::to_string(n.i) +
-                           ", " + std::to_string(n.j) + ") (--brackets, --exposures or the manifest)",
+                           ", " + std::to_string(n.j) +
+                           ") (--brackets, --exposures or the manifest)",
                        std::to_string(count));
   }
 
@@ -232,7 +233,8 @@ void WatchOptions::Check() const {
   if (brackets < 1 || brackets > 100)
     throw InputError("--brackets", "", "1 .. 100 photos per slide", std::to_string(brackets));
   if (brackets != 1 && import.pattern.empty())
-    throw BadInput("--brackets: only with --pattern (--exposures or the manifest say it otherwise)");
+    throw BadInput(
+        "--brackets: only with --pattern (--exposures or the manifest say it otherwise)");
 }
 
 WatchReport RunWatch(const WatchOptions& w) {

@@ -28,11 +28,11 @@ struct WatchOptions {
 };
 
 struct WatchReport {
-  bool skipped = false;   // dataset.json was complete already (no --force)
-  bool complete = false;  // every position and the board photo arrived
-  bool stopped = false;   // a stop signal ended it
-  bool idle = false;      // --idle-timeout ended it
-  int photos = 0;         // slide photos listed
+  bool skipped = false;                      // dataset.json was complete already (no --force)
+  bool complete = false;                     // every position and the board photo arrived
+  bool stopped = false;                      // a stop signal ended it
+  bool idle = false;                         // --idle-timeout ended it
+  int photos = 0;                            // slide photos listed
   std::vector<std::pair<int, int>> missing;  // positions not complete at the end
   std::vector<std::string> unused;           // files no photo entry names
 };

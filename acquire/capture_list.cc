@@ -181,13 +181,18 @@ std::optional<NamedPhoto> FilePattern::Match(const std::string& file) const {
   return n;
 }
 
+size_t OrderedPerSlide(const ImportOptions& o) {
+  if (!o.exposures.empty()) return o.exposures.size();
+  return size_t(std::max(1, o.brackets));
+}
+
 size_t OrderedPhotoCount(const ImportOptions& o, const SamplingGrid& grid) {
-  return size_t(grid.count()) * 2 * std::max<size_t>(1, o.exposures.size());
+  return size_t(grid.count()) * 2 * OrderedPerSlide(o);
 }
 
 NamedPhoto OrderedPhoto(const ImportOptions& o, const SamplingGrid& grid, size_t k,
                         const std::string& file) {
-  const size_t per_slide = std::max<size_t>(1, o.exposures.size());
+  const size_t per_slide = OrderedPerSlide(o);
   NamedPhoto n;
   const size_t position = k / (2 * per_slide), within = k % (2 * per_slide);
   std::tie(n.i, n.j) = ScanPosition(grid, o.scan, int(position));

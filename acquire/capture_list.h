@@ -56,8 +56,10 @@ class FilePattern {
 // slide p then n, each slide's bracket in --exposures order.
 NamedPhoto OrderedPhoto(const ImportOptions& options, const SamplingGrid& grid, size_t k,
                         const std::string& file);
-// Photos a capture in order holds: positions x 2 slides x exposures.
+// Photos a capture in order holds: positions x 2 slides x OrderedPerSlide.
 size_t OrderedPhotoCount(const ImportOptions& options, const SamplingGrid& grid);
+// Photos per slide of a capture in order: --exposures' count, else --brackets, else 1.
+size_t OrderedPerSlide(const ImportOptions& options);
 
 // Each photo is checked once (a regular file, an image by its content, BadInput naming it
 // otherwise) and its EXIF read once, however many steps ask for it.

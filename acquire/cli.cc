@@ -53,6 +53,10 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
       ->capture_default_str();
   cmd->add_flag("--compress", o.compress_float,
                 "--photo-format float: PIZ-compress the photos (smaller, slower)");
+  cmd->add_flag("--camera-folder", o.camera_folder,
+                "write the capture as a camera leaves it: camera/IMG_0001.TIF (JPG with a "
+                "response, DNG with raw) ... in capture order with EXIF, camera/BOARD.PNG, "
+                "setup.json and truth/, no dataset.json (acquire import makes it)");
   cmd->add_flag("--print-scene", c->print_scene,
                 "print the scene as JSON (the built-in one for --scene default) and exit");
   AddCommonOptions(cmd, common);
@@ -79,6 +83,10 @@ void AddPhotoOptions(CLI::App* cmd, ImportOptions* o) {
   cmd->add_option("--exposures", o->exposures,
                   "--order: the relative exposures of each slide's bracket, in capture order")
       ->delimiter(',');
+  cmd->add_option("--brackets", o->brackets,
+                  "--order without --exposures, --pattern: photos per slide (each bracket's "
+                  "exposures then from EXIF or the template)")
+      ->check(CLI::Range(1, 100));
   cmd->add_option("--exposure", o->exposure,
                   "relative exposure of every photo that has none of its own")
       ->check(FiniteIn(1e-9, 1e9));
@@ -115,9 +123,6 @@ CLI::App* AddWatchCommand(CLI::App& app, WatchOptions* w, CommonOptions* common)
                   "stop after this many seconds without a new file (0: wait until complete)")
       ->check(FiniteIn(0, 1e9))
       ->capture_default_str();
-  cmd->add_option("--brackets", w->brackets, "--pattern: photos per slide")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
   cmd->add_flag("--force", w->import.force, "watch again over a complete dataset.json");
   AddCommonOptions(cmd, common);
   return cmd;
@@ -149,7 +154,7 @@ int RunWatchCommand(WatchOptions w) {
   LogInfo("parameters: photos=", o.photos_dir, " setup=", o.setup_file, " out=", o.out_dir,
           " manifest=", o.manifest, " pattern=", o.pattern, " order=", o.order, " scan=", o.scan,
           " settle=", w.settle_s, " s poll=", w.poll_s, " s idle_timeout=", w.idle_timeout_s,
-          " s brackets=", w.brackets, " force=", o.force ? "yes" : "no");
+          " s brackets=", o.brackets, " force=", o.force ? "yes" : "no");
   const StopSignalScope
       stop_signals;  // Ctrl-C: dataset.json stays as the last complete position left it
   const WatchReport r = RunWatch(w);
@@ -209,6 +214,7 @@ int RunSynthCommand(SynthOptions synth, int threads) {
   params << "scene=" << synth.scene << " out=" << synth.out_dir << " interval="
          << (synth.interval_s >= 0 ? std::to_string(synth.interval_s) + " s" : "none")
          << " force=" << (synth.force ? "yes" : "no") << " photo_format=" << synth.photo_format
+         << " camera_folder=" << (synth.camera_folder ? "yes" : "no")
          << " threads=" << synth.threads;
   LogInfo("parameters: ", params.str());
   const StopSignalScope stop_signals;  // Ctrl-C: finish the photos in hand, then stop

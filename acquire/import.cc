@@ -46,7 +46,7 @@ std::vector<std::string> ByCaptureTime(const std::string& dir,
 // missing.
 std::vector<NamedPhoto> FromOrder(const ImportOptions& o, const SamplingGrid& grid,
                                   const std::vector<std::string>& files) {
-  const size_t per_slide = std::max<size_t>(1, o.exposures.size());
+  const size_t per_slide = OrderedPerSlide(o);
   const size_t expected = OrderedPhotoCount(o, grid);
   if (files.size() > expected || (files.size() < expected && !o.partial)) {
     std::ostringstream got;
@@ -83,7 +83,9 @@ std::vector<NamedPhoto> FromPattern(const std::string& pattern,
 std::vector<PhotoEntry> CompleteEntries(const CaptureList& list, const ImportOptions& o,
                                         const SamplingGrid& grid,
                                         std::vector<std::pair<int, int>>* missing) {
-  const int brackets = list.MostPerSlide();
+  const int brackets = !o.order.empty() ? int(OrderedPerSlide(o))
+                       : o.brackets > 0 ? o.brackets
+                                        : list.MostPerSlide();
   std::vector<PhotoEntry> entries = list.Entries(brackets, missing);
   if (o.partial && missing->size() < size_t(grid.count())) return entries;
   if (missing->empty()) return entries;
@@ -119,6 +121,14 @@ void ImportOptions::Check() const {
   for (const double e : exposures)
     if (!(e >= kMinExposure && e <= kMaxExposure))
       throw InputError("--exposures", "", "relative exposures in [1e-9, 1e9]", std::to_string(e));
+  if (brackets < 0 || brackets > 100)
+    throw InputError("--brackets", "", "1 .. 100 photos per slide", std::to_string(brackets));
+  if (brackets > 0 && !manifest.empty())
+    throw BadInput("--brackets: only with --order or --pattern (a manifest names each photo)");
+  if (brackets > 0 && !exposures.empty() && size_t(brackets) != exposures.size())
+    throw InputError("--brackets", "",
+                     "the number of --exposures (" + std::to_string(exposures.size()) + ")",
+                     std::to_string(brackets));
   if (std::set<double>(exposures.begin(), exposures.end()).size() != exposures.size())
     throw InputError("--exposures", "", "different exposures", "a repeated value");
 }
@@ -155,7 +165,7 @@ ImportReport RunImport(const ImportOptions& o) {
 
   WriteImportedDataset(ds, o.out_dir);
   report.photos = int(ds.photos.size());
-  report.brackets = list.MostPerSlide();
+  report.brackets = ds.photos.empty() ? 0 : list.MostPerSlide();
   report.missing = ds.missing_positions;
   return report;
 }

@@ -24,6 +24,10 @@ struct ImportOptions {
   // order they were taken (relative exposures; one value: no brackets).
   std::string scan = "rows";  // rows | serpentine | columns
   std::vector<double> exposures;
+  // Photos per slide (a bracket's exposures), for --order without --exposures (each photo's
+  // exposure then from EXIF) and --pattern; 0: --exposures' count, else as many as the fullest
+  // slide holds (import) or 1 (watch, --order).
+  int brackets = 0;
   // The relative exposure of a photo nothing else gives one for (no manifest exposure, pattern
   // {exposure} or --exposures, and no EXIF exposure time, f-number and ISO); without it such a
   // photo is an error.

@@ -85,9 +85,9 @@ class Watcher {
       }
     } else if (!o_.pattern.empty()) {
       pattern_.emplace(o_.pattern);
-      per_slide_ = w.brackets;
+      per_slide_ = std::max(1, o_.brackets);
     } else {
-      per_slide_ = int(std::max<size_t>(1, o_.exposures.size()));
+      per_slide_ = int(OrderedPerSlide(o_));
     }
     ds_.photos.clear();
     list_.Entries(per_slide_, &ds_.missing_positions);
@@ -230,11 +230,6 @@ void WatchOptions::Check() const {
                      std::to_string(poll_s));
   if (!(idle_timeout_s >= 0 && std::isfinite(idle_timeout_s)))
     throw InputError("--idle-timeout", "", "seconds >= 0", std::to_string(idle_timeout_s));
-  if (brackets < 1 || brackets > 100)
-    throw InputError("--brackets", "", "1 .. 100 photos per slide", std::to_string(brackets));
-  if (brackets != 1 && import.pattern.empty())
-    throw BadInput(
-        "--brackets: only with --pattern (--exposures or the manifest say it otherwise)");
 }
 
 WatchReport RunWatch(const WatchOptions& w) {

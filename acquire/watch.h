@@ -20,9 +20,6 @@ struct WatchOptions {
   double settle_s = 1;
   double poll_s = 0.2;        // s between two looks at the folder
   double idle_timeout_s = 0;  // stop after this long without a new or growing file (0: never)
-  // --pattern: photos per slide (exposures of a bracket); a manifest or --exposures says it
-  // otherwise.
-  int brackets = 1;
 
   void Check() const;  // BadInput naming the option
 };

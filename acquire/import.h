@@ -24,25 +24,35 @@ struct ImportOptions {
   // order they were taken (relative exposures; one value: no brackets).
   std::string scan = "rows";  // rows | serpentine | columns
   std::vector<double> exposures;
+  // Photos per slide (a bracket's exposures), for --order without --exposures (each photo's
+  // exposure then from EXIF) and --pattern; 0: --exposures' count, else as many as the fullest
+  // slide holds (import) or 1 (watch, --order).
+  int brackets = 0;
   // The relative exposure of a photo nothing else gives one for (no manifest exposure, pattern
   // {exposure} or --exposures, and no EXIF exposure time, f-number and ISO); without it such a
   // photo is an error.
   std::optional<double> exposure;
   bool force = false;  // rewrite an existing dataset.json
+  // Positions without both slides (all exposures) are left out and listed in dataset.json's
+  // missing_positions instead of refusing the folder (with --order: the photos after the last
+  // one are missing; a gap in the middle shifts every later photo and cannot be told).
+  bool partial = false;
 
   void Check() const;  // BadInput naming the option
 };
 
 struct ImportReport {
-  bool skipped = false;             // dataset.json existed (no --force)
-  int photos = 0;                   // slide photos listed
-  int brackets = 1;                 // exposures per slide
-  std::vector<std::string> unused;  // image files in the folder that no photo entry names
+  bool skipped = false;                      // dataset.json existed (no --force)
+  int photos = 0;                            // slide photos listed
+  int brackets = 1;                          // exposures per slide
+  std::vector<std::string> unused;           // image files in the folder that no photo entry names
+  std::vector<std::pair<int, int>> missing;  // --partial: the positions left out
 };
 
 // Builds dataset.json for the photos: every named file must be a regular file holding an image
-// (PNG, JPEG, TIFF or EXR by its content), every grid position must have both slides, and every
-// slide the same number of exposures; BadInput naming the file, line or position otherwise.
+// (PNG, JPEG, TIFF, EXR or RAW by its content), every grid position must have both slides (or,
+// with `partial`, be listed as missing), and every slide the same number of exposures; BadInput
+// naming the file, line or position otherwise.
 ImportReport RunImport(const ImportOptions& options);
 
 // The grid position of the k-th photo position of a scan (rows: i fastest; serpentine: rows,

@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "acquire/photo_store.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -101,28 +102,15 @@ ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale,
 
 namespace {
 
-// Sleeps `seconds` in short slices so that a stop signal ends the pause at once; false when
-// stopped.
-bool PauseUnlessStopped(double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!StopRequested()) {
-    const std::chrono::duration<double> left = end - std::chrono::steady_clock::now();
-    if (left.count() <= 0) return true;
-    std::this_thread::sleep_for(std::min(left, std::chrono::duration<double>(0.05)));
-  }
-  return false;
-}
-
 // Renders, applies the effects to and writes the photos of every position: in order with a
 // pause for a live acquisition, else on `threads` threads. A stop signal ends it after the
 // positions in hand (each written whole). Returns the number of photos written.
 int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
-                     const SynthOptions& options, PhotoEncoding encoding, int threads) {
+                     const SynthOptions& options, const PhotoStore& store, int threads) {
   const ScreenView view = ScreenView::Of(scene);
   const double scale = *dataset.radiometric_scale;
   const int count = scene.grid.count();
   const int stops = int(scene.Stops().size());
-  const int jpeg_quality = scene.Response() ? scene.Response()->quality() : 95;
   Progress progress("acquire", count);
   std::atomic<int> written{0};
   auto capture = [&](int q) {
@@ -140,8 +128,9 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std:
         ImageF& photo = scene.Brackets() ? exposed : render;
         const PhotoContext context = ContextOf(scene, i, j, positive, stop);
         ApplyEffects(scene, context, &photo);
-        WritePhoto(dir + "/" + dataset.photos[context.photo_index].file, photo, encoding,
-                   jpeg_quality);
+        const PhotoEntry& entry = dataset.photos[size_t(context.photo_index)];
+        StoreSlidePhoto(scene, store, dir + "/" + entry.file, photo, entry.exposure,
+                        context.photo_index);
         ++written;
       }
     progress.Advance();
@@ -176,20 +165,24 @@ namespace {
 // Writes the whole dataset into `dir`: dataset.json and the calibration photo first (a live
 // reader can start at once), the truth, then the photos. Returns the number of photos written.
 int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
-                 const SynthOptions& options, PhotoEncoding encoding, int threads) {
-  MakeDirectories(dir + "/photos");
+                 const SynthOptions& options, const PhotoStore& store, int threads) {
+  const std::string photos = dir + "/" + (options.camera_folder ? kCameraFolder : "photos");
+  MakeDirectories(photos);
   MakeDirectories(dir + "/truth");
   int orphans = 0;
-  for (const std::string& d : {dir, dir + "/photos", dir + "/truth"})
+  for (const std::string& d : {dir, photos, dir + "/truth"})
     orphans += RemoveOrphanedTemporaries(d);
   if (orphans > 0) LogInfo(dir, ": removed ", orphans, " temporary file(s) of an interrupted run");
-  dataset.Save(dir);
-  WriteCalibrationPhoto(scene, dir + "/" + scene.calibration.photo, threads);
+  if (options.camera_folder)
+    WriteSetupFile(dataset, dir + "/setup.json");  // what a lab knows; no dataset.json
+  else
+    dataset.Save(dir);
+  WriteCalibrationPhoto(scene, dir + "/" + dataset.calibration.photo, threads);
   WriteTruthCamera(scene, dir + "/truth/camera.json");
   if (scene.Response()) WriteTruthResponse(*scene.Response(), dir + "/truth/response.json");
   WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
                  dir + "/truth", threads);
-  return CapturePositions(scene, dataset, dir, options, encoding, threads);
+  return CapturePositions(scene, dataset, dir, options, store, threads);
 }
 
 }  // namespace
@@ -198,27 +191,29 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
   options.Check();
   SynthReport report;
   const std::string& out = options.out_dir;
-  if (!options.force && DatasetComplete(out)) {
+  if (!options.force &&
+      (options.camera_folder ? CameraFolderComplete(scene, out) : DatasetComplete(out))) {
     LogInfo("a complete dataset is already in ", out, " (use --force to redo it)");
     report.skipped = true;
     return report;
   }
   const int threads = ResolveThreads(options.threads);
   Dataset dataset = DatasetSkeleton(scene);
-  dataset.photos = PhotoList(scene);
+  dataset.photos = options.camera_folder ? CameraFolderPhotoList(scene) : PhotoList(scene);
+  if (options.camera_folder)
+    dataset.calibration.photo = std::string(kCameraFolder) + "/" + kCameraBoardPhoto;
   dataset.radiometric_scale = ChooseRadiometricScale(scene, threads);
   report.radiometric_scale = *dataset.radiometric_scale;
-  const PhotoEncoding encoding = SlidePhotoEncoding(scene, options);
+  PhotoStore store;
+  store.encoding = SlidePhotoEncoding(scene, options);
+  store.jpeg_quality = scene.Response() ? scene.Response()->quality() : 95;
+  store.camera_folder = options.camera_folder;
   LogInfo("scene ", scene.source, ": ", scene.grid.nu, "x", scene.grid.nv, " positions, ",
-          scene.camera.width, "x", scene.camera.height, " px photos (",
-          encoding == PhotoEncoding::kCurve8Jpeg    ? "8-bit JPEG"
-          : encoding == PhotoEncoding::kLinear16Png ? "16-bit PNG"
-          : encoding == PhotoEncoding::kHalfExr     ? "half-float EXR"
-                                                    : "float EXR",
-          "), radiometric scale ", report.radiometric_scale, " W/m^2 per unit, ",
-          scene.effects.size(), " effect(s)");
+          scene.camera.width, "x", scene.camera.height, " px photos (", StoreName(scene, store),
+          options.camera_folder ? ", a camera folder" : "", "), radiometric scale ",
+          report.radiometric_scale, " W/m^2 per unit, ", scene.effects.size(), " effect(s)");
   if (options.interval_s >= 0) {  // live: readers follow the files where they will stay
-    report.photos_written = WriteDataset(scene, dataset, out, options, encoding, threads);
+    report.photos_written = WriteDataset(scene, dataset, out, options, store, threads);
     return report;
   }
   // Offline: into a staging folder beside `out`, swapped in when complete, so that a failure, a
@@ -229,7 +224,7 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
     LogInfo(parent.string(), ": removed ", n, " staging folder(s) of an interrupted run");
   const std::string staging = TemporaryPathFor(out);
   try {
-    report.photos_written = WriteDataset(scene, dataset, staging, options, encoding, threads);
+    report.photos_written = WriteDataset(scene, dataset, staging, options, store, threads);
     if (StopRequested()) {
       fs::remove_all(staging);
       report.photos_written = 0;

@@ -21,6 +21,9 @@ struct SynthOptions {
   // (half-float EXR, RLE: lossless for half, ~1 MB a photo) or "float" (32-bit float EXR).
   std::string photo_format = "half";
   bool compress_float = false;  // "float" photos PIZ-compressed (smaller, slower)
+  // The capture as a camera leaves it (acquire/photo_store.h): camera/IMG_0001.<EXT> ... with
+  // EXIF, camera/BOARD.PNG, setup.json and truth/, no dataset.json (`acquire import` makes it).
+  bool camera_folder = false;
 
   void Check() const;  // BadInput naming the option
 };

@@ -191,14 +191,29 @@ Dataset Dataset::Parse(const JsonDocument& doc, const std::string& dir, bool wit
                (other.file == e.file ? "file" : "position, slide and exposure") + ")");
     ds.photos.push_back(e);
   }
+  // A partial dataset names the positions it lacks; every other position has both slides.
+  std::set<std::pair<int, int>> missing;
+  if (root.Has("missing_positions")) {
+    const JsonView list = root["missing_positions"];
+    for (size_t k = 0; k < list.Size(); ++k) {
+      const JsonView p = list[k];
+      if (p.Size() != 2) p.Fail("a position [i, j]");
+      const std::pair<int, int> ij = {p[size_t(0)].IntIn(0, ds.grid.nu - 1),
+                                      p[size_t(1)].IntIn(0, ds.grid.nv - 1)};
+      if (!missing.insert(ij).second) p.Fail("a position not listed before");
+      if (slides.count({ij.first, ij.second, true}) || slides.count({ij.first, ij.second, false}))
+        p.Fail("a position without photos (photos lists some for it)");
+      ds.missing_positions.push_back(ij);
+    }
+  }
   for (int j = 0; j < ds.grid.nv; ++j)
     for (int i = 0; i < ds.grid.nu; ++i)
       for (bool positive : {true, false})
-        if (!slides.count({i, j, positive}))
+        if (!slides.count({i, j, positive}) && !missing.count({i, j}))
           throw InputError(
               file, "photos",
               std::string("a photo through slide ") + (positive ? "p" : "n") +
-                  " for every grid position",
+                  " for every grid position not in missing_positions",
               "none for position (" + std::to_string(i) + ", " + std::to_string(j) + ")");
   return ds;
 }
@@ -235,6 +250,11 @@ nlohmann::json Dataset::ToJson() const {
                     {"file", p.file},
                     {"exposure", p.exposure}});
   j["photos"] = list;
+  if (!missing_positions.empty()) {
+    nlohmann::json missing = nlohmann::json::array();
+    for (const auto& [i, jj] : missing_positions) missing.push_back({i, jj});
+    j["missing_positions"] = missing;
+  }
   return j;
 }
 

@@ -100,6 +100,10 @@ struct Dataset {
   // references a camera's folder instead of copying it). Photo names are relative to it.
   std::string photo_folder;
   std::vector<PhotoEntry> photos;
+  // Positions the capture does not have (yet): a partial dataset (`acquire import --partial`,
+  // `acquire watch` while photos arrive). Exactly the positions without photos; every other
+  // position has both slides. Empty for a complete dataset (the usual case).
+  std::vector<std::pair<int, int>> missing_positions;
   bool synthetic = false;
 
   static Dataset Load(const std::string& dir);  // validates, errors name dataset.json and field
@@ -111,8 +115,9 @@ struct Dataset {
   std::string Path(const std::string& relative) const { return dir + "/" + relative; }
   // A photo's path: `file` (a PhotoEntry's or the calibration photo's) under photo_folder.
   std::string PhotoPath(const std::string& file) const;
-  // Photos of one position (both slides, all exposures), in file order.
+  // Photos of one position (both slides, all exposures), in file order; none for a missing one.
   std::vector<PhotoEntry> PhotosOf(int i, int j) const;
+  bool Partial() const { return !missing_positions.empty(); }
   SlabLayout Layout(int resolution) const {
     return {screen_w_mm, screen_h_mm, resolution, resolution};
   }

@@ -1,6 +1,9 @@
 #include "core/stop_signal.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <thread>
 
 namespace lumislab {
 namespace {
@@ -30,5 +33,15 @@ StopSignalScope::~StopSignalScope() {
 
 bool StopRequested() { return g_stop; }
 void RequestStop() { g_stop = true; }
+
+bool PauseUnlessStopped(double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!StopRequested()) {
+    const std::chrono::duration<double> left = end - std::chrono::steady_clock::now();
+    if (left.count() <= 0) return true;
+    std::this_thread::sleep_for(std::min(left, std::chrono::duration<double>(0.05)));
+  }
+  return false;
+}
 
 }  // namespace lumislab

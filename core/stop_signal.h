@@ -23,5 +23,8 @@ class StopSignalScope {
 bool StopRequested();
 // Sets the flag as a signal would (tests, and loops that stop for another reason).
 void RequestStop();
+// Sleeps `seconds` in 50 ms slices so that a stop signal ends the pause at once; false when
+// stopped.
+bool PauseUnlessStopped(double seconds);
 
 }  // namespace lumislab

@@ -315,6 +315,27 @@ void WriteImageFile(const std::string& path, const cv::Mat& image, const std::ve
   });
 }
 
+cv::Mat PhotoCodes(const ImageF& linear, PhotoEncoding encoding) {
+  LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "PhotoCodes: 1 or 3 channels");
+  const bool srgb = encoding == PhotoEncoding::kSrgb8Png;
+  const bool eight_bit = srgb || encoding == PhotoEncoding::kCurve8Jpeg;
+  const int type = eight_bit ? CV_8UC(linear.channels) : CV_16UC(linear.channels);
+  const double max = eight_bit ? 255.0 : 65535.0;
+  cv::Mat out(linear.height, linear.width, type);
+  for (int y = 0; y < linear.height; ++y)
+    for (int x = 0; x < linear.width; ++x)
+      for (int c = 0; c < linear.channels; ++c) {
+        const double v = linear.at(x, y, c);
+        const double code = std::round((srgb ? LinearToSrgb(v) : std::clamp(v, 0.0, 1.0)) * max);
+        const int oc = linear.channels == 3 ? 2 - c : 0;  // OpenCV stores BGR
+        if (eight_bit)
+          out.ptr<uint8_t>(y)[x * linear.channels + oc] = uint8_t(code);
+        else
+          out.ptr<uint16_t>(y)[x * linear.channels + oc] = uint16_t(code);
+      }
+  return out;
+}
+
 void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding,
                 int jpeg_quality) {
   LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "WritePhoto: 1 or 3 channels");
@@ -331,23 +352,8 @@ void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding enc
     WriteExr(path, linear, names, {}, options);
     return;
   }
-  const bool srgb = encoding == PhotoEncoding::kSrgb8Png;
+  const cv::Mat out = PhotoCodes(linear, encoding);
   const bool jpeg = encoding == PhotoEncoding::kCurve8Jpeg;
-  const bool eight_bit = srgb || jpeg;
-  const int type = eight_bit ? CV_8UC(linear.channels) : CV_16UC(linear.channels);
-  const double max = eight_bit ? 255.0 : 65535.0;
-  cv::Mat out(linear.height, linear.width, type);
-  for (int y = 0; y < linear.height; ++y)
-    for (int x = 0; x < linear.width; ++x)
-      for (int c = 0; c < linear.channels; ++c) {
-        const double v = linear.at(x, y, c);
-        const double code = std::round((srgb ? LinearToSrgb(v) : std::clamp(v, 0.0, 1.0)) * max);
-        const int oc = linear.channels == 3 ? 2 - c : 0;  // OpenCV stores BGR
-        if (eight_bit)
-          out.ptr<uint8_t>(y)[x * linear.channels + oc] = uint8_t(code);
-        else
-          out.ptr<uint16_t>(y)[x * linear.channels + oc] = uint16_t(code);
-      }
   if (jpeg)
     WriteImageFile(path, out, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
   else

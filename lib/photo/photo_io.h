@@ -125,5 +125,8 @@ enum class PhotoEncoding {
 };
 void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding,
                 int jpeg_quality = 95);
+// The codes an 8- or 16-bit encoding (kLinear16Png, kSrgb8Png, kCurve8Jpeg) stores, in
+// OpenCV's BGR order: what WritePhoto writes, for writers with EXIF (lib/photo/camera_write.h).
+cv::Mat PhotoCodes(const ImageF& linear, PhotoEncoding encoding);
 
 }  // namespace lumislab

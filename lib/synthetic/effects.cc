@@ -271,13 +271,34 @@ Eigen::Vector2d StageErrorEffect::StageOffsetMm(int i, int j) const {
   return {(2 * Uniform(seed_, i, j, 0) - 1) * max_mm_, (2 * Uniform(seed_, i, j, 1) - 1) * max_mm_};
 }
 
+std::shared_ptr<const Effect> MakeRaw(const JsonView& spec, const EffectSetting&) {
+  CheckKeys(spec, {"bit_depth", "black_level", "white_level"});
+  const int bits = spec.Has("bit_depth") ? spec["bit_depth"].IntIn(12, 16) : 14;
+  const int max_code = (1 << bits) - 1;
+  const int black = spec.Has("black_level") ? spec["black_level"].IntIn(0, (1 << bits) / 4) : 512;
+  // At least 1024 levels between black and white (black <= 2^bits / 4 leaves them by default).
+  const int white =
+      spec.Has("white_level") ? spec["white_level"].IntIn(black + 1024, max_code) : max_code;
+  return std::make_shared<RawEffect>(bits, black, white);
+}
+
+int RawEffect::Code(float value) const {
+  const double code = std::round(black_level_ + double(value) * (white_level_ - black_level_));
+  return int(std::clamp(code, 0.0, double(white_level_)));
+}
+
+void RawEffect::Apply(ImageF& rgb, const PhotoContext&) const {
+  const double range = white_level_ - black_level_;
+  for (float& v : rgb.data) v = float((Code(v) - black_level_) / range);
+}
+
 const std::map<std::string, EffectFactory>& EffectRegistry() {
   static const std::map<std::string, EffectFactory> registry = {
       {"sensor_noise", &MakeSensorNoise}, {"quantization", &MakeQuantization},
       {"vignetting", &MakeVignetting},    {"screen_gain", &MakeScreenGain},
       {"ambient", &MakeAmbient},          {"dark", &MakeDark},
       {"brackets", &MakeBrackets},        {"response", &MakeResponse},
-      {"stage_error", &MakeStageError},
+      {"stage_error", &MakeStageError},   {"raw", &MakeRaw},
   };
   return registry;
 }

@@ -193,6 +193,25 @@ class StageErrorEffect : public Effect {
   unsigned long long seed_;
 };
 
+// The camera's raw sensor output: each value becomes the integer code black + v (white - black)
+// of a `bit_depth`-bit sensor, clipped to [0, white] (white: saturation), and is kept as the
+// value the decoder gives back, (code - black) / (white - black). The photos are then stored as
+// an RGGB Bayer mosaic in a DNG (lib/photo/camera_write.h WriteDng), one channel per pixel.
+class RawEffect : public Effect {
+ public:
+  RawEffect(int bit_depth, int black_level, int white_level)
+      : bit_depth_(bit_depth), black_level_(black_level), white_level_(white_level) {}
+  std::string Type() const override { return "raw"; }
+  void Apply(ImageF& rgb, const PhotoContext& context) const override;
+  int Code(float value) const;  // the sensor code of a value
+  int bit_depth() const { return bit_depth_; }
+  int black_level() const { return black_level_; }
+  int white_level() const { return white_level_; }
+
+ private:
+  int bit_depth_, black_level_, white_level_;
+};
+
 // Builds an effect from its JSON object {"type": ..., params}; `spec` is effects[k] of a scene
 // file. Unknown types and bad or unknown parameters throw InputError naming the field.
 using EffectFactory = std::shared_ptr<const Effect> (*)(const JsonView& spec,

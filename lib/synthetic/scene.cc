@@ -127,6 +127,12 @@ void ParseCalibration(const JsonView& root, SynthScene* scene) {
   CheckBoardInView(*scene);
 }
 
+// raw (DNG photos) excludes the other effects that choose the photos' format.
+bool RawFormatClash(const std::string& a, const std::string& b) {
+  const auto format = [](const std::string& t) { return t == "response" || t == "quantization"; };
+  return (a == "raw" && format(b)) || (b == "raw" && format(a));
+}
+
 // The effects, built with the scene's camera and screen. brackets, response and dark are
 // listed at most once (each sets something of the whole dataset: its photos, their format, its
 // black level), and response (8-bit JPEG) excludes quantization (16-bit PNG).
@@ -140,8 +146,12 @@ void ParseEffects(const JsonView& effects, SynthScene* scene) {
     auto effect = MakeEffect(effects[k], setting);
     const std::string type = effect->Type();
     for (const auto& other : scene->effects) {
-      if (other->Type() == type && (type == "brackets" || type == "response" || type == "dark"))
+      if (other->Type() == type &&
+          (type == "brackets" || type == "response" || type == "dark" || type == "raw"))
         effects[k]["type"].Fail("a type listed once (" + type + " is listed before)");
+      if (RawFormatClash(type, other->Type()))
+        effects[k]["type"].Fail("not both raw (DNG) and " + (type == "raw" ? other->Type() : type) +
+                                " (a photo has one format)");
       const bool formats = (type == "response" && other->Type() == "quantization") ||
                            (type == "quantization" && other->Type() == "response");
       if (formats)
@@ -167,8 +177,10 @@ bool SynthScene::Quantized() const {
 const BracketsEffect* SynthScene::Brackets() const { return FindEffect<BracketsEffect>(*this); }
 const ResponseEffect* SynthScene::Response() const { return FindEffect<ResponseEffect>(*this); }
 const DarkEffect* SynthScene::Dark() const { return FindEffect<DarkEffect>(*this); }
+const RawEffect* SynthScene::Raw() const { return FindEffect<RawEffect>(*this); }
 
 std::string SynthScene::PhotoExtension() const {
+  if (Raw()) return "dng";
   return Response() ? "jpg" : Quantized() ? "png" : "exr";
 }
 

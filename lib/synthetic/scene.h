@@ -34,7 +34,9 @@ struct SynthScene {
   const BracketsEffect* Brackets() const;
   const ResponseEffect* Response() const;
   const DarkEffect* Dark() const;
-  std::string PhotoExtension() const;  // "jpg" (response), "png" (quantization) or "exr"
+  const RawEffect* Raw() const;
+  // "dng" (raw), "jpg" (response), "png" (quantization) or "exr"
+  std::string PhotoExtension() const;
   // The stops of each slide's exposure series: those of `brackets`, else {0}.
   std::vector<double> Stops() const;
   // Sum of the listed effects' stage offsets at position (i, j) (mm, lab frame; 0 without

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -212,6 +213,38 @@ TEST_F(Import, ExifGivesOrderExposureAndCamera) {
   EXPECT_NE(t.output.find("jpeg/" + jpegs[5] + ": EXIF DateTimeOriginal"), std::string::npos)
       << t.output;
   EXPECT_FALSE(fs::exists(root_ + "/ds2/dataset.json"));
+}
+
+// --partial: a capture that stopped early (order) or a manifest without a position gives a
+// dataset listing the positions it lacks, with a warning naming them; without --partial the
+// same folder is refused (BadFoldersAndDescriptionsAreRefused).
+TEST_F(Import, PartialListsTheMissingPositions) {
+  // The last position's two photos were never taken.
+  for (size_t k = names_.size() - 2; k < names_.size(); ++k)
+    fs::rename(root_ + "/camera/" + names_[k], root_ + "/" + names_[k]);
+  const auto r = RunToolIn(root_, "lumislab-acquire",
+                           "import --photos camera --setup setup.json --out ds --order name "
+                           "--exposure 1 --partial",
+                           60);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("partial dataset: 1 position(s) missing ((2, 1))"), std::string::npos)
+      << r.output;
+  const Dataset ds = Dataset::Load(root_ + "/ds");
+  EXPECT_EQ(ds.photos.size(), 10u);
+  EXPECT_EQ(ds.missing_positions, (std::vector<std::pair<int, int>>{{2, 1}}));
+  // A manifest without position (1, 0), and with one slide only of (0, 1): both missing; the
+  // lone photo is left out (and named among the unused files).
+  for (size_t k = names_.size() - 2; k < names_.size(); ++k)
+    fs::rename(root_ + "/" + names_[k], root_ + "/camera/" + names_[k]);
+  std::string manifest;
+  std::istringstream rows(manifest_);
+  for (std::string row; std::getline(rows, row);)
+    if (row.rfind("1,0,", 0) != 0 && row.rfind("0,1,n", 0) != 0) manifest += row + "\n";
+  testing::WriteFile(root_ + "/partial.csv", manifest);
+  Ok("lumislab-acquire",
+     "import --photos camera --setup setup.json --out ds2 --manifest partial.csv --partial");
+  EXPECT_EQ(Dataset::Load(root_ + "/ds2").missing_positions,
+            (std::vector<std::pair<int, int>>{{1, 0}, {0, 1}}));
 }
 
 TEST(ImportScan, ScanOrders) {

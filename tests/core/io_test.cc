@@ -5,6 +5,7 @@
 #include <ImfOutputFile.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -311,6 +312,37 @@ TEST_F(IoTest, DatasetRoundTripAndValidation) {
   expect_error("\"schema_version\": 2", "\"schema_version\": 4", "schema_version");
   expect_error("\"schema_version\": 2", "\"schema_version\": 3, \"photo_folder\": \"\"",
                "photo_folder: expected a folder path");
+}
+
+// A partial dataset (import --partial, watch) lists the positions it lacks: exactly those
+// without photos; a position missing without being listed, or listed with photos, is refused.
+TEST_F(IoTest, PartialDatasetListsItsMissingPositions) {
+  Dataset ds = SmallDataset();
+  ds.photos.erase(std::remove_if(ds.photos.begin(), ds.photos.end(),
+                                 [](const PhotoEntry& e) { return e.i == 2 && e.j == 1; }),
+                  ds.photos.end());
+  ds.missing_positions = {{2, 1}};
+  ds.Save(dir_.string());
+  const Dataset back = Dataset::Load(dir_.string());
+  EXPECT_TRUE(back.Partial());
+  EXPECT_EQ(back.missing_positions, (std::vector<std::pair<int, int>>{{2, 1}}));
+  EXPECT_TRUE(back.PhotosOf(2, 1).empty());
+  EXPECT_EQ(back.photos.size(), 10u);
+  auto refused = [&](const std::string& missing, const std::string& msg) {
+    nlohmann::json j = ds.ToJson();
+    j["missing_positions"] = nlohmann::json::parse(missing);
+    try {
+      Dataset::Parse(JsonDocument::Parse(j.dump(), "dataset.json"), dir_.string());
+      ADD_FAILURE() << "accepted " << missing;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.exit_code(), 2);
+      EXPECT_NE(std::string(e.what()).find(msg), std::string::npos) << e.what();
+    }
+  };
+  refused("[]", "none for position (2, 1)");
+  refused("[[2, 1], [0, 0]]", "missing_positions[1]: expected a position without photos");
+  refused("[[2, 1], [2, 1]]", "missing_positions[1]: expected a position not listed before");
+  refused("[[3, 1]]", "missing_positions[0][0]");
 }
 
 // Old files stay readable: a version-1 dataset.json reads with the version-2 defaults.

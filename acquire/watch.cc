@@ -1,0 +1,279 @@
+#include "acquire/watch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+
+#include "acquire/capture_list.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/stop_signal.h"
+#include "lib/photo/photo_io.h"
+
+namespace fs = std::filesystem;
+
+namespace lumislab {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// The folder's files (temporary names left out) and since when each has had its present size
+// and modification time: a file whose copy is in progress keeps changing, so it settles only
+// once the copy is done (or stalled for the settle time, when it is read and refused).
+class SettleTracker {
+ public:
+  explicit SettleTracker(double settle_s) : settle_s_(settle_s) {}
+
+  // Looks at the folder once; true when a file appeared, changed or went away.
+  bool Scan(const std::string& dir) {
+    const Clock::time_point now = Clock::now();
+    bool changed = false;
+    std::map<std::string, State> seen;
+    for (const std::string& name : FolderFiles(dir)) {
+      std::error_code size_ec, time_ec;
+      const auto size = fs::file_size(dir + "/" + name, size_ec);
+      const auto time = fs::last_write_time(dir + "/" + name, time_ec);
+      if (size_ec || time_ec) continue;  // gone since the listing: the next look tells
+      State state{size, time, now};
+      const auto it = files_.find(name);
+      if (it != files_.end() && it->second.size == size && it->second.time == time)
+        state.since = it->second.since;
+      else
+        changed = true;
+      seen.emplace(name, state);
+    }
+    changed = changed || seen.size() != files_.size();
+    files_ = std::move(seen);
+    return changed;
+  }
+  // Files in name order, with whether each has settled.
+  std::vector<std::pair<std::string, bool>> Files() const {
+    const Clock::time_point now = Clock::now();
+    std::vector<std::pair<std::string, bool>> out;
+    for (const auto& [name, state] : files_)
+      out.emplace_back(name, Seconds(now - state.since) >= settle_s_);
+    return out;
+  }
+
+ private:
+  struct State {
+    uintmax_t size;
+    fs::file_time_type time;
+    Clock::time_point since;  // when this size and time were first seen
+  };
+  double settle_s_;
+  std::map<std::string, State> files_;
+};
+
+// The capture as it arrives: which files were taken, the photo list, and dataset.json.
+class Watcher {
+ public:
+  explicit Watcher(const WatchOptions& w)
+      : o_(w.import), ds_(ImportSkeleton(o_)), list_(o_, ds_.grid), tracker_(w.settle_s) {
+    if (!o_.manifest.empty()) {
+      per_slide_ = 0;
+      std::map<std::tuple<int, int, bool>, int> count;
+      for (const NamedPhoto& n : ManifestPhotos(o_.manifest)) {
+        by_file_[n.file].push_back(n);
+        per_slide_ = std::max(per_slide_, ++count[{n.i, n.j, n.positive}]);
+      }
+    } else if (!o_.pattern.empty()) {
+      pattern_.emplace(o_.pattern);
+      per_slide_ = std::max(1, o_.brackets);
+    } else {
+      per_slide_ = int(OrderedPerSlide(o_));
+    }
+    ds_.photos.clear();
+    list_.Entries(per_slide_, &ds_.missing_positions);
+  }
+
+  // One look at the folder: takes the files that have settled, rewrites dataset.json when a
+  // position became complete. Returns whether the folder changed (a file new, growing or gone).
+  bool Step() {
+    const bool changed = tracker_.Scan(o_.photos_dir);
+    std::vector<std::string> arrived;
+    for (const auto& [name, settled] : tracker_.Files()) {
+      if (taken_.count(name)) continue;
+      // In name order a later name must wait for an earlier one still being copied.
+      if (!settled && o_.order == "name") break;
+      if (settled) arrived.push_back(name);
+    }
+    std::vector<std::string> ordered;
+    for (const std::string& name : arrived) {
+      taken_.insert(name);
+      if (name == ds_.calibration.photo) {
+        DecodePhoto(Path(name));  // an image, whole: BadInput naming it otherwise
+        board_ = true;
+      } else if (!o_.manifest.empty()) {
+        const auto it = by_file_.find(name);
+        if (it == by_file_.end()) {
+          unused_.push_back(name);
+          continue;
+        }
+        CheckPhoto(name);
+        for (const NamedPhoto& n : it->second) Add(n);
+      } else if (pattern_) {
+        const auto n = pattern_->Match(name);
+        if (!n) {
+          unused_.push_back(name);
+          continue;
+        }
+        CheckPhoto(name);
+        Add(*n);
+      } else {
+        CheckPhoto(name);
+        ordered.push_back(name);
+      }
+    }
+    AddInOrder(ordered);
+    std::vector<std::pair<int, int>> missing;
+    std::vector<PhotoEntry> entries = list_.Entries(per_slide_, &missing);
+    if (missing != ds_.missing_positions) {
+      ds_.photos = std::move(entries);
+      ds_.missing_positions = std::move(missing);
+      Write();
+    }
+    return changed;
+  }
+
+  void Write() const { WriteImportedDataset(ds_, o_.out_dir); }
+  bool Complete() const { return ds_.missing_positions.empty() && board_; }
+  const Dataset& dataset() const { return ds_; }
+  const std::vector<std::string>& unused() const { return unused_; }
+
+ private:
+  std::string Path(const std::string& name) const { return o_.photos_dir + "/" + name; }
+
+  // The photo decodes, whole, and has the capture's image size.
+  void CheckPhoto(const std::string& name) {
+    const Photo photo = DecodePhoto(Path(name));
+    list_.CheckImageSize(Path(name), photo.pixels.cols, photo.pixels.rows);
+  }
+
+  void Add(const NamedPhoto& n) {
+    list_.Add(n);
+    const int count = list_.Count(n.i, n.j, n.positive);
+    if (count > per_slide_)
+      throw InputError(n.where, "photos",
+                       std::to_string(per_slide_) + " photo(s) through slide " +
+                           (n.positive ? "p" : "n") + " at position (" + std::to_string(n.i) +
+                           ", " + std::to_string(n.j) +
+                           ") (--brackets, --exposures or the manifest)",
+                       std::to_string(count));
+  }
+
+  // --order: the new files take the next places of the capture, in name order or in the order
+  // of their EXIF time (equal times in name order). A file that belongs before one already
+  // placed came too late: the order cannot be trusted.
+  void AddInOrder(std::vector<std::string> files) {
+    if (files.empty()) return;
+    std::vector<std::pair<std::string, std::string>> keyed;  // (time or "", name)
+    for (const std::string& f : files) {
+      std::string key;
+      if (o_.order == "capture") {
+        const PhotoExif& exif = list_.headers().Of(Path(f));
+        if (!exif.date_time)
+          throw InputError(Path(f), "EXIF DateTimeOriginal", "a capture time (--order capture)",
+                           "nothing (missing); use --order name or a manifest");
+        key = *exif.date_time;
+      }
+      keyed.emplace_back(key, f);
+    }
+    std::sort(keyed.begin(), keyed.end());
+    if (last_ && keyed.front() < *last_)
+      throw InputError(Path(keyed.front().second), "capture order",
+                       "a photo taken after " + last_->second + ", which is placed already",
+                       "one that sorts before it (" +
+                           (o_.order == "capture" ? "EXIF time " + keyed.front().first
+                                                  : std::string("name order")) +
+                           "); use a manifest");
+    const size_t expected = OrderedPhotoCount(o_, ds_.grid);
+    for (const auto& key : keyed) {
+      if (placed_ >= expected)
+        throw InputError(Path(key.second), "capture order",
+                         "at most " + std::to_string(expected) + " photos (the grid is complete)",
+                         "one more");
+      Add(OrderedPhoto(o_, ds_.grid, placed_++, key.second));
+      last_ = key;
+    }
+  }
+
+  const ImportOptions& o_;
+  Dataset ds_;
+  CaptureList list_;
+  SettleTracker tracker_;
+  int per_slide_ = 1;
+  std::map<std::string, std::vector<NamedPhoto>> by_file_;  // manifest rows by file
+  std::optional<FilePattern> pattern_;
+  std::set<std::string> taken_;  // files looked at (placed, the board, or unused)
+  std::vector<std::string> unused_;
+  std::optional<std::pair<std::string, std::string>> last_;  // --order: the last file placed
+  size_t placed_ = 0;
+  bool board_ = false;
+};
+
+}  // namespace
+
+void WatchOptions::Check() const {
+  import.Check();
+  if (import.partial) throw BadInput("watch: --partial is import's (watch is partial as it goes)");
+  if (!(settle_s >= 0 && settle_s <= 3600))
+    throw InputError("--settle", "", "seconds in [0, 3600]", std::to_string(settle_s));
+  if (!(poll_s >= 0.01 && poll_s <= 1))
+    throw InputError("--poll", "", "seconds in [0.01, 1] (a stop is seen within a second)",
+                     std::to_string(poll_s));
+  if (!(idle_timeout_s >= 0 && std::isfinite(idle_timeout_s)))
+    throw InputError("--idle-timeout", "", "seconds >= 0", std::to_string(idle_timeout_s));
+}
+
+WatchReport RunWatch(const WatchOptions& w) {
+  w.Check();
+  const ImportOptions& o = w.import;
+  if (!fs::is_directory(o.photos_dir)) throw BadInput(o.photos_dir + ": photo folder not found");
+  WatchReport report;
+  const std::string out_json = o.out_dir + "/dataset.json";
+  // A complete dataset is skipped as import skips it; a partial one (a watch that was stopped)
+  // is watched again from the start: the files there are taken again as they settle.
+  if (fs::exists(out_json) && !o.force && !Dataset::Load(o.out_dir).Partial()) {
+    LogInfo(out_json, " is complete, skipping (use --force to watch again)");
+    report.skipped = true;
+    return report;
+  }
+  Watcher watcher(w);
+  watcher.Write();
+  LogInfo("watching ", o.photos_dir, " (", watcher.dataset().grid.count(), " positions; ",
+          "a file is taken once unchanged for ", w.settle_s, " s)");
+  auto last_change = Clock::now();
+  size_t missing = watcher.dataset().missing_positions.size();
+  while (true) {
+    if (watcher.Step()) last_change = Clock::now();
+    if (watcher.dataset().missing_positions.size() != missing) {
+      missing = watcher.dataset().missing_positions.size();
+      LogInfo(watcher.dataset().grid.count() - int(missing), "/", watcher.dataset().grid.count(),
+              " positions complete");
+    }
+    if (watcher.Complete()) break;
+    if (StopRequested()) {
+      report.stopped = true;
+      break;
+    }
+    if (w.idle_timeout_s > 0 && Seconds(Clock::now() - last_change) > w.idle_timeout_s) {
+      report.idle = true;
+      break;
+    }
+    PauseUnlessStopped(w.poll_s);
+  }
+  report.complete = watcher.Complete();
+  report.photos = int(watcher.dataset().photos.size());
+  report.missing = watcher.dataset().missing_positions;
+  report.unused = watcher.unused();
+  return report;
+}
+
+}  // namespace lumislab

@@ -65,19 +65,6 @@ struct Named {
   std::string where;
 };
 
-// Regular files of the folder that are not hidden (a copy in progress is written under a '.'
-// name by careful tools), sorted by name.
-std::vector<std::string> FolderFiles(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    if (name.empty() || name[0] == '.' || !entry.is_regular_file()) continue;
-    names.push_back(name);
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 std::vector<Named> FromManifest(const std::string& manifest) {
   CheckInputFile(manifest, "manifest");
   std::ifstream in(manifest);

@@ -4,11 +4,16 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace lumislab {
 
 // Throws BadInput "<path>: <what> not found" or "<path>: not a regular file (a folder, FIFO or
 // device is not a <what>)". `what`: "file", "photo", "scene file", ...
 void CheckInputFile(const std::string& path, const std::string& what);
+
+// The names of the regular files in `dir` that are not hidden (a copy in progress is written
+// under a '.' name by careful tools), sorted by name.
+std::vector<std::string> FolderFiles(const std::string& dir);
 
 }  // namespace lumislab

@@ -243,6 +243,22 @@ TEST_F(CameraCli, RealPhotosAgreeWithOpenCvsCalibrateCamera) {
   EXPECT_NE(again.output.find("skipping"), std::string::npos) << again.output;
 }
 
+TEST_F(CameraCli, WritesIntoTheDatasetsCalibFolder) {
+  CopyReal({0, 2, 4, 6, 8});
+  const std::string dataset = dir_ + "/ds";
+  const std::vector<std::string> args = {"camera",  "--photos",  dir_ + "/photos",
+                                         "--board", "9x6",       "--square-mm",
+                                         "25",      "--dataset", dataset};
+  ExpectBadInput(RunTool(args), dataset + ": dataset folder not found");
+  fs::create_directories(dataset);
+  const Result r = RunTool(args);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(CameraCalibration::Load(dataset + "/calib/camera.json").ViewsUsed(), 5);
+  EXPECT_TRUE(fs::exists(dataset + "/calib/camera.yaml"));
+  for (const auto& e : fs::directory_iterator(dataset + "/calib"))
+    EXPECT_NE(e.path().filename().string()[0], '.') << "temporary left: " << e.path();
+}
+
 TEST_F(CameraCli, PhotoWithoutTheBoardIsReportedAndLeftOut) {
   CopyReal({0, 2, 4, 6, 8});
   // A photo of something else: smooth random texture (pixel noise would only time the

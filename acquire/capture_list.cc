@@ -50,12 +50,6 @@ std::optional<int> ParseIndex(const std::string& text) {
   return std::stoi(text);
 }
 
-bool EndsWith(const std::string& name, const std::string& end) {
-  if (name.size() < end.size()) return false;
-  return std::equal(end.rbegin(), end.rend(), name.rbegin(),
-                    [](char a, char b) { return a == std::tolower((unsigned char)b); });
-}
-
 std::string Number(double v) {
   std::ostringstream os;
   os << v;
@@ -63,25 +57,6 @@ std::string Number(double v) {
 }
 
 }  // namespace
-
-bool IsTemporaryPhotoName(const std::string& name) {
-  if (name.empty() || name[0] == '.' || name[0] == '~' || name.back() == '~') return true;
-  for (const char* end : {".part", ".partial", ".tmp", ".crdownload"})
-    if (EndsWith(name, end)) return true;
-  return false;
-}
-
-std::vector<std::string> FolderFiles(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    std::error_code ec;
-    if (IsTemporaryPhotoName(name) || !entry.is_regular_file(ec)) continue;
-    names.push_back(name);
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 std::vector<NamedPhoto> ManifestPhotos(const std::string& manifest) {
   CheckInputFile(manifest, "manifest");

@@ -29,12 +29,7 @@ struct NamedPhoto {
   std::string where;
 };
 
-// A name that a copy or download in progress uses, never a camera's photo: a leading '.' (our
-// own temporaries, rsync) or '~', a trailing '~', or the endings .part, .partial, .tmp and
-// .crdownload (any case).
-bool IsTemporaryPhotoName(const std::string& name);
-// Regular files of the folder that are not temporary names, sorted by name.
-std::vector<std::string> FolderFiles(const std::string& dir);
+// (Folder listing and temporary names: core/input_file.h.)
 
 // The rows of a manifest (CSV: i,j,slide,file[,exposure]); BadInput naming the line.
 std::vector<NamedPhoto> ManifestPhotos(const std::string& manifest);

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <sstream>
 
+#include "calibrate/camera_command.h"
 #include "calibrate/screen_calibrator.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
@@ -88,9 +89,12 @@ int RunCalibrate(int argc, char** argv) {
                   "find corners on a copy whose long side is at most this (pixels)")
       ->check(CLI::Range(200, 100000))
       ->capture_default_str();
+  CameraCommand camera;
+  AddCameraCommand(&app, &common, &camera);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("calibrate", common);
   cv::setNumThreads(threads);
+  if (camera.sub->parsed()) return RunCameraCommand(&camera, threads);
   screen.options.refiner.threads = threads;
   screen.options.Check();
   screen.dataset_dir = TrimTrailingSlashes(screen.dataset_dir);

@@ -4,11 +4,20 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace lumislab {
 
 // Throws BadInput "<path>: <what> not found" or "<path>: not a regular file (a folder, FIFO or
 // device is not a <what>)". `what`: "file", "photo", "scene file", ...
 void CheckInputFile(const std::string& path, const std::string& what);
+
+// A name that a copy or download in progress uses, never a camera's photo: a leading '.' (our
+// own temporaries, rsync) or '~', a trailing '~', or the endings .part, .partial, .tmp and
+// .crdownload (any case).
+bool IsTemporaryPhotoName(const std::string& name);
+// The regular files of `dir` that are not temporary names, sorted by name (every stage that
+// lists a folder of photos lists it here).
+std::vector<std::string> FolderFiles(const std::string& dir);
 
 }  // namespace lumislab

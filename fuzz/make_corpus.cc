@@ -1,7 +1,9 @@
 // Writes the seed corpus of every fuzz target (fuzz/corpus/<target>/) with lumislab's own
 // writers: small valid files of each kind. The committed corpus was made with
 //   build-fuzz/fuzz/lumislab_fuzz_make_corpus fuzz/corpus
-// (the mesh seeds are hand-written: fuzz/corpus/fuzz_mesh_*). Rerun it when a file format changes.
+// (the mesh seeds are hand-written: fuzz/corpus/fuzz_mesh_*; fuzz_camera_calibration's seed is
+// lumislab-calibrate camera's output on tests/data/chessboard-opencv-left, photo folder
+// stripped). Rerun it when a file format changes.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>

@@ -8,6 +8,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libcli11-dev libopenexr-dev
   libopencv-dev libceres-dev libgtest-dev
+  # calibrate camera: ChArUco boards (OpenCV 4.6's aruco module)
+  libopencv-contrib-dev
   libglfw3-dev libosmesa6-dev python3-glad libassimp-dev
   # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), DNG and TIFF writing (libtiff)
   libraw-dev libexif-dev libtiff-dev

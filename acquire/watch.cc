@@ -10,6 +10,7 @@
 
 #include "acquire/capture_list.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/log.h"
 #include "core/stop_signal.h"
 #include "lib/photo/photo_io.h"

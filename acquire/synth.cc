@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "acquire/synth_calibration.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -189,6 +190,7 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
   if (scene.Response()) WriteTruthResponse(*scene.Response(), dir + "/truth/response.json");
   WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
                  dir + "/truth", threads);
+  WriteCalibrationCaptures(scene, dataset, dir, encoding, threads);  // scene.captures only
   return CapturePositions(scene, dataset, dir, options, encoding, threads);
 }
 

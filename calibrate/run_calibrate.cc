@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <sstream>
 
+#include "calibrate/run_radiometric.h"
 #include "calibrate/screen_calibrator.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
@@ -59,7 +60,10 @@ int RunScreen(const ScreenCommand& command, int threads) {
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
-  CLI::App app{"lumislab-calibrate: camera and screen calibration (docs/design.md §5, calib/)"};
+  CLI::App app{
+      "lumislab-calibrate: screen and radiometric calibration into <dataset>/calib/ "
+      "(docs/design.md §5.5, §5.13 - §5.16). Radiometric order: response, dark, flat, screen, "
+      "scale; each later step decodes its frames with the earlier steps' corrections"};
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);
@@ -88,9 +92,12 @@ int RunCalibrate(int argc, char** argv) {
                   "find corners on a copy whose long side is at most this (pixels)")
       ->check(CLI::Range(200, 100000))
       ->capture_default_str();
+  RadiometricCommand radiometric;
+  AddRadiometricCommands(&app, &common, &radiometric);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("calibrate", common);
   cv::setNumThreads(threads);
+  if (!sub->parsed()) return RunRadiometricCommand(radiometric);
   screen.options.refiner.threads = threads;
   screen.options.Check();
   screen.dataset_dir = TrimTrailingSlashes(screen.dataset_dir);

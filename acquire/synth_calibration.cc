@@ -104,7 +104,8 @@ void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
     manifest[key].push_back({{"file", f.file}, {"exposure", f.exposure}});
   }
   WriteJsonAtomically(dir + "/calibration/captures.json", manifest);
-  LogInfo("calibration captures: ", frames.size(), " frame(s) in ", dir, "/calibration");
+  LogInfo("calibration captures: ", frames.size(),
+          " frame(s) in calibration/ (listed in calibration/captures.json)");
 }
 
 }  // namespace lumislab

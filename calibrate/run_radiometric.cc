@@ -56,6 +56,21 @@ ScreenCalibration LoadScreen(const Dataset& dataset, const char* step) {
   return ScreenCalibration::Load(path);
 }
 
+// Which of calib/'s corrections a step decodes its photos with (one log line).
+std::shared_ptr<const PhotoCorrections> Corrections(const Dataset& dataset, CorrectionSet which,
+                                                    const char* step) {
+  auto c = std::make_shared<PhotoCorrections>(LoadPhotoCorrections(dataset.Path("calib"), which));
+  std::string what;
+  if (c->response) what += " response curve (" + c->response->file + ")";
+  if (c->dark) what += " dark map (" + c->dark->file + ")";
+  if (c->flat) what += " flat field (" + c->flat->file + ")";
+  LogInfo(step, ": decoding with", what.empty() ? " no radiometric calibration" : what,
+          which.response && !c->response ? "; 8-bit photos through the sRGB curve: no "
+                                           "calib/response.json"
+                                         : "");
+  return c;
+}
+
 FrameOptions Frames(const RadiometricCommand& c, const char* what) {
   FrameOptions f;
   f.files = c.frames;
@@ -71,8 +86,7 @@ int RunDark(const RadiometricCommand& c, const Dataset& dataset) {
   FrameOptions f = Frames(c, "dark frames");
   // The dark level is measured in the decoder's linear units: through the calibrated response
   // when there is one, never through an older dark or flat map.
-  f.corrections = std::make_shared<PhotoCorrections>(
-      LoadPhotoCorrections(dataset.Path("calib"), {false, true, false}));
+  f.corrections = Corrections(dataset, {false, true, false}, "dark");
   nlohmann::json report;
   const DarkMap map = CalibrateDark(DecodeCalibrationFrames(dataset, f), c.dark_options, &report);
   SaveDarkMap(out, map, report);
@@ -122,8 +136,7 @@ int RunFlat(const RadiometricCommand& c, const Dataset& dataset) {
   if (!Prepare(dataset, "flat.json", c.force, &out)) return 0;
   FrameOptions f = Frames(c, "flat frames");
   f.per_unit_exposure = true;
-  f.corrections = std::make_shared<PhotoCorrections>(
-      LoadPhotoCorrections(dataset.Path("calib"), {true, true, false}));
+  f.corrections = Corrections(dataset, {true, true, false}, "flat");
   nlohmann::json report;
   const FlatMap map = CalibrateFlat(DecodeCalibrationFrames(dataset, f), dataset, screen, &report);
   SaveFlatMap(out, map, report);
@@ -158,8 +171,7 @@ int RunScale(const RadiometricCommand& c, const Dataset& dataset) {
   reference.Check(dataset);
   std::string out;
   if (!Prepare(dataset, "scale.json", c.force, &out)) return 0;
-  const auto corrections =
-      std::make_shared<PhotoCorrections>(LoadPhotoCorrections(dataset.Path("calib")));
+  const auto corrections = Corrections(dataset, {}, "scale");
   nlohmann::json report;
   const RadiometricScale scale =
       CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report);

@@ -1,5 +1,6 @@
 #include "acquire/photo_store.h"
 
+#include <cctype>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -79,8 +80,16 @@ std::string StoreName(const SynthScene& scene, const PhotoStore& store) {
   return store.encoding == PhotoEncoding::kHalfExr ? "half-float EXR" : "float EXR";
 }
 
+std::string StoredExtension(const SynthScene& scene, const PhotoStore& store) {
+  if (!store.camera_folder || scene.Raw()) return scene.PhotoExtension();
+  return scene.Response() ? "jpg" : "tif";
+}
+
 std::vector<PhotoEntry> CameraFolderPhotoList(const SynthScene& scene) {
-  const std::string ext = scene.Raw() ? "DNG" : scene.Response() ? "JPG" : "TIF";
+  PhotoStore camera;
+  camera.camera_folder = true;
+  std::string ext = StoredExtension(scene, camera);
+  for (char& c : ext) c = char(std::toupper((unsigned char)c));
   std::vector<PhotoEntry> list = PhotoList(scene);
   for (size_t k = 0; k < list.size(); ++k) {
     char name[32];

@@ -36,6 +36,9 @@ PhotoExif SynthExif(double exposure, int photo_index);
 // `raw`; in a camera folder JPEG (response) or 16-bit TIFF with EXIF; else WritePhoto.
 void StoreSlidePhoto(const SynthScene& scene, const PhotoStore& store, const std::string& path,
                      const ImageF& photo, double exposure, int photo_index);
+// The extension (lower case) of the files StoreSlidePhoto writes: dng, jpg or tif in a camera
+// folder, else the scene's (SynthScene::PhotoExtension).
+std::string StoredExtension(const SynthScene& scene, const PhotoStore& store);
 // "DNG mosaic", "16-bit TIFF", ... for the log.
 std::string StoreName(const SynthScene& scene, const PhotoStore& store);
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "acquire/photo_store.h"
+#include "acquire/synth_calibration.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -182,6 +183,7 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
   if (scene.Response()) WriteTruthResponse(*scene.Response(), dir + "/truth/response.json");
   WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
                  dir + "/truth", threads);
+  WriteCalibrationCaptures(scene, dataset, dir, store, threads);  // scene.captures only
   return CapturePositions(scene, dataset, dir, options, store, threads);
 }
 

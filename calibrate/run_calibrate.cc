@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "calibrate/camera_command.h"
+#include "calibrate/run_radiometric.h"
 #include "calibrate/screen_calibrator.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
@@ -60,7 +61,10 @@ int RunScreen(const ScreenCommand& command, int threads) {
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
-  CLI::App app{"lumislab-calibrate: camera and screen calibration (docs/design.md §5, calib/)"};
+  CLI::App app{
+      "lumislab-calibrate: screen and radiometric calibration into <dataset>/calib/ "
+      "(docs/design.md §5.5, §5.13 - §5.16). Radiometric order: response, dark, flat, screen, "
+      "scale; each later step decodes its frames with the earlier steps' corrections"};
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);
@@ -91,10 +95,13 @@ int RunCalibrate(int argc, char** argv) {
       ->capture_default_str();
   CameraCommand camera;
   AddCameraCommand(&app, &common, &camera);
+  RadiometricCommand radiometric;
+  AddRadiometricCommands(&app, &common, &radiometric);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("calibrate", common);
   cv::setNumThreads(threads);
   if (camera.sub->parsed()) return RunCameraCommand(&camera, threads);
+  if (!sub->parsed()) return RunRadiometricCommand(radiometric);
   screen.options.refiner.threads = threads;
   screen.options.Check();
   screen.dataset_dir = TrimTrailingSlashes(screen.dataset_dir);

@@ -44,7 +44,7 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
   info.layout.window_h_mm = window.y();
   info.layout.res_x = root["resolution"][0].IntIn(1, kMaxSlabResolution);
   info.layout.res_y = root["resolution"][1].IntIn(1, kMaxSlabResolution);
-  info.units = root["units"].OneOf({"W/m^2", "relative"});
+  info.units = root["units"].OneOf({"W/m^2", "lux", "relative"});
   info.filter = ParseFilterInfo(root["filter"], info.grid);
   const JsonView present = root["present"];
   for (size_t k = 0; k < present.Size(); ++k) {

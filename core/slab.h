@@ -22,7 +22,7 @@ struct SlabInfo {
   double distance_mm = 0;
   SamplingGrid grid;
   SlabLayout layout;
-  std::string units = "W/m^2";  // or "relative"
+  std::string units = "W/m^2";  // or "lux" (calib/scale.json from a lux meter), "relative"
   FilterInfo filter;
   std::vector<std::pair<int, int>> present;  // positions written so far (i, j)
 

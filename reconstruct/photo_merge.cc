@@ -10,8 +10,11 @@
 
 namespace lumislab {
 
-DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry) {
-  return {entry, DecodePhoto(dataset.PhotoPath(entry.file), PhotoSpecOf(dataset, entry))};
+DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry,
+                                std::shared_ptr<const PhotoCorrections> corrections) {
+  PhotoSpec spec = PhotoSpecOf(dataset, entry);
+  spec.corrections = std::move(corrections);
+  return {entry, DecodePhoto(dataset.PhotoPath(entry.file), spec)};
 }
 
 void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,
@@ -113,16 +116,18 @@ bool FusedDifference(const Photo& plus, double gain_p, const Photo& minus, doubl
 
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain, int downsample) {
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
-  // Fast path: one linear photo per slide without black level or white balance, same 16-bit or
-  // float 3-channel type, nothing saturated. Averaging is linear, so averaging first and merging
-  // after gives the same numbers.
+  // Fast path: one linear photo per slide without black level, white balance or per-pixel
+  // calibration (dark, flat), same 16-bit or float 3-channel type, nothing saturated. Averaging is
+  // linear, so averaging first and merging after gives the same numbers.
   if (photos.size() == 2 && photos[0].entry.positive != photos[1].entry.positive) {
     const Photo& p = (photos[0].entry.positive ? photos[0] : photos[1]).photo;
     const Photo& n = (photos[0].entry.positive ? photos[1] : photos[0]).photo;
     const int type = p.pixels.type();
     const bool linear = p.transfer == Transfer::kLinear && n.transfer == Transfer::kLinear &&
                         p.Offset() == 0 && n.Offset() == 0 && p.UnityWhiteBalance() &&
-                        n.UnityWhiteBalance() && p.SaturationCode() == n.SaturationCode();
+                        n.UnityWhiteBalance() && p.SaturationCode() == n.SaturationCode() &&
+                        // dark map, hot pixels and flat field are per pixel: LinearReader's
+                        !p.PixelCorrections() && !n.PixelCorrections();
     if (linear && type == n.pixels.type() && (type == CV_16UC3 || type == CV_32FC3) &&
         n.pixels.size() == p.pixels.size()) {
       MergedPosition out;

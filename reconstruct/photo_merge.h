@@ -18,8 +18,10 @@ struct DecodedPhoto {
   Photo photo;  // decoded with the dataset's radiometry and the entry's exposure
 };
 
-// Decodes one photo of the dataset; a missing or undecodable file is bad input naming the photo.
-DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry);
+// Decodes one photo of the dataset, with the radiometric corrections of calib/ when given; a
+// missing or undecodable file is bad input naming the photo.
+DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry,
+                                std::shared_ptr<const PhotoCorrections> corrections = nullptr);
 
 // Checks that every photo has the calibration's image size (bad input naming the photo).
 void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,

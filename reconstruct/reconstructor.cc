@@ -26,8 +26,9 @@ void ReconstructOptions::Check() const {
                    std::to_string(samples_per_texel));
 }
 
-std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
-                                         const ScreenCalibration& calibration, int i, int j) {
+std::vector<DecodedPhoto> DecodePosition(
+    const Dataset& dataset, const ScreenCalibration& calibration, int i, int j,
+    const std::shared_ptr<const PhotoCorrections>& corrections) {
   const std::vector<PhotoEntry> entries = dataset.PhotosOf(i, j);
   bool has_p = false, has_n = false;
   for (const auto& e : entries) (e.positive ? has_p : has_n) = true;
@@ -37,7 +38,7 @@ std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
                      "position " + std::to_string(i) + "," + std::to_string(j) + " lacks " +
                          (has_p ? "n" : "p"));
   std::vector<DecodedPhoto> photos;
-  for (const auto& e : entries) photos.push_back(DecodeDatasetPhoto(dataset, e));
+  for (const auto& e : entries) photos.push_back(DecodeDatasetPhoto(dataset, e, corrections));
   CheckPhotoSizes(photos, calibration.image_width, calibration.image_height,
                   dataset.Path("calib/screen.json"));
   // One camera writes one kind of photo: an 8-bit photo among 16-bit ones (or the other way)
@@ -51,9 +52,9 @@ std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
   if (photos[0].photo.transfer == Transfer::kSrgb && dataset.photo_transfer == "auto") {
     static std::once_flag said;
     std::call_once(said, [&] {
-      LogWarning("8-bit photos (", photos[0].photo.path,
-                 ", ...) are linearised through the sRGB curve; set radiometry.transfer in "
-                 "dataset.json if the camera wrote them otherwise");
+      LogWarning("sRGB curve: no calib/response.json; 8-bit photos (", photos[0].photo.path,
+                 ", ...) are linearised through the sRGB curve (run lumislab-calibrate response, "
+                 "or set radiometry.transfer in dataset.json if the camera wrote them otherwise)");
     });
   }
   return photos;
@@ -77,7 +78,10 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   r.map_s = SecondsSince(t0);
   auto t1 = std::chrono::steady_clock::now();
   // 2. Linear, merged, E = peak * scale * (E+ - E-) in photo space, saturation flagged.
-  const double gain = dataset.filter.peak * dataset.radiometric_scale.value_or(1.0);
+  // calib/scale.json when calibrated, else dataset.json's scale (LoadReconstructRadiometry).
+  const std::optional<double> scale =
+      options.radiometry ? options.radiometry->scale : dataset.radiometric_scale;
+  const double gain = dataset.filter.peak * scale.value_or(1.0);
   const MergedPosition merged = MergePosition(photos, gain, map.downsample);
   r.saturated_pixels = merged.saturated_pixels;
   r.merge_s = SecondsSince(t1);
@@ -151,7 +155,8 @@ SlabPosition ReconstructPosition(const Dataset& dataset, const ScreenCalibration
   PositionReport local;
   PositionReport& r = report ? *report : local;
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<DecodedPhoto> photos = DecodePosition(dataset, calibration, i, j);
+  const std::vector<DecodedPhoto> photos = DecodePosition(
+      dataset, calibration, i, j, options.radiometry ? options.radiometry->corrections : nullptr);
   const double decode_s = SecondsSince(t0);
   SlabPosition out = ReconstructDecoded(dataset, calibration, info, i, j, photos, options, &r);
   r.decode_s = decode_s;

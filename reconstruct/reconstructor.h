@@ -1,6 +1,7 @@
 // The reconstruct stage: photos of one grid position -> fitted E_ij in the slab layout.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "core/dataset.h"
@@ -8,6 +9,7 @@
 #include "core/slab.h"
 #include "reconstruct/bell_fit.h"
 #include "reconstruct/photo_merge.h"
+#include "reconstruct/radiometry.h"
 #include "reconstruct/rectify.h"
 
 namespace lumislab {
@@ -16,7 +18,10 @@ struct ReconstructOptions {
   int resolution = 300;       // slab texels per side
   double lambda = 1e-4;       // regulariser of the fit (relative to B^T B, diagonal ~0.5)
   int samples_per_texel = 0;  // K; 0 = automatic (at least as dense as the photo pixels)
-  void Check() const;         // throws BadInput naming the option
+  // calib/'s corrections and scale (LoadReconstructRadiometry); null: dataset.json's radiometry
+  // only, no per-pixel correction.
+  std::shared_ptr<const ReconstructRadiometry> radiometry;
+  void Check() const;  // throws BadInput naming the option
 };
 
 struct PositionReport {
@@ -34,10 +39,12 @@ struct PositionReport {
   double map_s = 0, merge_s = 0, remap_s = 0;
 };
 
-// Photos of (i, j), decoded (both slides, all exposures); checks that both slides exist and
-// that the sizes match the calibration.
-std::vector<DecodedPhoto> DecodePosition(const Dataset& dataset,
-                                         const ScreenCalibration& calibration, int i, int j);
+// Photos of (i, j), decoded (both slides, all exposures) with `corrections` (calib/'s dark,
+// response, flat; null: none); checks that both slides exist and that the sizes match the
+// calibration.
+std::vector<DecodedPhoto> DecodePosition(
+    const Dataset& dataset, const ScreenCalibration& calibration, int i, int j,
+    const std::shared_ptr<const PhotoCorrections>& corrections = nullptr);
 // From decoded photos (the bench times decoding on its own).
 SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration& calibration,
                                 const SlabInfo& info, int i, int j,

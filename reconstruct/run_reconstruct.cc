@@ -72,9 +72,17 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
   const auto t0 = std::chrono::steady_clock::now();
   writer.Write(pos);
   r.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (r.saturated_pixels > 0)
-    LogWarning("position ", Name(position), ": ", r.saturated_pixels, " saturated photo pixels; ",
-               r.saturated_texels, " texels left out of the fit (mask 0)");
+  // Hot pixels of calib/dark.json count as clipped in every photo (said once at the start):
+  // warn only about the pixels the light saturated.
+  const auto& corrections = config.options.radiometry->corrections;
+  const int hot = corrections && corrections->dark ? corrections->dark->hot_count : 0;
+  if (r.saturated_pixels > hot)
+    LogWarning("position ", Name(position), ": ", r.saturated_pixels - hot,
+               " saturated photo pixels", hot ? " (and " + std::to_string(hot) + " hot ones)" : "",
+               "; ", r.saturated_texels, " texels left out of the fit (mask 0)");
+  else if (r.saturated_texels > 0)
+    LogDebug("position ", Name(position), ": ", r.saturated_texels,
+             " texels left out of the fit around hot pixels (mask 0)");
   LogDebug("position ", Name(position), ": seen ", r.seen_texels,
            " texels, K=", r.samples_per_texel, ", fit ", r.fit_iterations, " it (residual ",
            r.fit_residual, "), decode ", r.decode_s, " s, rectify ", r.rectify_s, " s, fit ",
@@ -111,7 +119,8 @@ void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_
 // Reconstructs every position the slab in `dir` lacks; false when stopped by a signal.
 bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, const std::string& dir,
               const RunConfig& config) {
-  SlabWriter writer(dataset, config.options.resolution, config.force, dir);
+  SlabWriter writer(dataset, config.options.resolution, config.force, dir,
+                    config.options.radiometry->units);
   const std::vector<Position> todo = Missing(dataset, writer);
   const int skipped = dataset.grid.count() - int(todo.size());
   if (skipped > 0)
@@ -125,8 +134,10 @@ bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, cons
   return !StopRequested();
 }
 
-int RunBatch(const RunConfig& config) {
+int RunBatch(RunConfig config) {
   const Dataset dataset = Dataset::Load(config.dataset_dir);
+  config.options.radiometry =
+      std::make_shared<ReconstructRadiometry>(LoadReconstructRadiometry(dataset));
   const std::string calib_path = CalibrationPath(config.dataset_dir);
   if (!fs::exists(calib_path))
     throw BadInput(calib_path + ": missing; run lumislab-calibrate screen first");
@@ -137,7 +148,7 @@ int RunBatch(const RunConfig& config) {
   CheckPhotosExist(dataset, all);
   // Photos that do not fit the calibration (size, format) are refused before anything is
   // written: decode the first position's photos now.
-  DecodePosition(dataset, calibration, 0, 0);
+  DecodePosition(dataset, calibration, 0, 0, config.options.radiometry->corrections);
   const std::string slab_dir = dataset.Path("slab");
   // --force over an existing slab builds the new one beside it and swaps it in when complete:
   // a failure or a stop leaves the previous slab as it was (and then nothing is resumable).
@@ -191,7 +202,7 @@ bool WaitFor(const std::string& path, double poll_s) {
   return true;
 }
 
-int RunWatch(const RunConfig& config) {
+int RunWatch(RunConfig config) {
   const std::string dir = config.dataset_dir;
   if (!fs::is_directory(dir))
     throw BadInput(dir + "/dataset.json: missing (the dataset folder does not exist)");
@@ -200,7 +211,10 @@ int RunWatch(const RunConfig& config) {
   auto dataset_time = fs::last_write_time(dir + "/dataset.json");
   if (!WaitFor(CalibrationPath(dir), config.poll_s)) return 1;
   const ScreenCalibration calibration = ScreenCalibration::Load(CalibrationPath(dir));
-  SlabWriter writer(dataset, config.options.resolution, config.force);
+  config.options.radiometry =
+      std::make_shared<ReconstructRadiometry>(LoadReconstructRadiometry(dataset));
+  SlabWriter writer(dataset, config.options.resolution, config.force, "",
+                    config.options.radiometry->units);
   Progress progress("reconstruct --watch", dataset.grid.count());
   progress.Advance(writer.PresentCount());
   auto last_new = std::chrono::steady_clock::now();

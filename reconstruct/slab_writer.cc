@@ -8,10 +8,12 @@
 
 namespace lumislab {
 
-SlabWriter::SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir)
+SlabWriter::SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir,
+                       const std::string& units)
     : dir_(dir.empty() ? dataset.Path("slab") : dir),
       info_(SlabInfo::FromDataset(dataset, resolution)) {
   info_.present.clear();
+  if (!units.empty()) info_.units = units;
   if (!force && std::filesystem::exists(dir_ + "/slab.json")) {
     const SlabInfo old = SlabInfo::Load(dir_);
     if (old.layout.res_x != info_.layout.res_x || old.layout.res_y != info_.layout.res_y)

@@ -15,8 +15,10 @@ class SlabWriter {
  public:
   // Opens `dir` (default: dataset/slab): keeps positions whose EXR already exists (unless
   // `force`), rejects an existing slab of another resolution unless `force`; writes a valid
-  // slab.json right away.
-  SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir = "");
+  // slab.json right away. `units`: the slab's units when not dataset.json's (calib/scale.json:
+  // "W/m^2" or "lux"; "relative"); "" takes them from the dataset.
+  SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir = "",
+             const std::string& units = "");
 
   const SlabInfo& info() const { return info_; }
   const std::string& dir() const { return dir_; }

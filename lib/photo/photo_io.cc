@@ -214,6 +214,10 @@ double Photo::Offset() const {
   return spec.black_level / ((spec.white_level - spec.black_level) * spec.exposure);
 }
 
+bool Photo::PixelCorrections() const {
+  return spec.corrections && (spec.corrections->dark || spec.corrections->flat);
+}
+
 double Photo::SaturationCode() const {
   if (pixels.depth() == CV_32F) return spec.saturation_level;
   return std::ceil(spec.saturation_level * CodeMax() - 1e-9);
@@ -247,6 +251,19 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
                    : photo.pixels.depth() == CV_8U  ? Transfer::kSrgb
                                                     : Transfer::kLinear;
   if (photo.format == PhotoFormat::kRaw) photo.transfer = Transfer::kLinear;  // sensor values
+  if (const PhotoCorrections* c = spec.corrections.get()) {
+    // The calibrated camera curve is what an 8-bit code means, whatever the dataset says.
+    if (c->response && photo.pixels.depth() == CV_8U) photo.transfer = Transfer::kResponse;
+    auto check_size = [&](const ImageF& map, const std::string& file) {
+      if (map.width != photo.pixels.cols || map.height != photo.pixels.rows)
+        throw InputError(
+            path, "image size",
+            std::to_string(map.width) + "x" + std::to_string(map.height) + " as the map of " + file,
+            std::to_string(photo.pixels.cols) + "x" + std::to_string(photo.pixels.rows));
+    };
+    if (c->dark) check_size(c->dark->offset, c->dark->file);
+    if (c->flat) check_size(c->flat->gain, c->flat->file);
+  }
   return photo;
 }
 
@@ -254,24 +271,36 @@ LinearReader::LinearReader(const Photo& photo) : photo_(photo) {
   channels_ = photo.pixels.channels();
   r_ = photo.rgb_order || channels_ == 1 ? 0 : 2;
   b_ = channels_ == 1 ? 0 : 2 - r_;
+  const PhotoCorrections* corrections = photo.spec.corrections.get();
   const bool srgb = photo.transfer == Transfer::kSrgb;
-  for (int v = 0; v < 256; ++v) curve8_[v] = srgb ? SrgbToLinear(v / 255.f) : v / 255.f;
+  for (int c = 0; c < 3; ++c)
+    for (int v = 0; v < 256; ++v)
+      curve8_[c][v] = photo.transfer == Transfer::kResponse
+                          ? corrections->response->linear_of_code[c][v]
+                      : srgb ? SrgbToLinear(v / 255.f)
+                             : v / 255.f;
   inv_max_ = float(1.0 / photo.CodeMax());
   black_ = float(photo.spec.black_level);
+  inv_range_ = float(1.0 / (photo.spec.white_level - photo.spec.black_level));
+  exposure_ = float(photo.spec.exposure);
+  inv_exposure_ = float(1.0 / photo.spec.exposure);
   inv_range_exposure_ =
       float(1.0 / ((photo.spec.white_level - photo.spec.black_level) * photo.spec.exposure));
   saturation_ = float(photo.spec.saturation_level);
   for (int c = 0; c < 3; ++c) white_balance_[c] = photo.white_balance[c];
-}
-
-float LinearReader::Value(float curve_value) const {
-  return (curve_value - black_) * inv_range_exposure_;
+  if (corrections) {
+    dark_ = corrections->dark.get();
+    flat_ = corrections->flat.get();
+  }
 }
 
 void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
   const cv::Mat& m = photo_.pixels;
   const int offsets[3] = {r_, channels_ == 1 ? 0 : 1, b_};
   const bool srgb = photo_.transfer == Transfer::kSrgb;
+  const size_t pixel = size_t(y) * m.cols + x;
+  // A hot pixel's value is its own dark current, not light: it leaves every merge as if clipped.
+  const bool hot = dark_ && dark_->hot[pixel];
   for (int c = 0; c < 3; ++c) {
     float v;
     if (m.depth() == CV_32F) {
@@ -280,10 +309,21 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
       v = m.ptr<uint16_t>(y)[size_t(x) * channels_ + offsets[c]] * inv_max_;
       if (srgb) v = SrgbToLinear(v);
     } else {
-      v = curve8_[m.ptr<uint8_t>(y)[size_t(x) * channels_ + offsets[c]]];
+      v = curve8_[c][m.ptr<uint8_t>(y)[size_t(x) * channels_ + offsets[c]]];
     }
-    clipped[c] = !(v < saturation_);  // NaN counts as clipped
-    rgb[c] = Value(v) * white_balance_[c];
+    clipped[c] = hot || !(v < saturation_);  // NaN counts as clipped
+    // Linear value before the exposure division, less the sensor's dark signal at this exposure;
+    // then per unit exposure, less the pixel's gain.
+    float linear;
+    if (dark_) {
+      linear = (v - black_) * inv_range_ - dark_->offset.data[pixel * 3 + c];
+      if (!dark_->current.empty()) linear -= dark_->current.data[pixel * 3 + c] * exposure_;
+      linear *= inv_exposure_;
+    } else {
+      linear = (v - black_) * inv_range_exposure_;
+    }
+    if (flat_) linear /= flat_->gain.data[pixel * 3 + c];
+    rgb[c] = linear * white_balance_[c];
   }
 }
 

@@ -14,12 +14,14 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "core/dataset.h"
 #include "core/image.h"
+#include "lib/photo/radiometric_calibration.h"
 
 namespace lumislab {
 
@@ -30,7 +32,9 @@ namespace lumislab {
 enum class PhotoFormat { kPng, kJpeg, kTiff, kExr, kRaw };
 // Largest photo decoded (pixels; a 100-megapixel camera fits), checked from the header.
 constexpr long long kMaxPhotoPixels = 1LL << 27;
-enum class Transfer { kAuto, kLinear, kSrgb };
+// kResponse: a camera response calibrated by lumislab-calibrate response (calib/response.json),
+// used for 8-bit photos whenever PhotoSpec::corrections holds one; never asked for, only resolved.
+enum class Transfer { kAuto, kLinear, kSrgb, kResponse };
 // White balance of a camera RAW: kUnity keeps the sensor's channels as they are (the
 // photometric default: one radiometric scale calibrates them), kAsShot applies the camera's
 // recorded multipliers (DNG AsShotNeutral, LibRaw's cam_mul), normalised so that green = 1.
@@ -47,6 +51,11 @@ struct PhotoSpec {
   // white level above then apply on top, defaults leave them alone).
   RawWhiteBalance raw_white_balance = RawWhiteBalance::kUnity;
   bool raw_half_size = false;  // one pixel per 2x2 Bayer quad (exact) instead of a demosaic
+  // Radiometric calibration (calib/: dark map and hot pixels, response curve, flat field),
+  // applied by LinearReader: the response replaces the transfer curve of 8-bit photos, the dark
+  // level (offset + current x exposure) is subtracted before the exposure division, hot pixels
+  // count as clipped, and the flat gain is divided out. Null: none.
+  std::shared_ptr<const PhotoCorrections> corrections;
   void Check(const std::string& where) const;  // BadInput naming `where` and the field
 };
 
@@ -72,6 +81,8 @@ struct Photo {
   double Offset() const;
   // Smallest stored code that counts as clipped (linear transfer).
   double SaturationCode() const;
+  // True when a per-pixel correction (dark map, flat field) applies: only LinearReader does it.
+  bool PixelCorrections() const;
 };
 
 // The spec of a dataset's slide photo (its radiometry and the photo's exposure), and of its
@@ -80,7 +91,8 @@ PhotoSpec PhotoSpecOf(const Dataset& dataset, const PhotoEntry& entry);
 PhotoSpec CalibrationPhotoSpec(const Dataset& dataset);
 
 // Decodes a photo. A path that is not a regular file, an unknown or corrupt format, or an
-// unsupported pixel layout is BadInput naming the photo (exit 2).
+// unsupported pixel layout is BadInput naming the photo (exit 2), as is a photo whose size
+// differs from that of a calibration map in spec.corrections (naming both).
 Photo DecodePhoto(const std::string& path, const PhotoSpec& spec = {});
 // The format from the file's first bytes; BadInput naming the file when it is none of ours.
 PhotoFormat DetectPhotoFormat(const std::string& path);
@@ -93,13 +105,14 @@ class LinearReader {
   void Read(int y, int x, float rgb[3], bool clipped[3]) const;
 
  private:
-  float Value(float curve_value) const;
   const Photo& photo_;
   int channels_;
-  int r_, b_;  // offsets of red and blue in a pixel
-  float curve8_[256];
-  float inv_max_, black_, inv_range_exposure_, saturation_;
-  float white_balance_[3];  // R, G, B
+  int r_, b_;             // offsets of red and blue in a pixel
+  float curve8_[3][256];  // R, G, B: 8-bit code -> curve value
+  float inv_max_, black_, inv_range_, inv_exposure_, exposure_, inv_range_exposure_, saturation_;
+  float white_balance_[3];         // R, G, B
+  const DarkMap* dark_ = nullptr;  // per-pixel corrections (PhotoSpec::corrections)
+  const FlatMap* flat_ = nullptr;
 };
 
 // The whole photo as linear, exposure-normalised Rec. 709 luminance (CV_32FC1); BadInput when a

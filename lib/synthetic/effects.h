@@ -113,6 +113,7 @@ class AmbientEffect : public Effect {
   AmbientEffect(const EffectSetting& setting, double level) : setting_(setting), level_(level) {}
   std::string Type() const override { return "ambient"; }
   void Apply(ImageF& rgb, const PhotoContext& context) const override;
+  double level() const { return level_; }
 
  private:
   EffectSetting setting_;

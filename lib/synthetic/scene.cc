@@ -208,6 +208,8 @@ SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   ParseCamera(root, &scene);
   ParseCalibration(root, &scene);
   if (root.Has("effects")) ParseEffects(root["effects"], &scene);
+  if (root.Has("calibration_captures"))
+    scene.captures = ParseCalibrationCaptures(root["calibration_captures"], scene);
   return scene;
 }
 

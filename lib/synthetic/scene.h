@@ -3,11 +3,13 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/dataset.h"
 #include "core/grid.h"
+#include "lib/synthetic/calibration_captures.h"
 #include "lib/synthetic/camera.h"
 #include "lib/synthetic/effects.h"
 #include "lib/synthetic/luminaire.h"
@@ -27,6 +29,9 @@ struct SynthScene {
   CameraSpec camera;
   CalibrationTarget calibration;                       // photo = photos/calib_0.png
   std::vector<std::shared_ptr<const Effect>> effects;  // in the order listed
+  // The radiometric calibration captures to write (scene block calibration_captures); none
+  // when the block is absent.
+  std::optional<CalibrationCaptures> captures;
 
   DualFilter Filter() const { return DualFilter::Truncated(k_max); }
   bool Quantized() const;  // photos are 16-bit PNG (else float EXR, or JPEG with a response)

@@ -1,0 +1,99 @@
+#include "calibrate/flat_calibrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace lumislab {
+
+FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset& dataset,
+                      const ScreenCalibration& screen, nlohmann::json* report) {
+  const int w = frames[0].photo.pixels.cols, h = frames[0].photo.pixels.rows;
+  const size_t n = size_t(w) * h;
+  // Pixels that see the screen.
+  std::vector<uint8_t> on_screen(n, 0);
+  size_t screen_pixels = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Eigen::Vector2d mm = screen.ScreenFromImage({x, y});
+      if (std::abs(mm.x()) <= 0.5 * dataset.screen_w_mm &&
+          std::abs(mm.y()) <= 0.5 * dataset.screen_h_mm)
+        on_screen[size_t(y) * w + x] = 1, ++screen_pixels;
+    }
+  if (screen_pixels == 0)
+    throw InputError(dataset.Path("calib/screen.json"), "screen_from_image",
+                     "a mapping under which some pixels see the screen", "none do");
+  const std::shared_ptr<const PhotoCorrections>& corrections = frames[0].photo.spec.corrections;
+  const DarkMap* dark = corrections ? corrections->dark.get() : nullptr;
+  std::vector<double> sum(n * 3, 0), sum2(n * 3, 0);
+  for (const auto& f : frames) {
+    const LinearReader reader(f.photo);
+    long long clipped_pixels = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = size_t(y) * w + x;
+        float v[3];
+        bool clipped[3];
+        reader.Read(y, x, v, clipped);
+        if (on_screen[p] && !(dark && dark->hot[p]) && (clipped[0] || clipped[1] || clipped[2]))
+          ++clipped_pixels;
+        for (int c = 0; c < 3; ++c) sum[p * 3 + c] += v[c], sum2[p * 3 + c] += double(v[c]) * v[c];
+      }
+    if (clipped_pixels > 0)
+      throw InputError(f.photo.path, "pixel data",
+                       "a flat frame without clipped pixels on the screen (lower the exposure)",
+                       std::to_string(clipped_pixels) + " clipped pixel(s)");
+  }
+  const double frames_n = double(frames.size());
+  double mean[3] = {0, 0, 0};
+  size_t used = 0;
+  for (size_t p = 0; p < n; ++p) {
+    if (!on_screen[p] || (dark && dark->hot[p])) continue;
+    for (int c = 0; c < 3; ++c) mean[c] += sum[p * 3 + c] / frames_n;
+    ++used;
+  }
+  for (double& m : mean) {
+    m /= double(std::max<size_t>(used, 1));
+    if (!(m > 0))
+      throw InputError(frames[0].photo.path, "pixel data",
+                       "a lit screen (mean linear value > 0 after dark subtraction)",
+                       std::to_string(m));
+  }
+  FlatMap map;
+  map.gain = ImageF(w, h, 3, 1.f);
+  double lo = 1e30, hi = -1e30, noise2 = 0;
+  long long clamped = 0, noise_n = 0;
+  for (size_t p = 0; p < n; ++p) {
+    if (!on_screen[p] || (dark && dark->hot[p])) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double m = sum[p * 3 + c] / frames_n;
+      double g = m / mean[c];
+      // The reader refuses gains outside [1e-3, 1e3]; a pixel that dark is not worth dividing.
+      if (!(g >= 1e-3 && g <= 1e3))
+        g = std::clamp(std::isfinite(g) ? g : 1.0, 1e-3, 1e3), ++clamped;
+      map.gain.data[p * 3 + c] = float(g);
+      lo = std::min(lo, g), hi = std::max(hi, g);
+      if (frames.size() >= 2 && m > 0) {
+        const double var = std::max(0.0, (sum2[p * 3 + c] - frames_n * m * m) / (frames_n - 1));
+        noise2 += var / (m * m) / frames_n;  // relative variance of the mean
+        ++noise_n;
+      }
+    }
+  }
+  nlohmann::json& r = *report;
+  r["frames"] = nlohmann::json::array();
+  for (const auto& f : frames)
+    r["frames"].push_back({{"file", f.photo.path}, {"exposure", f.exposure}});
+  r["screen_pixels"] = screen_pixels;
+  r["mean_value_rgb"] = {mean[0], mean[1], mean[2]};
+  r["min_gain"] = lo;
+  r["max_gain"] = hi;
+  r["clamped_values"] = clamped;
+  r["noise_rms"] = noise_n ? nlohmann::json(std::sqrt(noise2 / noise_n)) : nlohmann::json();
+  r["corrections_applied"] = {{"dark", dark != nullptr},
+                              {"response", corrections && corrections->response != nullptr}};
+  return map;
+}
+
+}  // namespace lumislab

@@ -1,0 +1,23 @@
+// lumislab-calibrate flat: frames of the screen under uniform irradiance -> calib/flat.json +
+// flat.exr, the per-pixel gain of lens vignetting times screen non-uniformity
+// (docs/design.md §5.15).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "calibrate/calibration_frames.h"
+#include "core/dataset.h"
+#include "core/screen_calibration.h"
+#include "lib/photo/radiometric_calibration.h"
+
+namespace lumislab {
+
+// The frames' mean (decoded per unit exposure, dark-subtracted and linearised by the decoder),
+// per channel normalised to mean 1 over the pixels whose centre sees the physical screen
+// (calib/screen.json); 1 on the other pixels and on hot ones. A pixel clipped in a frame
+// (other than a hot one) is bad input naming the frame: a flat must not saturate.
+FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset& dataset,
+                      const ScreenCalibration& screen, nlohmann::json* report);
+
+}  // namespace lumislab

@@ -1,0 +1,42 @@
+#include "reconstruct/radiometry.h"
+
+#include <filesystem>
+
+#include "core/log.h"
+
+namespace lumislab {
+
+ReconstructRadiometry LoadReconstructRadiometry(const Dataset& dataset) {
+  ReconstructRadiometry r;
+  const std::string calib = dataset.Path("calib");
+  const PhotoCorrections c = LoadPhotoCorrections(calib);
+  if (!c.Empty()) r.corrections = std::make_shared<PhotoCorrections>(c);
+  if (c.dark)
+    LogInfo("dark: subtracting ", c.dark->file, " (",
+            c.dark->current.empty() ? "constant level" : "offset + current x exposure", ", ",
+            c.dark->hot_count, " hot pixel(s) masked)");
+  if (c.response) LogInfo("response: 8-bit photos linearised through ", c.response->file);
+  if (c.flat) LogInfo("flat: dividing out ", c.flat->file);
+  const std::string scale_file = calib + "/scale.json";
+  if (std::filesystem::exists(scale_file)) {
+    const RadiometricScale s = LoadRadiometricScale(scale_file);
+    r.scale = s.scale;
+    r.units = s.units;
+    r.scale_source = scale_file;
+    LogInfo("scale: ", s.scale, " ", s.units, " per unit from ", scale_file,
+            dataset.radiometric_scale
+                ? " (dataset.json radiometry.scale_w_m2 " +
+                      std::to_string(*dataset.radiometric_scale) + " not used)"
+                : std::string());
+  } else if (dataset.radiometric_scale) {
+    r.scale = dataset.radiometric_scale;
+    r.units = "W/m^2";
+    r.scale_source = dataset.Path("dataset.json");
+    LogInfo("scale: ", *r.scale, " W/m^2 per unit from dataset.json radiometry.scale_w_m2");
+  } else {
+    LogInfo("scale: none (no calib/scale.json, no radiometry.scale_w_m2): relative units");
+  }
+  return r;
+}
+
+}  // namespace lumislab

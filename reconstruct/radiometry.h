@@ -1,0 +1,26 @@
+// What reconstruct takes from the radiometric calibration in calib/ (docs/design.md §5.13 -
+// §5.16): the per-pixel corrections the decoder applies (dark, response, flat) and the absolute
+// scale (calib/scale.json before dataset.json's radiometry.scale_w_m2).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/dataset.h"
+#include "lib/photo/radiometric_calibration.h"
+
+namespace lumislab {
+
+struct ReconstructRadiometry {
+  std::shared_ptr<const PhotoCorrections> corrections;  // null when calib/ holds none
+  std::optional<double> scale;  // units per unit value at exposure 1; none: relative
+  std::string units = "relative";
+  std::string scale_source;  // the file it came from
+};
+
+// Reads whichever of calib/dark.json, response.json, flat.json, scale.json exist (BadInput
+// naming the file and field when one is bad) and logs one line per correction it will apply.
+ReconstructRadiometry LoadReconstructRadiometry(const Dataset& dataset);
+
+}  // namespace lumislab

@@ -2,13 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
 
 namespace lumislab {
 
 FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset& dataset,
-                      const ScreenCalibration& screen, nlohmann::json* report) {
+                      const ScreenCalibration& screen, nlohmann::json* report, double smooth_px) {
   const int w = frames[0].photo.pixels.cols, h = frames[0].photo.pixels.rows;
   const size_t n = size_t(w) * h;
   // Pixels that see the screen.
@@ -27,6 +29,11 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
   const std::shared_ptr<const PhotoCorrections>& corrections = frames[0].photo.spec.corrections;
   const DarkMap* dark = corrections ? corrections->dark.get() : nullptr;
   std::vector<double> sum(n * 3, 0), sum2(n * 3, 0);
+  // Pixels clipped in some frame: isolated ones (hot pixels when no dark map is given, dust
+  // glints) keep gain 1 and are reported; more than kMaxClippedFraction of the screen means the
+  // frames are overexposed.
+  constexpr double kMaxClippedFraction = 1e-3;
+  std::vector<uint8_t> clipped_any(n, 0);
   for (const auto& f : frames) {
     const LinearReader reader(f.photo);
     long long clipped_pixels = 0;
@@ -37,14 +44,19 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
         bool clipped[3];
         reader.Read(y, x, v, clipped);
         if (on_screen[p] && !(dark && dark->hot[p]) && (clipped[0] || clipped[1] || clipped[2]))
-          ++clipped_pixels;
+          ++clipped_pixels, clipped_any[p] = 1;
         for (int c = 0; c < 3; ++c) sum[p * 3 + c] += v[c], sum2[p * 3 + c] += double(v[c]) * v[c];
       }
-    if (clipped_pixels > 0)
-      throw InputError(f.photo.path, "pixel data",
-                       "a flat frame without clipped pixels on the screen (lower the exposure)",
-                       std::to_string(clipped_pixels) + " clipped pixel(s)");
+    if (double(clipped_pixels) > kMaxClippedFraction * double(screen_pixels))
+      throw InputError(
+          f.photo.path, "pixel data",
+          "a flat frame with at most 0.1 % of the screen's pixels clipped (lower "
+          "the exposure)",
+          std::to_string(clipped_pixels) + " clipped pixel(s) of " + std::to_string(screen_pixels));
   }
+  long long clipped_left = 0;
+  for (size_t p = 0; p < n; ++p)
+    if (clipped_any[p]) on_screen[p] = 0, ++clipped_left;  // gain 1, out of the mean
   const double frames_n = double(frames.size());
   double mean[3] = {0, 0, 0};
   size_t used = 0;
@@ -81,7 +93,30 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
       }
     }
   }
+  if (smooth_px > 0) {
+    // Normalised convolution: blur(gain * mask) / blur(mask) over the pixels that count.
+    cv::Mat gain(h, w, CV_32FC3, map.gain.data.data()), mask(h, w, CV_32FC1, 0.f);
+    for (size_t p = 0; p < n; ++p)
+      if (on_screen[p] && !(dark && dark->hot[p])) mask.at<float>(int(p / w), int(p % w)) = 1.f;
+    cv::Mat weighted, blurred_mask, mask3;
+    cv::merge(std::vector<cv::Mat>{mask, mask, mask}, mask3);
+    cv::GaussianBlur(gain.mul(mask3), weighted, cv::Size(), smooth_px, smooth_px,
+                     cv::BORDER_REPLICATE);
+    cv::GaussianBlur(mask3, blurred_mask, cv::Size(), smooth_px, smooth_px, cv::BORDER_REPLICATE);
+    lo = 1e30, hi = -1e30;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (mask.at<float>(y, x) == 0.f) continue;  // hot, clipped and off-screen stay at 1
+        for (int c = 0; c < 3; ++c) {
+          const float m = blurred_mask.at<cv::Vec3f>(y, x)[c];
+          const float g = std::clamp(weighted.at<cv::Vec3f>(y, x)[c] / m, 1e-3f, 1e3f);
+          gain.at<cv::Vec3f>(y, x)[c] = g;
+          lo = std::min(lo, double(g)), hi = std::max(hi, double(g));
+        }
+      }
+  }
   nlohmann::json& r = *report;
+  r["smooth_px"] = smooth_px;
   r["frames"] = nlohmann::json::array();
   for (const auto& f : frames)
     r["frames"].push_back({{"file", f.photo.path}, {"exposure", f.exposure}});
@@ -90,6 +125,7 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
   r["min_gain"] = lo;
   r["max_gain"] = hi;
   r["clamped_values"] = clamped;
+  r["clipped_pixels_at_gain_1"] = clipped_left;
   r["noise_rms"] = noise_n ? nlohmann::json(std::sqrt(noise2 / noise_n)) : nlohmann::json();
   r["corrections_applied"] = {{"dark", dark != nullptr},
                               {"response", corrections && corrections->response != nullptr}};

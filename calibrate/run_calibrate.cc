@@ -62,9 +62,10 @@ int RunScreen(const ScreenCommand& command, int threads) {
 
 int RunCalibrate(int argc, char** argv) {
   CLI::App app{
-      "lumislab-calibrate: screen and radiometric calibration into <dataset>/calib/ "
-      "(docs/design.md §5.5, §5.13 - §5.16). Radiometric order: response, dark, flat, screen, "
-      "scale; each later step decodes its frames with the earlier steps' corrections"};
+      "lumislab-calibrate: camera, screen and radiometric calibration into <dataset>/calib/ "
+      "(docs/design.md §5.5, §5.12 - §5.16). Order: response, dark, screen, flat, scale (flat "
+      "and scale need the screen); each later step decodes its frames with the earlier steps' "
+      "corrections"};
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);

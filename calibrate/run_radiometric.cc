@@ -138,7 +138,8 @@ int RunFlat(const RadiometricCommand& c, const Dataset& dataset) {
   f.per_unit_exposure = true;
   f.corrections = Corrections(dataset, {true, true, false}, "flat");
   nlohmann::json report;
-  const FlatMap map = CalibrateFlat(DecodeCalibrationFrames(dataset, f), dataset, screen, &report);
+  const FlatMap map = CalibrateFlat(DecodeCalibrationFrames(dataset, f), dataset, screen, &report,
+                                    c.flat_smooth_px);
   SaveFlatMap(out, map, report);
   LogInfo("flat: ", c.frames.size(), " frame(s); gain ", report["min_gain"].get<double>(), " .. ",
           report["max_gain"].get<double>(), " over ", report["screen_pixels"].get<long long>(),
@@ -217,6 +218,13 @@ void AddRadiometricCommands(CLI::App* app, CommonOptions* common, RadiometricCom
       "gain (vignetting x screen non-uniformity), mean 1 on the screen, divided out of every "
       "photo; needs calib/screen.json");
   AddCommon(c->flat, common, c, true);
+  c->flat
+      ->add_option("--smooth-px", c->flat_smooth_px,
+                   "smooth the gain with a Gaussian of this sigma (pixels) over the screen "
+                   "pixels: for noisy or JPEG frames (vignetting and screen gain vary slowly); "
+                   "0: per pixel")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   c->scale = app->add_subcommand(
       "scale",
       "a radiometer / lux meter reading at a screen point for one position, T+ and T- -> "
@@ -235,8 +243,9 @@ void AddRadiometricCommands(CLI::App* app, CommonOptions* common, RadiometricCom
       ->capture_default_str();
   c->scale
       ->add_option("--radius-px", c->scale_options.radius_px,
-                   "average the (2r+1)^2 pixels around the point")
-      ->check(CLI::Range(0, 50))
+                   "the pixels within this distance of the point give a quadratic fit its value "
+                   "there (about a meter's aperture; noise and JPEG error average out)")
+      ->check(CLI::Range(2, 50))
       ->capture_default_str();
 }
 

@@ -24,6 +24,7 @@ struct RadiometricCommand {
   DarkOptions dark_options;
   ResponseOptions response_options;
   ScaleOptions scale_options;
+  double flat_smooth_px = 0;  // flat: Gaussian sigma of the gain map, pixels (0: none)
   // scale: a reference file, or its fields as options.
   std::string reference_file;
   std::string position, point_mm;  // "i,j", "x,y"

@@ -1,5 +1,7 @@
 #include "calibrate/scale_calibrator.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <cmath>
 
 #include "core/error.h"
@@ -57,28 +59,34 @@ struct SlideValue {
   int photos = 0;
 };
 
-// Adds the mean of one photo (per unit exposure) over the (2r + 1)^2 points spaced one pixel
-// apart and centred on the exact (sub-pixel) position of the reference point, each read
-// bilinearly: a gradient across the neighbourhood cancels. Nothing when a pixel read is clipped.
+// Adds the value of one photo (per unit exposure) at the exact (sub-pixel) position of the
+// reference point: a quadratic surface a + b x + c y + d x^2 + e x y + f y^2 least-squares
+// fitted to the pixels within r of it, per channel, evaluated there (a). The fit keeps the
+// light's slope and curvature across the neighbourhood from biasing the value (a plain mean
+// over a peak reads low) while averaging the pixels' noise and a JPEG's compression error.
+// Nothing when a pixel in the neighbourhood is clipped.
 void AddPhoto(const Photo& photo, const Eigen::Vector2d& at, int r, SlideValue* out) {
   const LinearReader reader(photo);
-  const int x0 = int(std::floor(at.x())), y0 = int(std::floor(at.y()));
-  const double fx = at.x() - x0, fy = at.y() - y0;
-  double sum[3] = {0, 0, 0};
-  for (int dy = -r; dy <= r; ++dy)
-    for (int dx = -r; dx <= r; ++dx)
-      for (int k = 0; k < 4; ++k) {
-        const int x = x0 + dx + (k & 1), y = y0 + dy + (k >> 1);
-        const double weight = ((k & 1) ? fx : 1 - fx) * ((k >> 1) ? fy : 1 - fy);
-        float v[3];
-        bool clipped[3];
-        reader.Read(y, x, v, clipped);
-        if (clipped[0] || clipped[1] || clipped[2]) return;
-        for (int c = 0; c < 3; ++c) sum[c] += weight * v[c];
-      }
-  const double count = double(2 * r + 1) * (2 * r + 1);
+  Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 3> atb = Eigen::Matrix<double, 6, 3>::Zero();
+  const int x0 = int(std::round(at.x())), y0 = int(std::round(at.y()));
+  const int reach = r + 1;
+  for (int y = y0 - reach; y <= y0 + reach; ++y)
+    for (int x = x0 - reach; x <= x0 + reach; ++x) {
+      const double dx = x - at.x(), dy = y - at.y();
+      if (dx * dx + dy * dy > double(r) * r + 0.5) continue;
+      float v[3];
+      bool clipped[3];
+      reader.Read(y, x, v, clipped);
+      if (clipped[0] || clipped[1] || clipped[2]) return;
+      Eigen::Matrix<double, 6, 1> row;
+      row << 1, dx, dy, dx * dx, dx * dy, dy * dy;
+      ata += row * row.transpose();
+      for (int c = 0; c < 3; ++c) atb.col(c) += row * double(v[c]);
+    }
+  const Eigen::Matrix<double, 6, 3> coefficients = ata.ldlt().solve(atb);
   const double e = photo.spec.exposure;
-  for (int c = 0; c < 3; ++c) out->rgb[c] += sum[c] / count * e;
+  for (int c = 0; c < 3; ++c) out->rgb[c] += coefficients(0, c) * e;
   out->exposure_sum += e;
   ++out->photos;
 }
@@ -96,8 +104,8 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
   reference.Check(dataset);
   const Eigen::Vector2d pixel = screen.ImageFromScreen(reference.point_mm);
   const int r = options.radius_px;
-  if (!(pixel.x() - r >= 0 && pixel.y() - r >= 0 && pixel.x() + r + 1 < screen.image_width &&
-        pixel.y() + r + 1 < screen.image_height))
+  if (!(pixel.x() - r - 2 >= 0 && pixel.y() - r - 2 >= 0 &&
+        pixel.x() + r + 2 < screen.image_width && pixel.y() + r + 2 < screen.image_height))
     throw InputError(reference.source, "point_mm",
                      "a point seen in the photos (calib/screen.json maps it to pixel " +
                          std::to_string(pixel.x()) + ", " + std::to_string(pixel.y()) + ")",
@@ -142,7 +150,7 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
   j["position"] = {reference.i, reference.j};
   j["point_mm"] = {reference.point_mm.x(), reference.point_mm.y()};
   j["pixel"] = {pixel.x(), pixel.y()};
-  j["neighbourhood_px"] = 2 * r + 1;
+  j["fit_radius_px"] = r;
   j["reading_p"] = reference.reading_p;
   j["reading_n"] = reference.reading_n;
   j["value_p"] = value[0];

@@ -31,12 +31,15 @@ ScaleReference LoadScaleReference(const std::string& path);
 std::string CanonicalUnit(const std::string& unit, const std::string& where);
 
 struct ScaleOptions {
-  int radius_px = 1;  // (2r + 1)^2 points one pixel apart around the point are averaged
+  // Pixels within this distance of the point give the quadratic fit its value at the point
+  // (at least 2: six coefficients).
+  int radius_px = 6;
 };
 
 // scale = (reading_p - reading_n) / (Y+ - Y-), Y the Rec. 709 luminance of the position's
 // corrected linear values (decoded with `corrections`, exposure-weighted over the unclipped
-// photos of each slide) averaged around the point's pixel; ambient light cancels in both
+// photos of each slide) at the point (a quadratic fit to the pixels within radius_px); ambient
+// light cancels in both
 // differences.
 RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration& screen,
                                 const ScaleReference& reference,

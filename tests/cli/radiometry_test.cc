@@ -230,9 +230,9 @@ TEST(Radiometry, ScaleMatchesTruthAndRefusesBadReadings) {
   const std::string ds = Synth("radiometry_scale", R"([{"type": "ambient", "level": 0.05}])",
                                R"({"reference": {"position": [1, 1], "point_mm": [0, 0]}})");
   WriteTrueScreen(ds);
-  // The point's value read bilinearly (radius 0): the slide's pattern curves within a few
-  // pixels of this small camera (a 3 x 3 neighbourhood reads 0.5 % low there).
-  ASSERT_EQ(Calibrate("scale --dataset " + ds + " --radius-px 0 --reference " + ds +
+  // The point's value from the default quadratic fit over 6 px: the slide's pattern curves
+  // within a few pixels of this small camera (a plain 3 x 3 mean read 0.5 % low there).
+  ASSERT_EQ(Calibrate("scale --dataset " + ds + " --reference " + ds +
                       "/truth/reference.json"),
             0);
   const RadiometricScale scale = LoadRadiometricScale(ds + "/calib/scale.json");
@@ -284,7 +284,7 @@ SlabComparison ChainRow(const std::string& ds, bool response, const std::string&
     const auto r = RunTool(
         "lumislab-calibrate",
         step == "scale"
-            ? "scale --dataset " + ds + " --radius-px 0 --reference " + ds + "/truth/reference.json"
+            ? "scale --dataset " + ds + " --reference " + ds + "/truth/reference.json"
             : step + " --dataset " + ds + FramesOf(ds, step));
     EXPECT_EQ(r.exit_code, 0) << r.output;
   }

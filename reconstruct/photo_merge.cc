@@ -1,10 +1,11 @@
 #include "reconstruct/photo_merge.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <filesystem>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <limits>
+#include <mutex>
+#include <numeric>
 
 #include "core/error.h"
 
@@ -24,17 +25,18 @@ void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int hei
           std::to_string(p.photo.pixels.cols) + "x" + std::to_string(p.photo.pixels.rows));
 }
 
-namespace {
-
-// Box average over factor x factor pixel blocks (exact: integer factor, cropped to a multiple).
-cv::Mat Downsample(const cv::Mat& image, int factor) {
-  if (factor == 1) return image;
-  const int w = image.cols / factor, h = image.rows / factor;
-  cv::Mat out;
-  cv::resize(image(cv::Rect(0, 0, w * factor, h * factor)), out, cv::Size(w, h), 0, 0,
-             cv::INTER_AREA);
-  return out;
+void MergeOptions::Check() const {
+  if (!(noise.full_well_e >= 1 && noise.full_well_e <= 1e9))
+    throw BadInput("--full-well: expected electrons in [1, 1e9], got " +
+                   std::to_string(noise.full_well_e));
+  if (!(noise.read_noise_e >= 0 && noise.read_noise_e <= 1e9))
+    throw BadInput("--read-noise: expected electrons in [0, 1e9], got " +
+                   std::to_string(noise.read_noise_e));
+  if (!(near_black_codes >= 0 && near_black_codes <= 1000))
+    throw BadInput("near_black_codes: expected [0, 1000], got " + std::to_string(near_black_codes));
 }
+
+namespace {
 
 // One pass over both photos of a position: F x F box sums of T+ and T-, their weighted
 // difference (RGB out), and the largest value seen (for the saturation check). Rows are summed
@@ -111,7 +113,8 @@ bool FusedDifference(const Photo& plus, double gain_p, const Photo& minus, doubl
 
 }  // namespace
 
-MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain, int downsample) {
+MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain, int downsample,
+                             const MergeOptions& options) {
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
   // Fast path: one linear photo per slide without black level or white balance, same 16-bit or
   // float 3-channel type, nothing saturated. Averaging is linear, so averaging first and merging
@@ -138,60 +141,273 @@ MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gai
       }
     }
   }
-  MergedPosition out = MergeFullResolution(photos, gain);
-  out.signal = Downsample(out.signal, downsample);
-  return out;
+  return MergeFullResolution(photos, gain, downsample, options);
 }
 
-MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain) {
-  LUMISLAB_CHECK(!photos.empty(), "MergePosition: no photos");
-  const int w = photos[0].photo.pixels.cols, h = photos[0].photo.pixels.rows;
-  std::vector<LinearReader> readers;
-  std::vector<float> exposure;
-  std::vector<bool> positive;
-  readers.reserve(photos.size());
-  for (const auto& p : photos) {
-    readers.emplace_back(p.photo);
-    exposure.push_back(float(p.photo.spec.exposure));
-    positive.push_back(p.entry.positive);
+namespace {
+
+// d(curve value) / d(code / code_max) of the photo's transfer curve at curve value l: the size
+// of one code step in curve units is this / code_max.
+float TransferSlope(Transfer transfer, float l) {
+  if (transfer != Transfer::kSrgb) return 1.f;
+  // sRGB decoding: l = c / 12.92 below c = 0.04045 (l = 0.0031308), else ((c + 0.055) / 1.055)^2.4,
+  // whose slope is 2.4 / 1.055 * l^(1.4 / 2.4).
+  return l <= 0.0031308f ? 1.f / 12.92f : 2.4f / 1.055f * std::pow(l, 1.4f / 2.4f);
+}
+
+// One photo in the merge, with what the noise model and the near-black test need. u is the
+// recorded value above black in units of the white level (the reader's value times the
+// recorded exposure), the same whatever exposure the merge assumes.
+struct Exposure {
+  LinearReader reader;
+  int slide = 0;        // 0: p, 1: n
+  float recorded = 1;   // exposure in dataset.json
+  float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
+  float floor_u = 0;    // below: near-black
+  float read_var = 0;   // (read noise / full well)^2, u^2
+  float code_step = 0;  // one code in u units at curve slope 1 (0: float photo)
+  Transfer transfer = Transfer::kLinear;
+  float black = 0, range = 1;  // curve value = u * range + black
+
+  explicit Exposure(const DecodedPhoto& p, const NoiseModel& noise, double near_black_codes)
+      : reader(p.photo) {
+    const Photo& photo = p.photo;
+    slide = p.entry.positive ? 0 : 1;
+    recorded = effective = float(photo.spec.exposure);
+    transfer = photo.transfer;
+    black = float(photo.spec.black_level);
+    range = float(photo.spec.white_level - photo.spec.black_level);
+    code_step = photo.pixels.depth() == CV_32F ? 0.f : float(1.0 / (photo.CodeMax() * range));
+    read_var = float(std::pow(noise.read_noise_e / noise.full_well_e, 2));
+    // n codes above black (the curve's slope at black: exact for sRGB up to code 10), or three
+    // read-noise sigmas, whichever is larger.
+    floor_u = std::max(float(near_black_codes) * code_step * TransferSlope(transfer, black),
+                       3.f * std::sqrt(read_var));
   }
-  MergedPosition out;
-  out.signal.create(h, w, CV_32FC4);
-  std::atomic<int> saturated{0};
-  const float g = float(gain);
-  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
-    int local_saturated = 0;
-    for (int y = rows.start; y < rows.end; ++y) {
-      float* o = out.signal.ptr<float>(y);
-      for (int x = 0; x < w; ++x, o += 4) {
-        // [slide][channel]: sum of unsaturated values (at their exposure) and of the exposures.
-        float sum_v[2][3] = {}, sum_e[2][3] = {};
-        for (size_t k = 0; k < readers.size(); ++k) {
-          float v[3];
-          bool clipped[3];
-          readers[k].Read(y, x, v, clipped);
-          const int s = positive[k] ? 0 : 1;
-          for (int c = 0; c < 3; ++c)
-            if (!clipped[c]) sum_v[s][c] += v[c] * exposure[k], sum_e[s][c] += exposure[k];
-        }
-        bool is_saturated = false;
-        for (int c = 0; c < 3; ++c) {
-          if (sum_e[0][c] <= 0 || sum_e[1][c] <= 0) {
-            is_saturated = true;
-            break;
-          }
-          o[c] = g * (sum_v[0][c] / sum_e[0][c] - sum_v[1][c] / sum_e[1][c]);
-        }
-        if (is_saturated) {
-          o[0] = o[1] = o[2] = 0.f;
-          ++local_saturated;
-        }
-        o[3] = is_saturated ? 1.f : 0.f;
-      }
+  // Variance of u at an expected value u (NoiseModel).
+  float Variance(float u, float inv_full_well) const {
+    float var = u * inv_full_well + read_var;
+    if (code_step > 0) {
+      const float q = code_step * TransferSlope(transfer, u * range + black);
+      var += q * q * (1.f / 12);
     }
-    saturated += local_saturated;
+    return var;
+  }
+  bool WellExposed(float u, bool clipped) const { return !clipped && u >= floor_u && u > 0; }
+};
+
+std::vector<Exposure> MakeExposures(const std::vector<DecodedPhoto>& photos,
+                                    const MergeOptions& options) {
+  std::vector<Exposure> exposures;
+  exposures.reserve(photos.size());
+  for (const auto& p : photos) exposures.emplace_back(p, options.noise, options.near_black_codes);
+  return exposures;
+}
+
+// Indices of one slide's photos, shortest recorded exposure first (ties in listing order).
+std::vector<size_t> SlideOrder(const std::vector<Exposure>& exposures, int slide) {
+  std::vector<size_t> order;
+  for (size_t k = 0; k < exposures.size(); ++k)
+    if (exposures[k].slide == slide) order.push_back(k);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return exposures[a].recorded < exposures[b].recorded;
   });
-  out.saturated_pixels = saturated;
+  return order;
+}
+
+std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w, int h) {
+  // A grid of at most ~2^18 pixels: the median of that many ratios is precise to ~1e-4.
+  const int stride = std::max(1, int(std::ceil(std::sqrt(double(w) * h / 262144.0))));
+  std::vector<BracketRatio> ratios;
+  for (int slide : {0, 1}) {
+    const std::vector<size_t> order = SlideOrder(exposures, slide);
+    if (order.size() < 2) continue;
+    std::vector<std::vector<float>> log_ratios(order.size() - 1);
+    std::vector<float> u(order.size() * 3);
+    std::vector<char> clipped(order.size() * 3);
+    for (int y = stride / 2; y < h; y += stride)
+      for (int x = stride / 2; x < w; x += stride) {
+        for (size_t k = 0; k < order.size(); ++k) {
+          const Exposure& e = exposures[order[k]];
+          float v[3];
+          bool c[3];
+          e.reader.Read(y, x, v, c);
+          for (int ch = 0; ch < 3; ++ch)
+            u[k * 3 + ch] = v[ch] * e.recorded, clipped[k * 3 + ch] = c[ch];
+        }
+        for (size_t k = 0; k + 1 < order.size(); ++k)
+          for (int ch = 0; ch < 3; ++ch) {
+            // Well exposed in both, and well above the near-black floor: the ratio of two
+            // values a few codes above black is dominated by their quantisation.
+            const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
+            if (clipped[k * 3 + ch] || clipped[(k + 1) * 3 + ch]) continue;
+            if (!(a >= 4 * exposures[order[k]].floor_u && a > 0)) continue;
+            if (!(b >= 4 * exposures[order[k + 1]].floor_u && b > 0)) continue;
+            log_ratios[k].push_back(std::log(b / a));
+          }
+      }
+    for (size_t k = 0; k + 1 < order.size(); ++k) {
+      BracketRatio r;
+      r.positive = slide == 0;
+      r.recorded_short = exposures[order[k]].recorded;
+      r.recorded_long = exposures[order[k + 1]].recorded;
+      r.estimated = r.Recorded();
+      std::vector<float>& v = log_ratios[k];
+      if (v.size() >= size_t(kMinRatioSamples)) {
+        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+        r.estimated = std::exp(double(v[v.size() / 2]));
+        r.samples = (long long)v.size();
+      }
+      ratios.push_back(r);
+    }
+  }
+  return ratios;
+}
+
+// Effective exposures from the estimated ratios: the middle exposure of each slide (the lower
+// of the two middle ones) keeps its recorded value, the others are chained from it.
+void ApplyRatios(std::vector<Exposure>& exposures, const std::vector<BracketRatio>& ratios) {
+  size_t r0 = 0;
+  for (int slide : {0, 1}) {
+    const std::vector<size_t> order = SlideOrder(exposures, slide);
+    if (order.size() < 2) continue;
+    const size_t m = (order.size() - 1) / 2;
+    for (size_t k = m + 1; k < order.size(); ++k)
+      exposures[order[k]].effective =
+          float(exposures[order[k - 1]].effective * ratios[r0 + k - 1].estimated);
+    for (size_t k = m; k-- > 0;)
+      exposures[order[k]].effective =
+          float(exposures[order[k + 1]].effective / ratios[r0 + k].estimated);
+    r0 += order.size() - 1;
+  }
+}
+
+// What one band of rows found, combined under a lock.
+struct MergeStats {
+  int saturated = 0, near_black = 0;
+  float brightest = 0, faintest = std::numeric_limits<float>::infinity();
+};
+
+}  // namespace
+
+std::vector<BracketRatio> EstimateBracketRatios(const std::vector<DecodedPhoto>& photos,
+                                                const MergeOptions& options) {
+  LUMISLAB_CHECK(!photos.empty(), "EstimateBracketRatios: no photos");
+  std::vector<Exposure> exposures = MakeExposures(photos, options);
+  return EstimateRatios(exposures, photos[0].photo.pixels.cols, photos[0].photo.pixels.rows);
+}
+
+MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain,
+                                   int downsample, const MergeOptions& options) {
+  LUMISLAB_CHECK(!photos.empty(), "MergePosition: no photos");
+  LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
+  const int w = photos[0].photo.pixels.cols, h = photos[0].photo.pixels.rows;
+  std::vector<Exposure> exposures = MakeExposures(photos, options);
+  MergedPosition out;
+  for (int slide : {0, 1})
+    out.exposures = std::max(out.exposures, int(SlideOrder(exposures, slide).size()));
+  if (out.exposures > 1) {
+    out.ratios = EstimateRatios(exposures, w, h);
+    if (options.bracket_ratios == BracketRatios::kEstimated) ApplyRatios(exposures, out.ratios);
+  }
+  const size_t n = exposures.size();
+  const float inv_full_well = float(1.0 / options.noise.full_well_e);
+  // F x F blocks of the top-left multiple of F make the output pixels; the rows and columns
+  // beyond are merged for the counts only.
+  const int f = downsample, ow = w / f, oh = h / f;
+  out.signal.create(oh, ow, CV_32FC4);
+  const float g = float(gain), inv_area = 1.f / float(f * f);
+  MergeStats total;
+  std::mutex total_mutex;
+  const int bands = (h + f - 1) / f;
+  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+    MergeStats stats;
+    std::vector<float> acc(size_t(ow) * 4);
+    std::vector<float> u(n * 3);
+    std::vector<char> clip(n * 3);
+    for (int band = range.start; band < range.end; ++band) {
+      std::fill(acc.begin(), acc.end(), 0.f);
+      for (int y = band * f; y < std::min(h, (band + 1) * f); ++y)
+        for (int x = 0; x < w; ++x) {
+          for (size_t k = 0; k < n; ++k) {
+            float v[3];
+            bool c[3];
+            exposures[k].reader.Read(y, x, v, c);
+            for (int ch = 0; ch < 3; ++ch)
+              u[k * 3 + ch] = v[ch] * exposures[k].recorded, clip[k * 3 + ch] = c[ch];
+          }
+          // [slide][channel]: the merged, exposure-normalised value.
+          float merged[2][3];
+          bool saturated = false, near_black = false;
+          for (int s = 0; s < 2 && !saturated; ++s)
+            for (int ch = 0; ch < 3; ++ch) {
+              // Pilot: over the well-exposed values, sum u / sum exposure, which is the
+              // maximum-likelihood estimate under shot noise alone (weights = exposure).
+              int longest = -1, well = 0;
+              float sum_u = 0, sum_e = 0;
+              for (size_t k = 0; k < n; ++k) {
+                const Exposure& e = exposures[k];
+                if (e.slide != s || clip[k * 3 + ch]) continue;
+                if (longest < 0 || e.effective > exposures[longest].effective) longest = int(k);
+                if (e.WellExposed(u[k * 3 + ch], false))
+                  sum_u += u[k * 3 + ch], sum_e += e.effective, ++well;
+              }
+              if (longest < 0) {  // clipped in every exposure
+                saturated = true;
+                break;
+              }
+              if (well == 0) {  // near-black in every exposure: the longest says the most
+                merged[s][ch] = u[longest * 3 + ch] / exposures[longest].effective;
+                near_black = true;
+                continue;
+              }
+              float value = sum_u / sum_e;
+              if (well > 1) {
+                // Inverse-variance weights e^2 / var(u) at the pilot's expected u = e * value:
+                // the read-noise and quantisation terms favour the longer exposures more than
+                // the shot-noise weights do. (Each exposure's own u would bias the weights
+                // towards the values that happen to read low.)
+                float sum_w = 0, sum_wx = 0;
+                for (size_t k = 0; k < n; ++k) {
+                  const Exposure& e = exposures[k];
+                  if (e.slide != s || !e.WellExposed(u[k * 3 + ch], clip[k * 3 + ch])) continue;
+                  const float wk =
+                      e.effective * e.effective / e.Variance(e.effective * value, inv_full_well);
+                  sum_w += wk, sum_wx += wk * u[k * 3 + ch] / e.effective;
+                }
+                value = sum_wx / sum_w;
+              }
+              merged[s][ch] = value;
+              stats.brightest = std::max(stats.brightest, value);
+              if (value > 0) stats.faintest = std::min(stats.faintest, value);
+            }
+          stats.saturated += saturated;
+          stats.near_black += near_black && !saturated;
+          if (band >= oh || x >= ow * f) continue;
+          float* o = &acc[size_t(x / f) * 4];
+          if (saturated) {
+            o[3] += 1.f;
+            continue;
+          }
+          for (int ch = 0; ch < 3; ++ch) o[ch] += g * (merged[0][ch] - merged[1][ch]);
+        }
+      if (band >= oh) continue;
+      float* o = out.signal.ptr<float>(band);
+      for (size_t k = 0; k < acc.size(); ++k) o[k] = acc[k] * inv_area;
+    }
+    std::lock_guard<std::mutex> lock(total_mutex);
+    total.saturated += stats.saturated;
+    total.near_black += stats.near_black;
+    total.brightest = std::max(total.brightest, stats.brightest);
+    total.faintest = std::min(total.faintest, stats.faintest);
+  });
+  out.saturated_pixels = total.saturated;
+  out.near_black_pixels = total.near_black;
+  if (total.brightest > 0 && std::isfinite(total.faintest)) {
+    out.brightest = total.brightest;
+    out.faintest = total.faintest;
+    out.dynamic_range_stops = std::log2(double(total.brightest) / total.faintest);
+  }
   return out;
 }
 

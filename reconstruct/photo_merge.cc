@@ -1,6 +1,7 @@
 #include "reconstruct/photo_merge.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -168,6 +169,8 @@ struct Exposure {
   float code_step = 0;  // one code in u units at curve slope 1 (0: float photo)
   Transfer transfer = Transfer::kLinear;
   float black = 0, range = 1;  // curve value = u * range + black
+  static constexpr int kQuantTable = 1025;
+  std::array<float, kQuantTable> quant_var{};  // q^2 / 12 at curve value k / (kQuantTable - 1)
 
   explicit Exposure(const DecodedPhoto& p, const NoiseModel& noise, double near_black_codes)
       : reader(p.photo) {
@@ -183,15 +186,18 @@ struct Exposure {
     // read-noise sigmas, whichever is larger.
     floor_u = std::max(float(near_black_codes) * code_step * TransferSlope(transfer, black),
                        3.f * std::sqrt(read_var));
-  }
-  // Variance of u at an expected value u (NoiseModel).
-  float Variance(float u, float inv_full_well) const {
-    float var = u * inv_full_well + read_var;
-    if (code_step > 0) {
-      const float q = code_step * TransferSlope(transfer, u * range + black);
-      var += q * q * (1.f / 12);
+    for (int k = 0; k < kQuantTable; ++k) {
+      const float q = code_step * TransferSlope(transfer, float(k) / (kQuantTable - 1));
+      quant_var[k] = q * q / 12;
     }
-    return var;
+  }
+  // Variance of u at an expected value u (NoiseModel); the quantisation term from a table over
+  // the curve value (1/1024 steps: the weights need not be exact, and a pow per value and
+  // exposure would cost more than decoding the photo).
+  float Variance(float u, float inv_full_well) const {
+    if (transfer != Transfer::kSrgb) return u * inv_full_well + read_var + quant_var[0];
+    const float l = std::clamp(u * range + black, 0.f, 1.f);
+    return u * inv_full_well + read_var + quant_var[int(l * (kQuantTable - 1) + 0.5f)];
   }
   bool WellExposed(float u, bool clipped) const { return !clipped && u >= floor_u && u > 0; }
 };
@@ -288,6 +294,103 @@ struct MergeStats {
   float brightest = 0, faintest = std::numeric_limits<float>::infinity();
 };
 
+// How a slide's channel at a pixel was merged.
+enum : uint8_t { kMeasured = 0, kNearBlackEverywhere = 1, kClippedEverywhere = 2 };
+
+// Merges one photo row of both slides, channel by channel, in passes over the row (one per
+// exposure) that the compiler vectorises, rather than branching per pixel and exposure.
+struct MergeRows {
+  const std::vector<Exposure>& exposures;
+  const std::vector<int>* members;         // [2]: each slide's photos, longest exposure first
+  int n3;                                  // 3 * width
+  std::vector<std::vector<float>> u;       // [photo][x * 3 + c]: recorded value above black
+  std::vector<std::vector<uint8_t>> clip;  // [photo][x * 3 + c]
+  // Per slide: the merged exposure-normalised value and how it was merged.
+  std::vector<float> value[2];
+  std::vector<uint8_t> state[2];
+  // Scratch: pilot sums, the longest unclipped value, the weighted sums.
+  std::vector<float> sum_u, sum_e, longest, sum_w, sum_wx;
+  std::vector<uint8_t> found;
+
+  MergeRows(const std::vector<Exposure>& e, const std::vector<int>* m, int width)
+      : exposures(e), members(m), n3(3 * width) {
+    u.assign(e.size(), std::vector<float>(n3));
+    clip.assign(e.size(), std::vector<uint8_t>(n3));
+    for (int s = 0; s < 2; ++s) value[s].resize(n3), state[s].resize(n3);
+    for (auto* v : {&sum_u, &sum_e, &longest, &sum_w, &sum_wx}) v->resize(n3);
+    found.resize(n3);
+  }
+
+  void Merge(int y, float inv_full_well, MergeStats* stats) {
+    for (size_t k = 0; k < exposures.size(); ++k) {
+      const Exposure& e = exposures[k];
+      float* uk = u[k].data();
+      uint8_t* ck = clip[k].data();
+      for (int x = 0; x < n3 / 3; ++x) {
+        float v[3];
+        bool c[3];
+        e.reader.Read(y, x, v, c);
+        for (int ch = 0; ch < 3; ++ch) uk[x * 3 + ch] = v[ch] * e.recorded, ck[x * 3 + ch] = c[ch];
+      }
+    }
+    for (int s = 0; s < 2; ++s) MergeSlide(s, inv_full_well, stats);
+  }
+
+  void MergeSlide(int s, float inv_full_well, MergeStats* stats) {
+    std::fill(sum_u.begin(), sum_u.end(), 0.f);
+    std::fill(sum_e.begin(), sum_e.end(), 0.f);
+    std::fill(found.begin(), found.end(), uint8_t(0));
+    // Pilot: over the well-exposed values, sum u / sum exposure, the maximum-likelihood
+    // estimate under shot noise alone (weights = exposures). Longest first, so the first
+    // unclipped value met is the longest exposure's (used where all are near-black).
+    for (const int k : members[s]) {
+      const Exposure& e = exposures[k];
+      const float* uk = u[k].data();
+      const uint8_t* ck = clip[k].data();
+      const float floor_u = e.floor_u, eff = e.effective, inv_eff = 1.f / e.effective;
+      for (int i = 0; i < n3; ++i) {
+        const bool well = !ck[i] && uk[i] >= floor_u && uk[i] > 0;
+        sum_u[i] += well ? uk[i] : 0.f;
+        sum_e[i] += well ? eff : 0.f;
+        longest[i] = !found[i] && !ck[i] ? uk[i] * inv_eff : longest[i];
+        found[i] |= !ck[i];
+      }
+    }
+    // Inverse-variance weights e^2 / var(u) at the pilot's expected u = e * pilot: the
+    // read-noise and quantisation terms favour the longer exposures more than the shot-noise
+    // weights do. (Each exposure's own u would bias the weights towards values that read low.)
+    // With one well-exposed value this is that value / its exposure.
+    std::fill(sum_w.begin(), sum_w.end(), 0.f);
+    std::fill(sum_wx.begin(), sum_wx.end(), 0.f);
+    for (const int k : members[s]) {
+      const Exposure& e = exposures[k];
+      const float* uk = u[k].data();
+      const uint8_t* ck = clip[k].data();
+      const float floor_u = e.floor_u, eff = e.effective;
+      for (int i = 0; i < n3; ++i) {
+        const bool well = !ck[i] && uk[i] >= floor_u && uk[i] > 0;
+        if (!well) continue;
+        const float pilot = sum_u[i] / sum_e[i];
+        // w / e = e / var(u), applied to u: sum_wx = sum w * (u / e).
+        const float w_over_e = eff / e.Variance(eff * pilot, inv_full_well);
+        sum_w[i] += w_over_e * eff;
+        sum_wx[i] += w_over_e * uk[i];
+      }
+    }
+    float* v = value[s].data();
+    uint8_t* st = state[s].data();
+    for (int i = 0; i < n3; ++i) {
+      const bool measured = sum_e[i] > 0;
+      v[i] = !found[i] ? 0.f : measured ? sum_wx[i] / sum_w[i] : longest[i];
+      st[i] = !found[i] ? kClippedEverywhere : measured ? kMeasured : kNearBlackEverywhere;
+      if (measured) {
+        stats->brightest = std::max(stats->brightest, v[i]);
+        if (v[i] > 0) stats->faintest = std::min(stats->faintest, v[i]);
+      }
+    }
+  }
+};
+
 }  // namespace
 
 std::vector<BracketRatio> EstimateBracketRatios(const std::vector<DecodedPhoto>& photos,
@@ -317,69 +420,32 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
   const int f = downsample, ow = w / f, oh = h / f;
   out.signal.create(oh, ow, CV_32FC4);
   const float g = float(gain), inv_area = 1.f / float(f * f);
+  // Each slide's photos, longest effective exposure first.
+  std::vector<int> members[2];
+  for (int k = 0; k < int(n); ++k) members[exposures[k].slide].push_back(k);
+  for (auto& m : members)
+    std::stable_sort(m.begin(), m.end(),
+                     [&](int a, int b) { return exposures[a].effective > exposures[b].effective; });
   MergeStats total;
   std::mutex total_mutex;
   const int bands = (h + f - 1) / f;
   cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
     MergeStats stats;
+    MergeRows rows(exposures, members, w);
     std::vector<float> acc(size_t(ow) * 4);
-    std::vector<float> u(n * 3);
-    std::vector<char> clip(n * 3);
     for (int band = range.start; band < range.end; ++band) {
       std::fill(acc.begin(), acc.end(), 0.f);
-      for (int y = band * f; y < std::min(h, (band + 1) * f); ++y)
+      for (int y = band * f; y < std::min(h, (band + 1) * f); ++y) {
+        rows.Merge(y, inv_full_well, &stats);
+        const float* v0 = rows.value[0].data();
+        const float* v1 = rows.value[1].data();
         for (int x = 0; x < w; ++x) {
-          for (size_t k = 0; k < n; ++k) {
-            float v[3];
-            bool c[3];
-            exposures[k].reader.Read(y, x, v, c);
-            for (int ch = 0; ch < 3; ++ch)
-              u[k * 3 + ch] = v[ch] * exposures[k].recorded, clip[k * 3 + ch] = c[ch];
-          }
-          // [slide][channel]: the merged, exposure-normalised value.
-          float merged[2][3];
+          // A pixel is saturated (near-black) when a channel of a slide is, in every exposure.
           bool saturated = false, near_black = false;
-          for (int s = 0; s < 2 && !saturated; ++s)
+          for (int s = 0; s < 2; ++s)
             for (int ch = 0; ch < 3; ++ch) {
-              // Pilot: over the well-exposed values, sum u / sum exposure, which is the
-              // maximum-likelihood estimate under shot noise alone (weights = exposure).
-              int longest = -1, well = 0;
-              float sum_u = 0, sum_e = 0;
-              for (size_t k = 0; k < n; ++k) {
-                const Exposure& e = exposures[k];
-                if (e.slide != s || clip[k * 3 + ch]) continue;
-                if (longest < 0 || e.effective > exposures[longest].effective) longest = int(k);
-                if (e.WellExposed(u[k * 3 + ch], false))
-                  sum_u += u[k * 3 + ch], sum_e += e.effective, ++well;
-              }
-              if (longest < 0) {  // clipped in every exposure
-                saturated = true;
-                break;
-              }
-              if (well == 0) {  // near-black in every exposure: the longest says the most
-                merged[s][ch] = u[longest * 3 + ch] / exposures[longest].effective;
-                near_black = true;
-                continue;
-              }
-              float value = sum_u / sum_e;
-              if (well > 1) {
-                // Inverse-variance weights e^2 / var(u) at the pilot's expected u = e * value:
-                // the read-noise and quantisation terms favour the longer exposures more than
-                // the shot-noise weights do. (Each exposure's own u would bias the weights
-                // towards the values that happen to read low.)
-                float sum_w = 0, sum_wx = 0;
-                for (size_t k = 0; k < n; ++k) {
-                  const Exposure& e = exposures[k];
-                  if (e.slide != s || !e.WellExposed(u[k * 3 + ch], clip[k * 3 + ch])) continue;
-                  const float wk =
-                      e.effective * e.effective / e.Variance(e.effective * value, inv_full_well);
-                  sum_w += wk, sum_wx += wk * u[k * 3 + ch] / e.effective;
-                }
-                value = sum_wx / sum_w;
-              }
-              merged[s][ch] = value;
-              stats.brightest = std::max(stats.brightest, value);
-              if (value > 0) stats.faintest = std::min(stats.faintest, value);
+              saturated |= rows.state[s][x * 3 + ch] == kClippedEverywhere;
+              near_black |= rows.state[s][x * 3 + ch] == kNearBlackEverywhere;
             }
           stats.saturated += saturated;
           stats.near_black += near_black && !saturated;
@@ -389,8 +455,9 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
             o[3] += 1.f;
             continue;
           }
-          for (int ch = 0; ch < 3; ++ch) o[ch] += g * (merged[0][ch] - merged[1][ch]);
+          for (int ch = 0; ch < 3; ++ch) o[ch] += g * (v0[x * 3 + ch] - v1[x * 3 + ch]);
         }
+      }
       if (band >= oh) continue;
       float* o = out.signal.ptr<float>(band);
       for (size_t k = 0; k < acc.size(); ++k) o[k] = acc[k] * inv_area;

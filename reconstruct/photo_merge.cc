@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cfloat>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -38,6 +39,15 @@ void MergeOptions::Check() const {
 }
 
 namespace {
+
+// The stored codes of `photo` map to linear values as code * Gain() - Offset(), with nothing
+// else applied per pixel (the condition under which Photo's Gain/Offset/SaturationCode may stand
+// in for LinearReader): linear transfer, unity white balance, 16-bit or float RGB.
+bool CodesAreLinear(const Photo& photo) {
+  const int type = photo.pixels.type();
+  return photo.transfer == Transfer::kLinear && photo.UnityWhiteBalance() &&
+         (type == CV_16UC3 || type == CV_32FC3);
+}
 
 // One pass over both photos of a position: F x F box sums of T+ and T-, their weighted
 // difference (RGB out), and the largest value seen (for the saturation check). Rows are summed
@@ -124,11 +134,9 @@ MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gai
     const Photo& p = (photos[0].entry.positive ? photos[0] : photos[1]).photo;
     const Photo& n = (photos[0].entry.positive ? photos[1] : photos[0]).photo;
     const int type = p.pixels.type();
-    const bool linear = p.transfer == Transfer::kLinear && n.transfer == Transfer::kLinear &&
-                        p.Offset() == 0 && n.Offset() == 0 && p.UnityWhiteBalance() &&
-                        n.UnityWhiteBalance() && p.SaturationCode() == n.SaturationCode();
-    if (linear && type == n.pixels.type() && (type == CV_16UC3 || type == CV_32FC3) &&
-        n.pixels.size() == p.pixels.size()) {
+    const bool linear = CodesAreLinear(p) && CodesAreLinear(n) && p.Offset() == 0 &&
+                        n.Offset() == 0 && p.SaturationCode() == n.SaturationCode();
+    if (linear && type == n.pixels.type() && n.pixels.size() == p.pixels.size()) {
       MergedPosition out;
       const double gp = gain * p.Gain(), gn = gain * n.Gain();
       const bool ok = type == CV_16UC3
@@ -161,6 +169,11 @@ float TransferSlope(Transfer transfer, float l) {
 // recorded exposure), the same whatever exposure the merge assumes.
 struct Exposure {
   LinearReader reader;
+  // CodesAreLinear: u = code * u_gain - u_offset, clipped at code >= saturation_code (or NaN),
+  // read a row at a time instead of through the reader.
+  const Photo* source = nullptr;
+  bool linear_codes = false;
+  float u_gain = 0, u_offset = 0, saturation_code = 0;
   int slide = 0;        // 0: p, 1: n
   float recorded = 1;   // exposure in dataset.json
   float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
@@ -177,6 +190,11 @@ struct Exposure {
     const Photo& photo = p.photo;
     slide = p.entry.positive ? 0 : 1;
     recorded = effective = float(photo.spec.exposure);
+    source = &photo;
+    linear_codes = CodesAreLinear(photo);
+    u_gain = float(photo.Gain() * photo.spec.exposure);
+    u_offset = float(photo.Offset() * photo.spec.exposure);
+    saturation_code = float(photo.SaturationCode());
     transfer = photo.transfer;
     black = float(photo.spec.black_level);
     range = float(photo.spec.white_level - photo.spec.black_level);
@@ -196,8 +214,9 @@ struct Exposure {
   // exposure would cost more than decoding the photo).
   float Variance(float u, float inv_full_well) const {
     if (transfer != Transfer::kSrgb) return u * inv_full_well + read_var + quant_var[0];
-    const float l = std::clamp(u * range + black, 0.f, 1.f);
-    return u * inv_full_well + read_var + quant_var[int(l * (kQuantTable - 1) + 0.5f)];
+    const float l = u * range + black;  // NaN (an unused lane of the merge) reads entry 0
+    const int k = l >= 1.f ? kQuantTable - 1 : l > 0.f ? int(l * (kQuantTable - 1) + 0.5f) : 0;
+    return u * inv_full_well + read_var + quant_var[k];
   }
   bool WellExposed(float u, bool clipped) const { return !clipped && u >= floor_u && u > 0; }
 };
@@ -295,99 +314,150 @@ struct MergeStats {
 };
 
 // How a slide's channel at a pixel was merged.
+// Bits, so that the states of a pixel's channels combine with OR.
 enum : uint8_t { kMeasured = 0, kNearBlackEverywhere = 1, kClippedEverywhere = 2 };
 
 // Merges one photo row of both slides, channel by channel, in passes over the row (one per
 // exposure) that the compiler vectorises, rather than branching per pixel and exposure.
 struct MergeRows {
   const std::vector<Exposure>& exposures;
-  const std::vector<int>* members;         // [2]: each slide's photos, longest exposure first
-  int n3;                                  // 3 * width
-  std::vector<std::vector<float>> u;       // [photo][x * 3 + c]: recorded value above black
-  std::vector<std::vector<uint8_t>> clip;  // [photo][x * 3 + c]
+  const std::vector<int>* members;  // [2]: each slide's photos, longest exposure first
+  int n3;                           // 3 * width
+  // [photo][x * 3 + c]: recorded value above black, and 1 where clipped (0 otherwise). All
+  // per-row arrays are float, so that the passes below vectorise without conversions.
+  std::vector<std::vector<float>> u, clip;
   // Per slide: the merged exposure-normalised value and how it was merged.
   std::vector<float> value[2];
   std::vector<uint8_t> state[2];
-  // Scratch: pilot sums, the longest unclipped value, the weighted sums.
-  std::vector<float> sum_u, sum_e, longest, sum_w, sum_wx;
-  std::vector<uint8_t> found;
+  // Scratch: pilot sums, the longest unclipped value and whether one was met, weighted sums.
+  std::vector<float> sum_u, sum_e, longest, found, sum_w, sum_wx;
 
   MergeRows(const std::vector<Exposure>& e, const std::vector<int>* m, int width)
       : exposures(e), members(m), n3(3 * width) {
     u.assign(e.size(), std::vector<float>(n3));
-    clip.assign(e.size(), std::vector<uint8_t>(n3));
+    clip.assign(e.size(), std::vector<float>(n3));
     for (int s = 0; s < 2; ++s) value[s].resize(n3), state[s].resize(n3);
-    for (auto* v : {&sum_u, &sum_e, &longest, &sum_w, &sum_wx}) v->resize(n3);
-    found.resize(n3);
+    for (auto* v : {&sum_u, &sum_e, &longest, &found, &sum_w, &sum_wx}) v->resize(n3);
+  }
+
+  // One row of 16-bit or float linear codes (CodesAreLinear) into u and clip, RGB order.
+  template <typename T>
+  void ReadLinearRow(const Exposure& e, int y, float* __restrict uk, float* __restrict ck) {
+    const Photo& photo = *e.source;
+    const T* __restrict row = photo.pixels.ptr<T>(y);
+    const int r = photo.rgb_order ? 0 : 2;
+    const float gain = e.u_gain, offset = e.u_offset, saturation = e.saturation_code;
+    // In storage order first (a plain loop that vectorises), then blue and red swapped.
+    for (int j = 0; j < n3; ++j) {
+      const float code = float(row[j]);
+      const float value = code * gain - offset;
+      const bool ok = (code < saturation) & (std::abs(value) <= FLT_MAX);  // NaN: clipped
+      uk[j] = ok ? value : 0.f;
+      ck[j] = ok ? 0.f : 1.f;
+    }
+    if (r != 0)
+      for (int j = 0; j < n3; j += 3) std::swap(uk[j], uk[j + 2]), std::swap(ck[j], ck[j + 2]);
   }
 
   void Merge(int y, float inv_full_well, MergeStats* stats) {
     for (size_t k = 0; k < exposures.size(); ++k) {
       const Exposure& e = exposures[k];
       float* uk = u[k].data();
-      uint8_t* ck = clip[k].data();
+      float* ck = clip[k].data();
+      if (e.linear_codes) {
+        if (e.source->pixels.depth() == CV_16U)
+          ReadLinearRow<uint16_t>(e, y, uk, ck);
+        else
+          ReadLinearRow<float>(e, y, uk, ck);
+        continue;
+      }
       for (int x = 0; x < n3 / 3; ++x) {
         float v[3];
         bool c[3];
         e.reader.Read(y, x, v, c);
-        for (int ch = 0; ch < 3; ++ch) uk[x * 3 + ch] = v[ch] * e.recorded, ck[x * 3 + ch] = c[ch];
+        for (int ch = 0; ch < 3; ++ch) {
+          const float value = v[ch] * e.recorded;
+          const bool ok = !c[ch] && std::isfinite(value);
+          uk[x * 3 + ch] = ok ? value : 0.f;
+          ck[x * 3 + ch] = ok ? 0.f : 1.f;
+        }
       }
     }
     for (int s = 0; s < 2; ++s) MergeSlide(s, inv_full_well, stats);
   }
 
   void MergeSlide(int s, float inv_full_well, MergeStats* stats) {
-    std::fill(sum_u.begin(), sum_u.end(), 0.f);
-    std::fill(sum_e.begin(), sum_e.end(), 0.f);
-    std::fill(found.begin(), found.end(), uint8_t(0));
-    // Pilot: over the well-exposed values, sum u / sum exposure, the maximum-likelihood
-    // estimate under shot noise alone (weights = exposures). Longest first, so the first
-    // unclipped value met is the longest exposure's (used where all are near-black).
+    float* __restrict su = sum_u.data();
+    float* __restrict se = sum_e.data();
+    float* __restrict lg = longest.data();
+    float* __restrict fd = found.data();
+    float* __restrict sw = sum_w.data();
+    float* __restrict swx = sum_wx.data();
+    std::fill_n(su, n3, 0.f);
+    std::fill_n(se, n3, 0.f);
+    std::fill_n(lg, n3, 0.f);
+    std::fill_n(fd, n3, 0.f);
+    // Pilot: over the well-exposed values (Exposure::WellExposed), sum u / sum exposure, the
+    // maximum-likelihood estimate under shot noise alone (weights = exposures). Longest first,
+    // so the first unclipped value met is the longest exposure's (used where all are
+    // near-black).
     for (const int k : members[s]) {
       const Exposure& e = exposures[k];
-      const float* uk = u[k].data();
-      const uint8_t* ck = clip[k].data();
+      const float* __restrict uk = u[k].data();
+      const float* __restrict ck = clip[k].data();
       const float floor_u = e.floor_u, eff = e.effective, inv_eff = 1.f / e.effective;
+      // 0/1 masks multiplied in (u is finite, 0 where clipped), no branches.
       for (int i = 0; i < n3; ++i) {
-        const bool well = !ck[i] && uk[i] >= floor_u && uk[i] > 0;
-        sum_u[i] += well ? uk[i] : 0.f;
-        sum_e[i] += well ? eff : 0.f;
-        longest[i] = !found[i] && !ck[i] ? uk[i] * inv_eff : longest[i];
-        found[i] |= !ck[i];
+        const float unclipped = 1.f - ck[i];
+        const float well = (uk[i] >= floor_u) & (uk[i] > 0.f) ? unclipped : 0.f;
+        su[i] += well * uk[i];
+        se[i] += well * eff;
+        lg[i] += (1.f - fd[i]) * unclipped * uk[i] * inv_eff;  // lg is 0 until the first
+        fd[i] = std::max(fd[i], unclipped);
       }
     }
     // Inverse-variance weights e^2 / var(u) at the pilot's expected u = e * pilot: the
     // read-noise and quantisation terms favour the longer exposures more than the shot-noise
     // weights do. (Each exposure's own u would bias the weights towards values that read low.)
-    // With one well-exposed value this is that value / its exposure.
-    std::fill(sum_w.begin(), sum_w.end(), 0.f);
-    std::fill(sum_wx.begin(), sum_wx.end(), 0.f);
+    // With one well-exposed value this is that value / its exposure. Computed on every lane and
+    // selected (a value that is not well exposed may give inf or NaN here, never used).
+    std::fill_n(sw, n3, 0.f);
+    std::fill_n(swx, n3, 0.f);
+    for (int i = 0; i < n3; ++i) su[i] /= se[i];  // su: the pilot from here on
     for (const int k : members[s]) {
       const Exposure& e = exposures[k];
-      const float* uk = u[k].data();
-      const uint8_t* ck = clip[k].data();
+      const float* __restrict uk = u[k].data();
+      const float* __restrict ck = clip[k].data();
       const float floor_u = e.floor_u, eff = e.effective;
-      for (int i = 0; i < n3; ++i) {
-        const bool well = !ck[i] && uk[i] >= floor_u && uk[i] > 0;
-        if (!well) continue;
-        const float pilot = sum_u[i] / sum_e[i];
-        // w / e = e / var(u), applied to u: sum_wx = sum w * (u / e).
-        const float w_over_e = eff / e.Variance(eff * pilot, inv_full_well);
-        sum_w[i] += w_over_e * eff;
-        sum_wx[i] += w_over_e * uk[i];
-      }
+      const float constant = e.read_var + e.quant_var[0];
+      const auto accumulate = [&](auto variance) {
+        for (int i = 0; i < n3; ++i) {
+          const bool well = (ck[i] == 0.f) & (uk[i] >= floor_u) & (uk[i] > 0.f);
+          // A select, not a product: where the pixel is not well exposed, 0 / 0 pilots and
+          // zero variances may give NaN or inf here.
+          // w / e = e / var(u), applied to u: sum_wx = sum w * (u / e).
+          const float w_over_e = eff / variance(eff * su[i]);
+          sw[i] += well ? w_over_e * eff : 0.f;
+          swx[i] += well ? w_over_e * uk[i] : 0.f;
+        }
+      };
+      if (e.transfer == Transfer::kSrgb)
+        accumulate([&](float u_expected) { return e.Variance(u_expected, inv_full_well); });
+      else  // the quantisation term is a constant: Variance without the table
+        accumulate([&](float u_expected) { return u_expected * inv_full_well + constant; });
     }
     float* v = value[s].data();
     uint8_t* st = state[s].data();
+    float brightest = stats->brightest, faintest = stats->faintest;
     for (int i = 0; i < n3; ++i) {
-      const bool measured = sum_e[i] > 0;
-      v[i] = !found[i] ? 0.f : measured ? sum_wx[i] / sum_w[i] : longest[i];
-      st[i] = !found[i] ? kClippedEverywhere : measured ? kMeasured : kNearBlackEverywhere;
-      if (measured) {
-        stats->brightest = std::max(stats->brightest, v[i]);
-        if (v[i] > 0) stats->faintest = std::min(stats->faintest, v[i]);
-      }
+      const bool measured = se[i] > 0;
+      const bool any = fd[i] != 0.f;
+      v[i] = !any ? 0.f : measured ? swx[i] / sw[i] : lg[i];
+      st[i] = !any ? kClippedEverywhere : measured ? kMeasured : kNearBlackEverywhere;
+      brightest = std::max(brightest, measured ? v[i] : 0.f);
+      faintest = std::min(faintest, measured & (v[i] > 0) ? v[i] : faintest);
     }
+    stats->brightest = brightest, stats->faintest = faintest;
   }
 };
 
@@ -439,23 +509,25 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
         rows.Merge(y, inv_full_well, &stats);
         const float* v0 = rows.value[0].data();
         const float* v1 = rows.value[1].data();
-        for (int x = 0; x < w; ++x) {
-          // A pixel is saturated (near-black) when a channel of a slide is, in every exposure.
-          bool saturated = false, near_black = false;
-          for (int s = 0; s < 2; ++s)
-            for (int ch = 0; ch < 3; ++ch) {
-              saturated |= rows.state[s][x * 3 + ch] == kClippedEverywhere;
-              near_black |= rows.state[s][x * 3 + ch] == kNearBlackEverywhere;
-            }
+        const uint8_t* s0 = rows.state[0].data();
+        const uint8_t* s1 = rows.state[1].data();
+        const bool in_band = band < oh;
+        for (int x = 0, ox = 0, dx = 0; x < w; ++x) {
+          // A pixel is saturated (near-black) when a channel of a slide is, in every exposure:
+          // the states are bits, so one OR over the six channels tells.
+          const int i = x * 3;
+          const uint8_t any = s0[i] | s0[i + 1] | s0[i + 2] | s1[i] | s1[i + 1] | s1[i + 2];
+          const bool saturated = any & kClippedEverywhere;
           stats.saturated += saturated;
-          stats.near_black += near_black && !saturated;
-          if (band >= oh || x >= ow * f) continue;
-          float* o = &acc[size_t(x / f) * 4];
-          if (saturated) {
-            o[3] += 1.f;
-            continue;
+          stats.near_black += !saturated && (any & kNearBlackEverywhere);
+          if (in_band && ox < ow) {
+            float* o = &acc[size_t(ox) * 4];
+            if (saturated)
+              o[3] += 1.f;
+            else
+              for (int ch = 0; ch < 3; ++ch) o[ch] += g * (v0[i + ch] - v1[i + ch]);
           }
-          for (int ch = 0; ch < 3; ++ch) o[ch] += g * (v0[x * 3 + ch] - v1[x * 3 + ch]);
+          if (++dx == f) dx = 0, ++ox;  // the output pixel of x (x / f, without dividing)
         }
       }
       if (band >= oh) continue;

@@ -73,13 +73,15 @@ TEST(BracketMerge, NoiseModelWeights) {
 }
 
 // A pixel clipped in every exposure of a slide is masked (A = 1, RGB 0) and counted; one clipped
-// only in the long exposure takes the short one's value exactly.
+// (or NaN) only in the long exposure takes the short one's value exactly.
 TEST(BracketMerge, ClippedInEveryExposureIsMaskedAndCounted) {
   auto scene = [](int x, int y) { return x == 2 && y == 3 ? 5.0 : x == 1 && y == 1 ? 0.6 : 0.1; };
   std::vector<DecodedPhoto> photos;
   for (double e : {1.0, 4.0})
-    photos.push_back(MakePhoto(8, 8, true, e, CV_32F, Transfer::kLinear,
-                               [&](int x, int y, int) { return std::min(1.0, e * scene(x, y)); }));
+    photos.push_back(MakePhoto(8, 8, true, e, CV_32F, Transfer::kLinear, [&](int x, int y, int) {
+      // A NaN (a float photo's broken pixel) counts as clipped.
+      return x == 6 && y == 6 && e == 4 ? std::nan("") : std::min(1.0, e * scene(x, y));
+    }));
   photos.push_back(Constant(false, 1, 0.0, 8, 8));
   const MergedPosition m = MergeFullResolution(photos, 2.0);
   EXPECT_EQ(m.saturated_pixels, 1);
@@ -87,6 +89,7 @@ TEST(BracketMerge, ClippedInEveryExposureIsMaskedAndCounted) {
   EXPECT_FLOAT_EQ(At(m, 1, 1)[0], 2 * 0.6f);  // 2.4 clipped at exposure 4
   EXPECT_NEAR(At(m, 5, 5)[1], 2 * 0.1f, 1e-7);
   EXPECT_EQ(At(m, 5, 5)[3], 0.f);
+  EXPECT_NEAR(At(m, 6, 6)[2], 2 * 0.1f, 1e-7);  // the NaN left out
   // F x F averaging in the same pass: A is the fraction of saturated pixels of the block.
   const MergedPosition d = MergeFullResolution(photos, 2.0, 2);
   ASSERT_EQ(d.signal.cols, 4);

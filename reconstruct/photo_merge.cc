@@ -174,10 +174,16 @@ struct Exposure {
   const Photo* source = nullptr;
   bool linear_codes = false;
   float u_gain = 0, u_offset = 0, saturation_code = 0;
+  // 8-bit photos: u and clipped per code and channel (R, G, B), read through the reader from a
+  // 256-pixel photo holding every code, so the table is the decoder's own linearisation. Valid
+  // because LinearReader maps a code the same way at every pixel.
+  std::vector<float> code_u[3];
+  std::vector<uint8_t> code_clipped[3];
   int slide = 0;        // 0: p, 1: n
   float recorded = 1;   // exposure in dataset.json
   float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
-  float floor_u = 0;    // below: near-black
+  // Well exposed: not clipped, u >= floor_u and u > 0; unclipped below that: near-black.
+  float floor_u = 0;
   float read_var = 0;   // (read noise / full well)^2, u^2
   float code_step = 0;  // one code in u units at curve slope 1 (0: float photo)
   Transfer transfer = Transfer::kLinear;
@@ -192,6 +198,26 @@ struct Exposure {
     recorded = effective = float(photo.spec.exposure);
     source = &photo;
     linear_codes = CodesAreLinear(photo);
+    if (photo.pixels.depth() == CV_8U) {
+      Photo codes = photo;
+      codes.pixels.create(1, 256, photo.pixels.type());
+      for (int v = 0; v < 256; ++v)
+        for (int c = 0; c < codes.pixels.channels(); ++c)
+          codes.pixels.ptr<uint8_t>(0)[v * codes.pixels.channels() + c] = uint8_t(v);
+      const LinearReader code_reader(codes);
+      for (int c = 0; c < 3; ++c) code_u[c].resize(256), code_clipped[c].resize(256);
+      for (int v = 0; v < 256; ++v) {
+        float rgb[3];
+        bool clipped[3];
+        code_reader.Read(0, v, rgb, clipped);
+        for (int c = 0; c < 3; ++c) {
+          const float value = rgb[c] * recorded;
+          const bool ok = !clipped[c] && std::isfinite(value);
+          code_u[c][v] = ok ? value : 0.f;
+          code_clipped[c][v] = !ok;
+        }
+      }
+    }
     u_gain = float(photo.Gain() * photo.spec.exposure);
     u_offset = float(photo.Offset() * photo.spec.exposure);
     saturation_code = float(photo.SaturationCode());
@@ -218,7 +244,6 @@ struct Exposure {
     const int k = l >= 1.f ? kQuantTable - 1 : l > 0.f ? int(l * (kQuantTable - 1) + 0.5f) : 0;
     return u * inv_full_well + read_var + quant_var[k];
   }
-  bool WellExposed(float u, bool clipped) const { return !clipped && u >= floor_u && u > 0; }
 };
 
 std::vector<Exposure> MakeExposures(const std::vector<DecodedPhoto>& photos,
@@ -359,6 +384,29 @@ struct MergeRows {
       for (int j = 0; j < n3; j += 3) std::swap(uk[j], uk[j + 2]), std::swap(ck[j], ck[j + 2]);
   }
 
+  // One row of 8-bit codes through the exposure's tables, RGB order (1 or 3 channels).
+  void ReadCodeRow(const Exposure& e, int y, float* __restrict uk, float* __restrict ck) {
+    const cv::Mat& m = e.source->pixels;
+    const uint8_t* row = m.ptr<uint8_t>(y);
+    const int channels = m.channels();
+    const int offsets[3] = {channels == 1         ? 0
+                            : e.source->rgb_order ? 0
+                                                  : 2,
+                            channels == 1 ? 0 : 1,
+                            channels == 1         ? 0
+                            : e.source->rgb_order ? 2
+                                                  : 0};
+    for (int c = 0; c < 3; ++c) {
+      const float* table = e.code_u[c].data();
+      const uint8_t* clipped = e.code_clipped[c].data();
+      for (int x = 0; x < n3 / 3; ++x) {
+        const uint8_t code = row[x * channels + offsets[c]];
+        uk[x * 3 + c] = table[code];
+        ck[x * 3 + c] = clipped[code];
+      }
+    }
+  }
+
   void Merge(int y, float inv_full_well, MergeStats* stats) {
     for (size_t k = 0; k < exposures.size(); ++k) {
       const Exposure& e = exposures[k];
@@ -369,6 +417,10 @@ struct MergeRows {
           ReadLinearRow<uint16_t>(e, y, uk, ck);
         else
           ReadLinearRow<float>(e, y, uk, ck);
+        continue;
+      }
+      if (!e.code_u[0].empty()) {
+        ReadCodeRow(e, y, uk, ck);
         continue;
       }
       for (int x = 0; x < n3 / 3; ++x) {
@@ -397,7 +449,7 @@ struct MergeRows {
     std::fill_n(se, n3, 0.f);
     std::fill_n(lg, n3, 0.f);
     std::fill_n(fd, n3, 0.f);
-    // Pilot: over the well-exposed values (Exposure::WellExposed), sum u / sum exposure, the
+    // Pilot: over the well-exposed values (Exposure::floor_u), sum u / sum exposure, the
     // maximum-likelihood estimate under shot noise alone (weights = exposures). Longest first,
     // so the first unclipped value met is the longest exposure's (used where all are
     // near-black).

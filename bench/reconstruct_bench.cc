@@ -1,7 +1,9 @@
 // reconstruct_bench: how much the reconstruction costs on top of merely decoding the photos.
 // Per position, N runs (median): decode only, then the full per-position reconstruction
 // (decode, merge + remap + area average, fit, EXR write). Prints a table and the ratio
-// reconstruct / decode (target <= 1.25: the stage should be decode-bound), writes CSV.
+// reconstruct / decode (target <= 1.25: the stage should be decode-bound), writes CSV. Then the
+// same for camera photos of 6000 x 4000 with 3 exposures per slide, as JPEG, 16-bit TIFF and DNG
+// (bench/camera_dataset.h): decode, full time per position and their ratio per format.
 // Single-threaded by default (--threads 1); never asserted in tests.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <fstream>
 #include <opencv2/core.hpp>
 
+#include "camera_dataset.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
@@ -35,52 +38,10 @@ struct Row {
   int k = 0, f = 1, iterations = 0;
 };
 
-int RunBench(int argc, char** argv) {
-  std::string dataset_dir, out_dir = "/tmp/lumislab_reconstruct_bench", csv;
-  int runs = 5, threads = 1, resolution = 300, positions = 0, image_px = 2000;
-  CLI::App app{"reconstruct_bench: decode time vs full per-position reconstruction time"};
-  app.add_option("--dataset", dataset_dir,
-                 "dataset folder with calib/screen.json (default: make a synthetic 2x2 one)");
-  app.add_option("--out", out_dir, "scratch folder (slab written here)")->capture_default_str();
-  app.add_option("--csv", csv, "CSV output (default: <out>/reconstruct_bench.csv)");
-  app.add_option("--runs", runs, "runs per position (median)")->capture_default_str();
-  app.add_option("--threads", threads, "OpenCV threads")->capture_default_str();
-  app.add_option("--resolution", resolution, "slab resolution")->capture_default_str();
-  app.add_option("--positions", positions, "only the first N positions (0: all)");
-  app.add_option("--image-px", image_px, "synthetic dataset: photo size (square, 16-bit PNG)")
-      ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  if (runs < 1 || threads < 1) throw BadInput("--runs and --threads: expected >= 1");
-  cv::setNumThreads(threads);
-  MakeDirectories(out_dir);
-  if (dataset_dir.empty()) {
-    dataset_dir = out_dir + "/dataset";
-    std::filesystem::remove_all(dataset_dir);
-    testing::SyntheticOptions o;
-    o.nu = o.nv = 2;
-    o.screen_mm = 1200;
-    o.image_px = image_px;
-    o.px_per_mm = 0.9 * image_px / 1200.0;
-    o.perspective = 0.0002;
-    o.ext = ".png";
-    std::printf("making a synthetic dataset in %s (%dx%d 16-bit PNG)\n", dataset_dir.c_str(),
-                image_px, image_px);
-    testing::MakeSyntheticDataset(dataset_dir, o);
-  }
-  if (csv.empty()) csv = out_dir + "/reconstruct_bench.csv";
-  const Dataset dataset = Dataset::Load(dataset_dir);
-  const ScreenCalibration calibration = ScreenCalibration::Load(dataset_dir + "/calib/screen.json");
-  const SlabInfo info = SlabInfo::FromDataset(dataset, resolution);
-  const std::string slab_dir = out_dir + "/slab";
-  MakeDirectories(slab_dir);
-  ReconstructOptions options;
-  options.resolution = resolution;
-  options.Check();
-
+// Per position, `runs` times: decode only, then the full reconstruction with the EXR write.
+std::vector<Row> Measure(const Dataset& dataset, const ScreenCalibration& calibration,
+                         const SlabInfo& info, const ReconstructOptions& options,
+                         const std::string& slab_dir, int runs, int positions) {
   std::vector<Row> rows;
   for (int j = 0; j < dataset.grid.nv; ++j)
     for (int i = 0; i < dataset.grid.nu; ++i) {
@@ -117,6 +78,103 @@ int RunBench(int argc, char** argv) {
       rows.push_back(row);
     }
 
+  return rows;
+}
+
+// Decode vs full time per position for camera photos of each format (one position, brackets).
+void CameraFormats(const std::string& out_dir, int width, int height, int runs, int resolution,
+                   const std::string& formats) {
+  std::printf("\ncamera photos: %dx%d, 3 exposures per slide (6 photos per position), slab %d^2\n",
+              width, height, resolution);
+  std::printf("%-12s %10s %10s %10s %10s %7s %4s\n", "format", "MB/photo", "decode", "merge",
+              "full", "ratio", "F");
+  for (const auto format :
+       {bench::CameraFormat::kJpeg, bench::CameraFormat::kTiff16, bench::CameraFormat::kDng}) {
+    const char* key = format == bench::CameraFormat::kJpeg     ? "jpeg"
+                      : format == bench::CameraFormat::kTiff16 ? "tiff"
+                                                               : "dng";
+    if (formats.find(key) == std::string::npos) continue;
+    const std::string dir = out_dir + "/camera";
+    bench::MakeCameraDataset(dir, format, width, height);
+    const Dataset dataset = Dataset::Load(dir);
+    const ScreenCalibration calibration = ScreenCalibration::Load(dir + "/calib/screen.json");
+    const SlabInfo info = SlabInfo::FromDataset(dataset, resolution);
+    ReconstructOptions options;
+    options.resolution = resolution;
+    const std::string slab_dir = out_dir + "/camera_slab";
+    MakeDirectories(slab_dir);
+    const Row r = Measure(dataset, calibration, info, options, slab_dir, runs, 1).at(0);
+    const double mb =
+        double(std::filesystem::file_size(dataset.Path(dataset.photos[0].file))) / (1 << 20);
+    std::printf("%-12s %10.1f %10.1f %10.1f %10.1f %7.3f %4d\n", bench::CameraFormatName(format),
+                mb, 1e3 * r.decode, 1e3 * r.merge, 1e3 * r.total, r.total / r.decode, r.f);
+    std::filesystem::remove_all(dir);
+    std::filesystem::remove_all(slab_dir);
+  }
+  std::printf(
+      "(ms, medians; decode = decoding the position's 6 photos only; full = decode, merge, "
+      "rectify, fit and EXR write; target full / decode <= 1.25)\n");
+}
+
+int RunBench(int argc, char** argv) {
+  std::string dataset_dir, out_dir = "/tmp/lumislab_reconstruct_bench", csv;
+  int runs = 5, threads = 1, resolution = 300, positions = 0, image_px = 2000;
+  CLI::App app{"reconstruct_bench: decode time vs full per-position reconstruction time"};
+  app.add_option("--dataset", dataset_dir,
+                 "dataset folder with calib/screen.json (default: make a synthetic 2x2 one)");
+  app.add_option("--out", out_dir, "scratch folder (slab written here)")->capture_default_str();
+  app.add_option("--csv", csv, "CSV output (default: <out>/reconstruct_bench.csv)");
+  app.add_option("--runs", runs, "runs per position (median)")->capture_default_str();
+  app.add_option("--threads", threads, "OpenCV threads")->capture_default_str();
+  app.add_option("--resolution", resolution, "slab resolution")->capture_default_str();
+  app.add_option("--positions", positions, "only the first N positions (0: all)");
+  app.add_option("--image-px", image_px, "synthetic dataset: photo size (square, 16-bit PNG)")
+      ->capture_default_str();
+  int camera_w = 6000, camera_h = 4000;
+  bool no_camera = false;
+  std::string formats = "jpeg,tiff,dng";
+  app.add_option("--formats", formats, "camera photos: which formats (jpeg, tiff, dng)")
+      ->capture_default_str();
+  app.add_option("--camera-width", camera_w, "camera photos: width")->capture_default_str();
+  app.add_option("--camera-height", camera_h, "camera photos: height")->capture_default_str();
+  app.add_flag("--no-camera", no_camera, "skip the JPEG / TIFF / DNG camera photo table");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (runs < 1 || threads < 1) throw BadInput("--runs and --threads: expected >= 1");
+  if (camera_w < 64 || camera_h < 64 || camera_w > 20000 || camera_h > 20000 || camera_w % 2 ||
+      camera_h % 2)
+    throw BadInput("--camera-width, --camera-height: expected even sizes in [64, 20000]");
+  cv::setNumThreads(threads);
+  MakeDirectories(out_dir);
+  if (dataset_dir.empty()) {
+    dataset_dir = out_dir + "/dataset";
+    std::filesystem::remove_all(dataset_dir);
+    testing::SyntheticOptions o;
+    o.nu = o.nv = 2;
+    o.screen_mm = 1200;
+    o.image_px = image_px;
+    o.px_per_mm = 0.9 * image_px / 1200.0;
+    o.perspective = 0.0002;
+    o.ext = ".png";
+    std::printf("making a synthetic dataset in %s (%dx%d 16-bit PNG)\n", dataset_dir.c_str(),
+                image_px, image_px);
+    testing::MakeSyntheticDataset(dataset_dir, o);
+  }
+  if (csv.empty()) csv = out_dir + "/reconstruct_bench.csv";
+  const Dataset dataset = Dataset::Load(dataset_dir);
+  const ScreenCalibration calibration = ScreenCalibration::Load(dataset_dir + "/calib/screen.json");
+  const SlabInfo info = SlabInfo::FromDataset(dataset, resolution);
+  const std::string slab_dir = out_dir + "/slab";
+  MakeDirectories(slab_dir);
+  ReconstructOptions options;
+  options.resolution = resolution;
+  options.Check();
+
+  const std::vector<Row> rows =
+      Measure(dataset, calibration, info, options, slab_dir, runs, positions);
   std::printf(
       "\nreconstruct_bench: %s, %dx%d photos, slab %d^2, %d run(s) per position (median), "
       "%d thread(s)\n",
@@ -155,6 +213,7 @@ int RunBench(int argc, char** argv) {
       1e3 * Median(decodes), 1e3 * Median(totals), Median(ratios), Median(stage_ratios));
   WriteTextAtomically(csv, csv_text);
   std::printf("csv: %s\n", csv.c_str());
+  if (!no_camera) CameraFormats(out_dir, camera_w, camera_h, runs, resolution, formats);
   return 0;
 }
 

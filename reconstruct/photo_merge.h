@@ -1,7 +1,10 @@
 // Photos of one grid position -> one image of E = peak * scale * (E+ - E-) in photo pixel space.
-// Decoding and linearisation are lib/photo's (one decoder for every stage). Brackets: per slide
-// and channel, sum of values / sum of exposures over the exposures that are not saturated (an
-// exposure-weighted average of value / exposure).
+// Decoding and linearisation are lib/photo's (one decoder for every stage). Brackets (several
+// exposures of a slide) are merged per slide, pixel and channel into one linear radiance value
+// (docs/design.md §3.5 step 2): clipped values are left out, near-black values are left out when
+// a longer exposure measured the pixel, and the rest are averaged with the inverse-variance
+// weights of a sensor noise model (NoiseModel). The exposure ratios between brackets are
+// estimated from the pixels and reported against the recorded ones; optionally used.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -27,20 +30,75 @@ DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry,
 void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,
                      const std::string& calibration_file);
 
+// Noise of a recorded value u (linear, above black, in units of the white level: u = 1 at the
+// white level), the same for every photo of a slide:
+//   var(u) = u / full_well_e  +  (read_noise_e / full_well_e)^2  +  q(u)^2 / 12
+// shot noise (Poisson: the electron count's variance is the count), read noise (constant) and
+// the quantisation of the stored codes (q: the step between neighbouring codes at u, in u units;
+// 1/255 or 1/65535 of the range for linear photos, the sRGB curve's slope for sRGB-encoded 8-bit
+// photos, 0 for float photos). Only the ratio of the terms matters for the weights.
+struct NoiseModel {
+  double full_well_e = 20000;  // electrons at u = 1
+  double read_noise_e = 3;     // rms electrons
+};
+
+// How the exposures of a bracket are known: as recorded (dataset.json, from EXIF or the
+// manifest), or from the pixels: the ratio between consecutive exposures of a slide estimated
+// from the pixels well exposed in both, chained from the middle exposure, which keeps its
+// recorded value.
+enum class BracketRatios { kRecorded, kEstimated };
+
+struct MergeOptions {
+  NoiseModel noise;
+  // A value is near-black when it lies less than this many code steps above the black level
+  // (at the photo's bit depth, through its transfer curve), or less than 3 read-noise sigmas
+  // above it, whichever is larger. Near-black values are not used where a longer exposure of
+  // the slide measured the pixel; where every exposure is near-black the longest is used.
+  double near_black_codes = 4;
+  BracketRatios bracket_ratios = BracketRatios::kRecorded;
+  void Check() const;  // BadInput naming the field
+};
+
+// Consecutive exposures (shorter, longer) of one slide and their ratio.
+struct BracketRatio {
+  bool positive = true;                          // slide
+  double recorded_short = 1, recorded_long = 1;  // recorded exposures
+  double estimated = 1;   // longer / shorter from the pixels (the recorded ratio when samples = 0)
+  long long samples = 0;  // pixel channels well exposed in both that the estimate used
+  double Recorded() const { return recorded_long / recorded_short; }
+  double Deviation() const { return estimated / Recorded() - 1; }  // relative
+};
+// Too few pixels well exposed in both: the ratio is not estimated (the recorded one is used).
+constexpr long long kMinRatioSamples = 200;
+
 struct MergedPosition {
   // R, G, B = gain * (E+ - E-) at the photo pixels box-averaged `downsample` x `downsample`
   // (exact INTER_AREA on the top-left multiple of the factor). CV_32FC3 when no pixel is
   // saturated; otherwise CV_32FC4 with A > 0 wherever a saturated pixel contributed.
   cv::Mat signal;
-  int saturated_pixels = 0;  // pixels with a channel saturated in every exposure of a slide
-  bool fast_path = false;    // one exposure per slide, nothing saturated: merged after averaging
+  int saturated_pixels = 0;   // pixels with a channel clipped in every exposure of a slide
+  int near_black_pixels = 0;  // pixels with a channel near-black in every exposure of a slide
+  int exposures = 1;          // most photos of one slide
+  // Merged exposure-normalised slide values (both slides, all channels) that a well-exposed
+  // value measured: the brightest, the faintest > 0, and log2(brightest / faintest). 0 when
+  // not computed (fast path) or nothing was well exposed.
+  double brightest = 0, faintest = 0, dynamic_range_stops = 0;
+  std::vector<BracketRatio> ratios;  // consecutive exposures of each slide, shortest first
+  bool fast_path = false;  // one exposure per slide, nothing saturated: merged after averaging
 };
 
 // gain = filter peak * radiometric scale. Needs at least one photo of each slide.
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain,
-                             int downsample = 1);
+                             int downsample = 1, const MergeOptions& options = {});
 // The general path (brackets, saturation, 8-bit sRGB, black level), per pixel at full
-// resolution; the signal is CV_32FC4 with A = 1 where saturated.
-MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain);
+// resolution, box-averaged `downsample` x `downsample` in the same pass; the signal is
+// CV_32FC4 with A = the fraction of saturated pixels.
+MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain,
+                                   int downsample = 1, const MergeOptions& options = {});
+
+// The exposure ratios of each slide's consecutive exposures, estimated from the pixels
+// (median of the ratio of values well exposed in both, on a grid of at most ~2^18 pixels).
+std::vector<BracketRatio> EstimateBracketRatios(const std::vector<DecodedPhoto>& photos,
+                                                const MergeOptions& options = {});
 
 }  // namespace lumislab

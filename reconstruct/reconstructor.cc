@@ -24,6 +24,7 @@ void ReconstructOptions::Check() const {
   if (samples_per_texel < 0 || samples_per_texel > 64)
     throw BadInput("--samples-per-texel: expected 0 (auto) .. 64, got " +
                    std::to_string(samples_per_texel));
+  merge.Check();
 }
 
 std::vector<DecodedPhoto> DecodePosition(
@@ -82,8 +83,13 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   const std::optional<double> scale =
       options.radiometry ? options.radiometry->scale : dataset.radiometric_scale;
   const double gain = dataset.filter.peak * scale.value_or(1.0);
-  const MergedPosition merged = MergePosition(photos, gain, map.downsample);
+  const MergedPosition merged = MergePosition(photos, gain, map.downsample, options.merge);
   r.saturated_pixels = merged.saturated_pixels;
+  r.exposures = merged.exposures;
+  r.near_black_pixels = merged.near_black_pixels;
+  r.brightest = merged.brightest, r.faintest = merged.faintest;
+  r.dynamic_range_stops = merged.dynamic_range_stops;
+  r.bracket_ratios = merged.ratios;
   r.merge_s = SecondsSince(t1);
   t1 = std::chrono::steady_clock::now();
   // 3. Into the luminaire frame, area-averaged per texel.

@@ -21,6 +21,7 @@ struct ReconstructOptions {
   // calib/'s corrections and scale (LoadReconstructRadiometry); null: dataset.json's radiometry
   // only, no per-pixel correction.
   std::shared_ptr<const ReconstructRadiometry> radiometry;
+  MergeOptions merge;  // brackets: noise model, near-black floor, exposure ratios
   void Check() const;  // throws BadInput naming the option
 };
 
@@ -28,6 +29,12 @@ struct PositionReport {
   int i = 0, j = 0;
   int saturated_pixels = 0;  // photo pixels clipped in every exposure of a slide
   int saturated_texels = 0;  // texels dropped because a sample touched a saturated pixel
+  // Brackets (MergedPosition): exposures per slide, pixels near-black in every exposure of a
+  // slide, the merged image's dynamic range, the exposure ratios found in the pixels.
+  int exposures = 1;
+  int near_black_pixels = 0;
+  double brightest = 0, faintest = 0, dynamic_range_stops = 0;
+  std::vector<BracketRatio> bracket_ratios;
   int seen_texels = 0;
   int samples_per_texel = 0;
   int downsample = 1;  // photo box-averaged F x F before the remap

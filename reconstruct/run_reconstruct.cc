@@ -62,6 +62,39 @@ void CheckPhotosExist(const Dataset& dataset, const std::vector<Position>& todo)
   }
 }
 
+// What the merge of a bracket found: the dynamic range, the pixels no exposure measured well,
+// and how far the exposure ratios in the pixels are from the recorded ones (info above 1 %, a
+// warning above 5 %: EXIF shutter times are nominal, 1/30 s may be 1/32 s).
+void ReportBrackets(const Position& position, const PositionReport& r, const RunConfig& config) {
+  LogInfo("position ", Name(position), ": ", r.exposures, " exposures per slide merged, dynamic ",
+          "range ", r.dynamic_range_stops, " stops (", r.brightest, " / ", r.faintest, "), ",
+          r.saturated_pixels, " pixels clipped in every exposure (masked), ", r.near_black_pixels,
+          " near-black in every exposure");
+  const bool used = config.options.merge.bracket_ratios == BracketRatios::kEstimated;
+  for (const BracketRatio& b : r.bracket_ratios) {
+    std::ostringstream text;
+    text << "position " << Name(position) << " slide " << (b.positive ? "p" : "n") << ": exposures "
+         << b.recorded_short << " -> " << b.recorded_long << ": ratio ";
+    if (b.samples == 0) {
+      text << "not estimated (fewer than " << kMinRatioSamples
+           << " values well exposed in both); the recorded " << b.Recorded() << " is used";
+      LogInfo(text.str());
+      continue;
+    }
+    text << b.estimated << " in the pixels, " << b.Recorded() << " recorded ("
+         << 100 * b.Deviation() << " %, " << b.samples << " values); "
+         << (used ? "the estimate is used"
+                  : "the recorded one is used (--bracket-ratios estimated uses the estimate)");
+    const double deviation = std::abs(b.Deviation());
+    if (deviation > 0.05)
+      LogWarning(text.str());
+    else if (deviation > 0.01)
+      LogInfo(text.str());
+    else
+      LogDebug(text.str());
+  }
+}
+
 // Reconstructs one position and writes it into the slab.
 void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibration,
                      SlabWriter& writer, const Position& position, const RunConfig& config) {
@@ -83,6 +116,7 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
   else if (r.saturated_texels > 0)
     LogDebug("position ", Name(position), ": ", r.saturated_texels,
              " texels left out of the fit around hot pixels (mask 0)");
+  if (r.exposures > 1) ReportBrackets(position, r, config);
   LogDebug("position ", Name(position), ": seen ", r.seen_texels,
            " texels, K=", r.samples_per_texel, ", fit ", r.fit_iterations, " it (residual ",
            r.fit_residual, "), decode ", r.decode_s, " s, rectify ", r.rectify_s, " s, fit ",
@@ -259,6 +293,11 @@ std::string Parameters(const RunConfig& config) {
          << " lambda=" << config.options.lambda << " samples_per_texel="
          << (config.options.samples_per_texel ? std::to_string(config.options.samples_per_texel)
                                               : std::string("auto"))
+         << " bracket_ratios="
+         << (config.options.merge.bracket_ratios == BracketRatios::kEstimated ? "estimated"
+                                                                              : "recorded")
+         << " full_well=" << config.options.merge.noise.full_well_e
+         << " read_noise=" << config.options.merge.noise.read_noise_e
          << " watch=" << (config.watch ? "yes" : "no") << " force=" << (config.force ? "yes" : "no")
          << " threads=" << config.threads;
   return params.str();
@@ -286,6 +325,20 @@ int RunReconstruct(int argc, char** argv) {
   app.add_option("--samples-per-texel", config.options.samples_per_texel,
                  "K x K samples per texel (0: automatic, as dense as the photo pixels)")
       ->capture_default_str();
+  std::string bracket_ratios = "recorded";
+  app.add_option("--bracket-ratios", bracket_ratios,
+                 "exposure brackets: 'recorded' divides by the exposures in dataset.json (EXIF "
+                 "or manifest), 'estimated' by the ratios between consecutive exposures measured "
+                 "in the pixels well exposed in both (the middle exposure keeps its recorded "
+                 "value); both report the difference")
+      ->check(CLI::IsMember({"recorded", "estimated"}))
+      ->capture_default_str();
+  app.add_option("--full-well", config.options.merge.noise.full_well_e,
+                 "brackets' noise model: electrons at the white level (shot noise)")
+      ->capture_default_str();
+  app.add_option("--read-noise", config.options.merge.noise.read_noise_e,
+                 "brackets' noise model: read noise in electrons rms")
+      ->capture_default_str();
   app.add_option("--poll", config.poll_s, "--watch: polling interval in seconds")
       ->capture_default_str();
   app.add_option("--idle-timeout", config.idle_timeout_s,
@@ -293,6 +346,8 @@ int RunReconstruct(int argc, char** argv) {
       ->capture_default_str();
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   config.threads = StartTool("reconstruct", common);
+  config.options.merge.bracket_ratios =
+      bracket_ratios == "estimated" ? BracketRatios::kEstimated : BracketRatios::kRecorded;
   config.options.Check();
   if (!(config.poll_s > 0 && config.poll_s <= 60))
     throw BadInput("--poll: expected seconds in (0, 60], got " + std::to_string(config.poll_s));

@@ -1278,7 +1278,7 @@ std::vector<Case> SlabCases() {
       P("resolution_huge").Do(SetJson(j, "/resolution", {100000, 40})).Names({j, "resolution"}));
   v.push_back(
       P("resolution_not_files").Do(SetJson(j, "/resolution", {60, 60})).Names({"ds/slab/pos_"}));
-  v.push_back(P("units_lux").Do(SetJson(j, "/units", "lux")).Names({j, "units"}));
+  v.push_back(P("units_candela").Do(SetJson(j, "/units", "cd")).Names({j, "units"}));
   v.push_back(P("distance_zero").Do(SetJson(j, "/distance_mm", 0)).Names({j, "distance_mm"}));
   v.push_back(
       P("distance_nan_string").Do(SetJson(j, "/distance_mm", "NaN")).Names({j, "distance_mm"}));

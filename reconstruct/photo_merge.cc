@@ -244,15 +244,14 @@ struct Exposure {
     read_var = float(std::pow(noise.read_noise_e / noise.full_well_e, 2));
     // n codes above black (the curve's slope at black: exact for sRGB up to code 10), or three
     // read-noise sigmas, whichever is larger.
-    const ResponseCurve* response =
-        transfer == Transfer::kResponse && photo.spec.corrections
-            ? photo.spec.corrections->response.get()
-            : nullptr;
+    const ResponseCurve* response = transfer == Transfer::kResponse && photo.spec.corrections
+                                        ? photo.spec.corrections->response.get()
+                                        : nullptr;
     auto slope = [&](float l) {
       return response ? ResponseSlope(*response, l) : TransferSlope(transfer, l);
     };
-    floor_u = std::max(float(near_black_codes) * code_step * slope(black),
-                       3.f * std::sqrt(read_var));
+    floor_u =
+        std::max(float(near_black_codes) * code_step * slope(black), 3.f * std::sqrt(read_var));
     for (int k = 0; k < kQuantTable; ++k) {
       const float q = code_step * slope(float(k) / (kQuantTable - 1));
       quant_var[k] = q * q / 12;

@@ -232,9 +232,7 @@ TEST(Radiometry, ScaleMatchesTruthAndRefusesBadReadings) {
   WriteTrueScreen(ds);
   // The point's value from the default quadratic fit over 6 px: the slide's pattern curves
   // within a few pixels of this small camera (a plain 3 x 3 mean read 0.5 % low there).
-  ASSERT_EQ(Calibrate("scale --dataset " + ds + " --reference " + ds +
-                      "/truth/reference.json"),
-            0);
+  ASSERT_EQ(Calibrate("scale --dataset " + ds + " --reference " + ds + "/truth/reference.json"), 0);
   const RadiometricScale scale = LoadRadiometricScale(ds + "/calib/scale.json");
   const double truth =
       JsonDocument::Load(ds + "/dataset.json").root()["radiometry"]["scale_w_m2"].Number();
@@ -283,9 +281,8 @@ SlabComparison ChainRow(const std::string& ds, bool response, const std::string&
   for (const std::string& step : steps) {
     const auto r = RunTool(
         "lumislab-calibrate",
-        step == "scale"
-            ? "scale --dataset " + ds + " --reference " + ds + "/truth/reference.json"
-            : step + " --dataset " + ds + FramesOf(ds, step));
+        step == "scale" ? "scale --dataset " + ds + " --reference " + ds + "/truth/reference.json"
+                        : step + " --dataset " + ds + FramesOf(ds, step));
     EXPECT_EQ(r.exit_code, 0) << r.output;
   }
   const auto r = RunTool("lumislab-reconstruct", "--dataset " + ds + " --resolution 40 --force");

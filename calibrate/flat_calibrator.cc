@@ -81,9 +81,10 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
     for (int c = 0; c < 3; ++c) {
       const double m = sum[p * 3 + c] / frames_n;
       double g = m / mean[c];
-      // The reader refuses gains outside [1e-3, 1e3]; a pixel that dark is not worth dividing.
-      if (!(g >= 1e-3 && g <= 1e3))
-        g = std::clamp(std::isfinite(g) ? g : 1.0, 1e-3, 1e3), ++clamped;
+      // Vignetting and a screen's non-uniformity stay within a factor of a few; a gain below
+      // 1/20 or above 20 is a defective pixel (dead, or dark-subtracted to nothing), and
+      // dividing by it would multiply the pixel's error into the photos: it keeps gain 1.
+      if (!(g >= 0.05 && g <= 20)) g = 1.0, ++clamped;
       map.gain.data[p * 3 + c] = float(g);
       lo = std::min(lo, g), hi = std::max(hi, g);
       if (frames.size() >= 2 && m > 0) {

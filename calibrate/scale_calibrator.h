@@ -33,7 +33,7 @@ std::string CanonicalUnit(const std::string& unit, const std::string& where);
 struct ScaleOptions {
   // Pixels within this distance of the point give the quadratic fit its value at the point
   // (at least 2: six coefficients).
-  int radius_px = 6;
+  int radius_px = 3;
 };
 
 // scale = (reading_p - reading_n) / (Y+ - Y-), Y the Rec. 709 luminance of the position's

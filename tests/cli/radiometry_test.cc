@@ -230,7 +230,7 @@ TEST(Radiometry, ScaleMatchesTruthAndRefusesBadReadings) {
   const std::string ds = Synth("radiometry_scale", R"([{"type": "ambient", "level": 0.05}])",
                                R"({"reference": {"position": [1, 1], "point_mm": [0, 0]}})");
   WriteTrueScreen(ds);
-  // The point's value from the default quadratic fit over 6 px: the slide's pattern curves
+  // The point's value from the default quadratic fit over 3 px: the slide's pattern curves
   // within a few pixels of this small camera (a plain 3 x 3 mean read 0.5 % low there).
   ASSERT_EQ(Calibrate("scale --dataset " + ds + " --reference " + ds + "/truth/reference.json"), 0);
   const RadiometricScale scale = LoadRadiometricScale(ds + "/calib/scale.json");

@@ -161,7 +161,7 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   const auto rows = Evidence("JPEG camera", {"response", "dark", "flat", "scale"});
   ASSERT_EQ(rows.size(), 5u);
   ASSERT_EQ(rows[0].positions.size(), 9u);
-  // Issue 8 asks for 1 %; this JPEG chain reaches 1.1 % overall (1.2 % worst position), the
+  // Issue 8 asks for 1 % per position; this JPEG chain reaches 1.0 % overall (1.1 % worst), the
   // true curve instead of the recovered one 0.9 %. What is left: the response recovered through
   // the residual dark offset (Debevec assumes code = f(E t); an offset that does not scale with
   // t bends the low codes by ~6 % at code 48) and JPEG's compression error in the flat and the

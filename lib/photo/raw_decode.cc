@@ -2,6 +2,7 @@
 
 #include <libraw.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <ctime>
@@ -128,10 +129,17 @@ RawImage DecodeRaw(const std::string& path, bool half_size) {
     for (int y = 0; y < h / 2; ++y)
       for (int x = 0; x < w / 2; ++x) {
         float sum[3] = {0, 0, 0};
+        bool clipped[3] = {false, false, false};
         for (int dy = 0; dy < 2; ++dy)
-          for (int dx = 0; dx < 2; ++dx)
-            sum[pattern[dy][dx]] += mosaic.at<float>(2 * y + dy, 2 * x + dx);
-        image.rgb.at<cv::Vec3f>(y, x) = cv::Vec3f(sum[0], sum[1] / 2, sum[2]);
+          for (int dx = 0; dx < 2; ++dx) {
+            const float v = mosaic.at<float>(2 * y + dy, 2 * x + dx);
+            sum[pattern[dy][dx]] += v;
+            clipped[pattern[dy][dx]] |= v >= 1.f;
+          }
+        cv::Vec3f rgb(sum[0], sum[1] / 2, sum[2]);
+        for (int c = 0; c < 3; ++c)
+          if (clipped[c]) rgb[c] = std::max(rgb[c], 1.f);  // a clipped sample clips the mean
+        image.rgb.at<cv::Vec3f>(y, x) = rgb;
       }
     return image;
   }
@@ -140,15 +148,23 @@ RawImage DecodeRaw(const std::string& path, bool half_size) {
     for (int x = 0; x < w; ++x) {
       float sum[3] = {0, 0, 0};
       int count[3] = {0, 0, 0};
+      bool clipped[3] = {false, false, false};
       for (int yy = std::max(y - 1, 0); yy <= std::min(y + 1, h - 1); ++yy)
         for (int xx = std::max(x - 1, 0); xx <= std::min(x + 1, w - 1); ++xx) {
           const int c = pattern[yy & 1][xx & 1];
-          sum[c] += mosaic.at<float>(yy, xx);
+          const float v = mosaic.at<float>(yy, xx);
+          sum[c] += v;
+          clipped[c] |= v >= 1.f;
           ++count[c];
         }
       cv::Vec3f& out = image.rgb.at<cv::Vec3f>(y, x);
       const int own = pattern[y & 1][x & 1];
-      for (int c = 0; c < 3; ++c) out[c] = c == own ? mosaic.at<float>(y, x) : sum[c] / count[c];
+      for (int c = 0; c < 3; ++c) {
+        out[c] = c == own ? mosaic.at<float>(y, x) : sum[c] / count[c];
+        // An interpolated value that used a clipped sample is unknown, not a darker one: it
+        // counts as clipped too (at the white level, 1), so the merge leaves it out.
+        if (c != own && clipped[c]) out[c] = std::max(out[c], 1.f);
+      }
     }
   return image;
 }

@@ -159,6 +159,41 @@ TEST(Raw, AsShotWhiteBalanceAppliesMultipliersAfterClipping) {
             << ", max relative error " << max_error << "\n";
 }
 
+// A clipped sample leaves the values interpolated from it unknown: the demosaic flags them as
+// clipped (a hot or saturated red site at (4, 4) spoils the red of its 8 neighbours, which
+// otherwise read as a plausible, too dark value and passed into the merge).
+TEST(Raw, DemosaicedValuesFromAClippedSampleCountAsClipped) {
+  const std::string dir = ScratchDir();
+  cv::Mat mosaic = TruthMosaic();
+  mosaic.at<uint16_t>(4, 4) = kWhite;  // red site (even row, even column)
+  const Photo photo = DecodePhoto(WriteTruthDng(dir, mosaic));
+  const LinearReader reader(photo);
+  int clipped_red = 0, clipped_other = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      float rgb[3];
+      bool clipped[3];
+      reader.Read(y, x, rgb, clipped);
+      const bool near = std::abs(x - 4) <= 1 && std::abs(y - 4) <= 1;
+      EXPECT_EQ(clipped[0], near) << "red at " << x << "," << y;
+      clipped_red += clipped[0];
+      clipped_other += clipped[1] + clipped[2];
+    }
+  EXPECT_EQ(clipped_red, 9);
+  EXPECT_EQ(clipped_other, 0);  // green and blue did not use the site
+  // Half size: the quad holding the site has its red clipped, no other quad.
+  PhotoSpec half;
+  half.raw_half_size = true;
+  const Photo quads = DecodePhoto(WriteTruthDng(dir, mosaic), half);
+  const LinearReader quad_reader(quads);
+  float rgb[3];
+  bool clipped[3];
+  quad_reader.Read(2, 2, rgb, clipped);
+  EXPECT_TRUE(clipped[0]);
+  quad_reader.Read(2, 3, rgb, clipped);
+  EXPECT_FALSE(clipped[0]);
+}
+
 // Sets a LONG value held in IFD0 (little-endian TIFF) and returns the old one.
 uint32_t PatchLong(std::string& bytes, uint16_t tag, uint32_t value);
 

@@ -321,6 +321,7 @@ std::vector<double> EvidenceRows(const std::string& ds, const std::string& title
 
 // A JPEG camera: a response curve unlike sRGB, brackets, a dark level with hot pixels.
 TEST(Radiometry, EvidenceResponseAndDark) {
+  if (testing::kSanitized) GTEST_SKIP() << "accuracy run (several chains): the Release build's";
   const std::string ds =
       Synth("radiometry_chain_jpeg",
             R"([{"type": "dark", "black_level": 0.005, "dark_current": 0.01, "hot_fraction": 0.001,
@@ -352,6 +353,7 @@ TEST(Radiometry, EvidenceResponseAndDark) {
 // that dataset.json does not record, dark current and hot pixels; flats taken dim, where the
 // dark signal is a third of the light.
 TEST(Radiometry, EvidenceDarkFlatScale) {
+  if (testing::kSanitized) GTEST_SKIP() << "accuracy run (several chains): the Release build's";
   const std::string ds =
       Synth("radiometry_chain_linear",
             R"([{"type": "screen_gain", "amplitude": 0.15, "seed": 2},

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "calibrate/camera_projection_cost.h"
+#include "calibrate/ceres_options.h"
 #include "core/error.h"
 
 namespace lumislab {
@@ -86,14 +87,9 @@ CameraRefinement RefineCamera(const std::vector<CameraViewData>& views,
     }
   }
 
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_SCHUR;  // poses eliminated first
-  solver.max_num_iterations = options.max_iterations;
-  solver.num_threads = options.threads;
-  solver.function_tolerance = 1e-14;
-  solver.gradient_tolerance = 1e-14;
-  solver.parameter_tolerance = 1e-12;
-  solver.logging_type = ceres::SILENT;
+  // DENSE_SCHUR: the poses are eliminated first.
+  const ceres::Solver::Options solver =
+      RefinerSolverOptions(ceres::DENSE_SCHUR, options.max_iterations, options.threads);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   if (!summary.IsSolutionUsable())

@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "calibrate/ceres_options.h"
 #include "calibrate/homography_distortion_cost.h"
 #include "core/error.h"
 
@@ -89,14 +90,8 @@ RefinementResult RefineScreenMapping(const std::vector<Eigen::Vector2d>& pixels,
     problem.SetManifold(dist, new ceres::SubsetManifold(2, {1}));
   }
 
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = options.max_iterations;
-  solver.num_threads = options.threads;
-  solver.function_tolerance = 1e-14;
-  solver.gradient_tolerance = 1e-14;
-  solver.parameter_tolerance = 1e-12;
-  solver.logging_type = ceres::SILENT;
+  const ceres::Solver::Options solver =
+      RefinerSolverOptions(ceres::DENSE_QR, options.max_iterations, options.threads);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
 

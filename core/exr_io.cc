@@ -9,6 +9,7 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -120,6 +121,11 @@ bool CheckExrHeader(const std::string& path, bool strict) {
   for (int part = 0;; ++part) {
     std::string name, type;
     int attributes = 0;
+    // What OpenEXR sizes its buffers by when it opens the file, checked after the part's header.
+    int64_t window[4] = {0, 0, -1, -1};  // dataWindow xMin, yMin, xMax, yMax
+    bool has_window = false;
+    int compression = 0, channels = 0;
+    int64_t tile_x = 0, tile_y = 0;  // 0: scan lines
     for (;; ++attributes) {
       if (!read_string(&name)) return fail("an attribute name that does not end in time");
       if (name.empty()) break;  // end of this part's header
@@ -134,19 +140,30 @@ bool CheckExrHeader(const std::string& path, bool strict) {
       if (fixed >= 0 && size != fixed)
         return fail(what + "a " + type + " of " + std::to_string(fixed) + " bytes, stated as " +
                     std::to_string(size));
+      if (name == "dataWindow" && type == "box2i") {
+        for (int64_t& v : window)
+          if (!read_int(&v)) return fail(what + "shorter than its 16 bytes");
+        has_window = true;
+      } else if (name == "compression" && type == "compression") {
+        compression = in.get();
+      } else if (name == "tiles" && type == "tiledesc") {
+        if (!read_int(&tile_x) || !read_int(&tile_y)) return fail(what + "shorter than 9 bytes");
+        tile_x = uint32_t(tile_x), tile_y = uint32_t(tile_y);  // unsigned in the file
+      }
       if (type == "chlist") {  // channels up to an empty name, 16 bytes after each name
         std::string channel;
         do {
           if (!read_string(&channel, 255)) return fail(what + "a channel name that does not end");
-          if (!channel.empty()) in.seekg(16, std::ios::cur);
+          if (!channel.empty()) in.seekg(16, std::ios::cur), ++channels;
         } while (!channel.empty() && in && in.tellg() - value_start <= size);
         if (!in || in.tellg() - value_start != size)
           return fail(what + "a channel list that does not fill its " + std::to_string(size) +
                       " bytes");
       } else if (type == "preview") {  // width, height, then width x height RGBA bytes
         int64_t width = 0, height = 0;
+        // Each side at most the size first, so that the product cannot overflow.
         if (size < 8 || !read_int(&width) || !read_int(&height) || width < 0 || height < 0 ||
-            8 + 4 * width * height != size)
+            width > size || height > size || 8 + 4 * width * height != size)
           return fail(what + "a preview image whose pixels are not its " + std::to_string(size) +
                       " bytes");
       } else if (type == "stringvector") {  // strings of int32 length each, within the size
@@ -160,6 +177,34 @@ bool CheckExrHeader(const std::string& path, bool strict) {
         }
       }
       in.seekg(value_start + size);
+    }
+    if (attributes > 0) {
+      // OpenEXR allocates a line or tile buffer (and an offset table) from these before reading
+      // a pixel: a 1 KB file claiming a 2^31-wide window made it allocate and clear gigabytes
+      // (found by fuzz_slab_position). Bound them by what lumislab reads: at most 2^15 pixels a
+      // side, kMaxExrPixels in all, and a decode buffer of at most 256 MiB.
+      if (!has_window) return fail("no dataWindow");
+      const int64_t width = window[2] - window[0] + 1, height = window[3] - window[1] + 1;
+      if (width <= 0 || height <= 0 || width > 1 << 15 || height > 1 << 15 ||
+          width * height > kMaxExrPixels)
+        return fail("dataWindow of " + std::to_string(width) + " x " + std::to_string(height) +
+                    " pixels, not within 1 .. 32768 a side and " + std::to_string(kMaxExrPixels) +
+                    " in all");
+      // Scan lines per compressed block, by OpenEXR's compression codes (NO, RLE, ZIPS: 1; ZIP,
+      // PXR24: 16; PIZ, B44, B44A, DWAA: 32; DWAB: 256).
+      static const int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+      const int64_t lines = compression >= 0 && compression < 10 ? kLines[compression] : 256;
+      const int64_t block = tile_x > 0 || tile_y > 0 ? std::min<int64_t>(tile_x, width) *
+                                                           std::min<int64_t>(tile_y, height)
+                                                     : width * std::min(lines, height);
+      if (tile_x < 0 || tile_y < 0 || ((tile_x > 0 || tile_y > 0) && (tile_x == 0 || tile_y == 0)))
+        return fail("a tile size of " + std::to_string(tile_x) + " x " + std::to_string(tile_y));
+      if (tile_x > 0 && (width + tile_x - 1) / tile_x * ((height + tile_y - 1) / tile_y) > 1 << 20)
+        return fail("more than 2^20 tiles of " + std::to_string(tile_x) + " x " +
+                    std::to_string(tile_y));
+      if (block * std::max(channels, 1) * 4 > int64_t(256) << 20)
+        return fail(std::to_string(channels) + " channels of " + std::to_string(width) +
+                    " pixels a line: a decode buffer over 256 MiB");
     }
     // A single part ends with its header; multipart headers end with an empty one.
     if (!multipart || attributes == 0) break;

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -178,7 +180,8 @@ TEST_F(IoTest, ExrHeaderClaimingAHugeImageIsRefusedBeforeAllocating) {
     ADD_FAILURE() << "accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.exit_code(), 2);
-    EXPECT_NE(std::string(e.what()).find("huge.exr: dataWindow: expected an image of at most"),
+    EXPECT_NE(std::string(e.what()).find("huge.exr: not a readable EXR file: header: dataWindow "
+                                         "of 32768 x 32768 pixels"),
               std::string::npos)
         << e.what();
   }
@@ -219,6 +222,42 @@ TEST_F(IoTest, ExrAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
 }
 
+// Found by fuzz_slab_position in CI: a data window tens of millions of pixels wide made OpenEXR's
+// InputFile allocate and clear a line buffer of gigabytes before ReadExr could check the size
+// (OpenEXR itself refuses only windows near 2^31).
+// The header walk bounds the window, and the decode buffer it implies, first.
+TEST_F(IoTest, ExrDataWindowTensOfMillionsWideIsRefusedBeforeOpenExrAllocates) {
+  const std::string path = (dir_ / "window.exr").string();
+  WriteExr(path, ImageF(4, 3, 1), {"Y"});
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string key("dataWindow\0box2i\0\x10\0\0\0", 21);
+  const size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const int32_t window[4] = {-(1 << 25), 0, (1 << 25) - 1, 0};  // 2^26 wide, 1 high
+  std::memcpy(&bytes[at + key.size()], window, sizeof window);  // little-endian, as EXR is
+  std::ofstream(path, std::ios::binary) << bytes;
+  const auto start = std::chrono::steady_clock::now();
+  for (const auto& read : std::vector<std::function<void()>>{[&] { ReadExr(path, {"Y"}); },
+                                                             [&] { ExrChannelNames(path); }}) {
+    try {
+      read();
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.exit_code(), 2);
+      EXPECT_NE(std::string(e.what()).find("window.exr: not a readable EXR file: header: "
+                                           "dataWindow of 67108864 x 1 pixels"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_FALSE(ExrComplete(path, 4, 3));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
+}
+
 // Found by fuzz_slab_position in CI: a channel list running past its stated size makes OpenEXR
 // read the rest of the header from another place than the size says, where a string attribute
 // claims 1.7 GB. The header walk reads a channel list as OpenEXR does and refuses it.
@@ -238,6 +277,24 @@ TEST_F(IoTest, ExrChannelListRunningPastItsSizeIsRefused) {
   }
   EXPECT_FALSE(ExrComplete(path, 8, 6));
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
+}
+
+// Found by fuzz_slab_position: a preview attribute whose width times height overflowed 64 bits
+// in the header walk's own size check (undefined behaviour, caught by UBSan).
+TEST_F(IoTest, ExrPreviewOfOverflowingSizeIsRefused) {
+  const std::string path =
+      std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/hostile/exr_preview_size_overflow.exr";
+  try {
+    ExrChannelNames(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_NE(std::string(e.what()).find("exr_preview_size_overflow.exr: not a readable EXR "
+                                         "file: header: attribute channels: a preview image"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(ExrComplete(path, 8, 6));
 }
 
 TEST_F(IoTest, TemporaryNamesFitAndOrphansOfDeadProcessesAreRemoved) {

@@ -204,6 +204,8 @@ struct Exposure {
   float black = 0, range = 1;  // curve value = u * range + black
   static constexpr int kQuantTable = 1025;
   std::array<float, kQuantTable> quant_var{};  // q^2 / 12 at curve value k / (kQuantTable - 1)
+  // The table varies (sRGB, or a calibrated response curve); otherwise entry 0 holds for all.
+  bool curved = false;
 
   explicit Exposure(const DecodedPhoto& p, const NoiseModel& noise, double near_black_codes)
       : reader(p.photo) {
@@ -252,6 +254,7 @@ struct Exposure {
     };
     floor_u =
         std::max(float(near_black_codes) * code_step * slope(black), 3.f * std::sqrt(read_var));
+    curved = transfer == Transfer::kSrgb || response != nullptr;
     for (int k = 0; k < kQuantTable; ++k) {
       const float q = code_step * slope(float(k) / (kQuantTable - 1));
       quant_var[k] = q * q / 12;
@@ -261,7 +264,7 @@ struct Exposure {
   // the curve value (1/1024 steps: the weights need not be exact, and a pow per value and
   // exposure would cost more than decoding the photo).
   float Variance(float u, float inv_full_well) const {
-    if (transfer != Transfer::kSrgb) return u * inv_full_well + read_var + quant_var[0];
+    if (!curved) return u * inv_full_well + read_var + quant_var[0];
     const float l = u * range + black;  // NaN (an unused lane of the merge) reads entry 0
     const int k = l >= 1.f ? kQuantTable - 1 : l > 0.f ? int(l * (kQuantTable - 1) + 0.5f) : 0;
     return u * inv_full_well + read_var + quant_var[k];
@@ -515,7 +518,7 @@ struct MergeRows {
           swx[i] += well ? w_over_e * uk[i] : 0.f;
         }
       };
-      if (e.transfer == Transfer::kSrgb)
+      if (e.curved)
         accumulate([&](float u_expected) { return e.Variance(u_expected, inv_full_well); });
       else  // the quantisation term is a constant: Variance without the table
         accumulate([&](float u_expected) { return u_expected * inv_full_well + constant; });

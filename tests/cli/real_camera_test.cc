@@ -161,11 +161,11 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   const auto rows = Evidence("JPEG camera", {"response", "dark", "flat", "scale"});
   ASSERT_EQ(rows.size(), 5u);
   ASSERT_EQ(rows[0].positions.size(), 9u);
-  // Issue 8 asks for 1 % per position; this JPEG chain reaches 1.0 % overall (1.1 % worst), the
-  // true curve instead of the recovered one 0.9 %. What is left: the response recovered through
-  // the residual dark offset (Debevec assumes code = f(E t); an offset that does not scale with
-  // t bends the low codes by ~6 % at code 48) and JPEG's compression error in the flat and the
-  // slide photos. Held at 1.5 % so that a regression shows; the DNG chain below holds 1 %.
+  // Issue 8 asks for 1 % per position; this JPEG chain reaches 0.99 % overall (1.11 % worst),
+  // and the true curve instead of the recovered one only 0.94 % (1.03 % worst): the floor is the
+  // 8-bit rounding of these noise-free photos and JPEG's compression error (docs/design.md
+  // §5.16), not the curve. Held at 1.5 % so that a regression shows; the DNG chain below holds
+  // 1 %.
   for (const auto& p : rows[0].positions)
     EXPECT_LE(p.relative_l2, 0.015) << "position " << p.i << "," << p.j;
   // Each correction matters; the dark map least here (1.3 % without it): the dark signal is

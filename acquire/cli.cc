@@ -57,6 +57,11 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
                 "write the capture as a camera leaves it: camera/IMG_0001.TIF (JPG with a "
                 "response, DNG with raw) ... in capture order with EXIF, camera/BOARD.PNG, "
                 "setup.json and truth/, no dataset.json (acquire import makes it)");
+  cmd->add_option("--calibration-views", o.calibration_views,
+                  "also write N photos of a free-standing 9x6 chessboard (30 mm squares) in "
+                  "varied poses, for lumislab-calibrate camera, into calibration/camera/")
+      ->check(CLI::Range(0, kMaxCalibrationViews))
+      ->capture_default_str();
   cmd->add_flag("--print-scene", c->print_scene,
                 "print the scene as JSON (the built-in one for --scene default) and exit");
   AddCommonOptions(cmd, common);
@@ -215,7 +220,7 @@ int RunSynthCommand(SynthOptions synth, int threads) {
          << (synth.interval_s >= 0 ? std::to_string(synth.interval_s) + " s" : "none")
          << " force=" << (synth.force ? "yes" : "no") << " photo_format=" << synth.photo_format
          << " camera_folder=" << (synth.camera_folder ? "yes" : "no")
-         << " threads=" << synth.threads;
+         << " calibration_views=" << synth.calibration_views << " threads=" << synth.threads;
   LogInfo("parameters: ", params.str());
   const StopSignalScope stop_signals;  // Ctrl-C: finish the photos in hand, then stop
   const SynthReport r = RunSynth(synth);

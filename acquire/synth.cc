@@ -52,6 +52,9 @@ void SynthOptions::Check() const {
   ResolveThreads(threads);  // BadInput naming --threads when out of range
   if (photo_format != "half" && photo_format != "float")
     throw BadInput("--photo-format: expected half or float, got " + photo_format);
+  if (calibration_views < 0 || calibration_views > kMaxCalibrationViews)
+    throw BadInput("--calibration-views: expected 0 .. " + std::to_string(kMaxCalibrationViews) +
+                   ", got " + std::to_string(calibration_views));
   if (truth_resolution < 1 || truth_resolution > kMaxSlabResolution)
     throw BadInput("--truth-resolution: expected 1 .. " + std::to_string(kMaxSlabResolution) +
                    ", got " + std::to_string(truth_resolution));
@@ -184,6 +187,7 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
   WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
                  dir + "/truth", threads);
   WriteCalibrationCaptures(scene, dataset, dir, store, threads);  // scene.captures only
+  WriteCameraViews(scene, dataset, dir, store, options.calibration_views, threads);
   return CapturePositions(scene, dataset, dir, options, store, threads);
 }
 
@@ -193,8 +197,13 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
   options.Check();
   SynthReport report;
   const std::string& out = options.out_dir;
+  PhotoStore store;
+  store.encoding = SlidePhotoEncoding(scene, options);
+  store.jpeg_quality = scene.Response() ? scene.Response()->quality() : 95;
+  store.camera_folder = options.camera_folder;
   if (!options.force &&
-      (options.camera_folder ? CameraFolderComplete(scene, out) : DatasetComplete(out))) {
+      (options.camera_folder ? CameraFolderComplete(scene, out) : DatasetComplete(out)) &&
+      CameraViewsComplete(scene, store, out, options.calibration_views)) {
     LogInfo("a complete dataset is already in ", out, " (use --force to redo it)");
     report.skipped = true;
     return report;
@@ -206,10 +215,6 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
     dataset.calibration.photo = std::string(kCameraFolder) + "/" + kCameraBoardPhoto;
   dataset.radiometric_scale = ChooseRadiometricScale(scene, threads);
   report.radiometric_scale = *dataset.radiometric_scale;
-  PhotoStore store;
-  store.encoding = SlidePhotoEncoding(scene, options);
-  store.jpeg_quality = scene.Response() ? scene.Response()->quality() : 95;
-  store.camera_folder = options.camera_folder;
   LogInfo("scene ", scene.source, ": ", scene.grid.nu, "x", scene.grid.nv, " positions, ",
           scene.camera.width, "x", scene.camera.height, " px photos (", StoreName(scene, store),
           options.camera_folder ? ", a camera folder" : "", "), radiometric scale ",

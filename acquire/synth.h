@@ -10,6 +10,8 @@
 
 namespace lumislab {
 
+constexpr int kMaxCalibrationViews = 100;
+
 struct SynthOptions {
   std::string scene = "default";  // scene file or "default"
   std::string out_dir;
@@ -24,6 +26,8 @@ struct SynthOptions {
   // The capture as a camera leaves it (acquire/photo_store.h): camera/IMG_0001.<EXT> ... with
   // EXIF, camera/BOARD.PNG, setup.json and truth/, no dataset.json (`acquire import` makes it).
   bool camera_folder = false;
+  // Photos of a free-standing board for lumislab-calibrate camera (calibration/camera/).
+  int calibration_views = 0;
 
   void Check() const;  // BadInput naming the option
 };

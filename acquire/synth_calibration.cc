@@ -1,6 +1,8 @@
 #include "acquire/synth_calibration.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
@@ -9,6 +11,7 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "lib/synthetic/calibration_captures.h"
+#include "lib/synthetic/camera_views.h"
 
 namespace lumislab {
 namespace {
@@ -104,6 +107,66 @@ void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
   WriteJsonAtomically(dir + "/calibration/captures.json", manifest);
   LogInfo("calibration captures: ", frames.size(),
           " frame(s) in calibration/ (listed in calibration/captures.json)");
+}
+
+std::string CameraViewFile(const SynthScene& scene, const PhotoStore& store, int k) {
+  return Numbered("calibration/camera/view", k, StoredExtension(scene, store));
+}
+
+void WriteCameraViews(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
+                      const PhotoStore& store, int count, int threads) {
+  if (count <= 0) return;
+  MakeDirectories(dir + "/calibration/camera");
+  RemoveOrphanedTemporaries(dir + "/calibration/camera");
+  const std::vector<BoardPose> poses = CameraViewPoses(scene, count);
+  // Noise streams after the slide photos' and the calibration captures'.
+  const int first_index =
+      int(dataset.photos.size()) +
+      (scene.captures ? int(FrameList(scene, StoredExtension(scene, store)).size()) : 0);
+  nlohmann::json views = nlohmann::json::array();
+  for (int k = 0; k < count; ++k) {
+    const ImageF board = RenderCameraView(scene, poses[k], threads);
+    ImageF photo(board.width, board.height, 3);
+    for (size_t p = 0; p < board.data.size(); ++p)
+      for (int c = 0; c < 3; ++c) photo.data[p * 3 + c] = board.data[p];
+    PhotoContext context;
+    context.photo_index = first_index + k;
+    context.exposure = scene.camera.exposure;
+    ApplyCaptureEffects(scene, CaptureKind::kCameraView, context, &photo);
+    const std::string file = CameraViewFile(scene, store, k);
+    StoreSlidePhoto(scene, store, dir + "/" + file, photo, context.exposure, context.photo_index);
+    const Eigen::AngleAxisd r(poses[k].rotation);
+    const Eigen::Vector3d rvec = r.angle() * r.axis();
+    const Eigen::Vector3d& t = poses[k].translation_mm;
+    views.push_back({{"photo", file},
+                     {"tilt_deg", poses[k].TiltDeg()},
+                     {"rotation", {rvec.x(), rvec.y(), rvec.z()}},
+                     {"translation_mm", {t.x(), t.y(), t.z()}}});
+  }
+  nlohmann::json j;
+  j["schema_version"] = 1;
+  j["board"] = {{"type", "chessboard"},
+                {"inner_corners", {kViewBoardInnerCols, kViewBoardInnerRows}},
+                {"square_mm", kViewBoardSquareMm}};
+  j["views"] = views;
+  j["note"] =
+      "camera_from_board poses (angle-axis rad, mm) of the board views; board corner (c, r) is "
+      "at ((c + 1 - 5) s, (r + 1 - 3.5) s, 0) mm in the board frame, s = square_mm";
+  WriteJsonAtomically(dir + "/truth/camera_views.json", j);
+  LogInfo("calibration views: ", count, " photo(s) of a ", kViewBoardInnerCols, "x",
+          kViewBoardInnerRows, " board of ", kViewBoardSquareMm,
+          " mm squares in calibration/camera/ (lumislab-calibrate camera --photos "
+          "<out>/calibration/camera --board ",
+          kViewBoardInnerCols, "x", kViewBoardInnerRows, " --square-mm ", kViewBoardSquareMm, ")");
+}
+
+bool CameraViewsComplete(const SynthScene& scene, const PhotoStore& store, const std::string& dir,
+                         int count) {
+  if (count <= 0) return true;
+  if (!std::filesystem::exists(dir + "/truth/camera_views.json")) return false;
+  for (int k = 0; k < count; ++k)
+    if (!std::filesystem::exists(dir + "/" + CameraViewFile(scene, store, k))) return false;
+  return true;
 }
 
 }  // namespace lumislab

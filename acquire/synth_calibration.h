@@ -20,4 +20,15 @@ namespace lumislab {
 void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
                               const std::string& dir, const PhotoStore& store, int threads);
 
+// `acquire synth --calibration-views N`: N photos of a free-standing board
+// (lib/synthetic/camera_views.h) in calibration/camera/view_<kk>.<ext>, stored like the slide
+// photos (every effect but screen_gain and ambient; noise streams after the slide photos' and
+// the calibration captures'), and their poses in truth/camera_views.json.
+std::string CameraViewFile(const SynthScene& scene, const PhotoStore& store, int k);
+void WriteCameraViews(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
+                      const PhotoStore& store, int count, int threads);
+// True when `dir` holds the N views and truth/camera_views.json (true for N = 0).
+bool CameraViewsComplete(const SynthScene& scene, const PhotoStore& store, const std::string& dir,
+                         int count);
+
 }  // namespace lumislab

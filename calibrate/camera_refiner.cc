@@ -116,4 +116,34 @@ CameraRefinement RefineCamera(const std::vector<CameraViewData>& views,
   return result;
 }
 
+PoseRefinement RefinePose(const CameraViewData& view, const Eigen::Vector4d& intrinsics,
+                          const Vector5d& distortion, const CameraRefinerOptions& options) {
+  options.Check();
+  LUMISLAB_CHECK(view.pixels.size() == view.board_mm.size() && view.pixels.size() >= 4,
+                 "RefinePose: a view needs >= 4 matching corners");
+  Eigen::Vector4d camera = intrinsics;
+  Vector5d lens = distortion;
+  PoseRefinement result;
+  result.pose = view.pose;
+  ceres::Problem problem;
+  for (size_t i = 0; i < view.pixels.size(); ++i)
+    problem.AddResidualBlock(CameraProjectionCost::Create(view.pixels[i], view.board_mm[i]),
+                             new ceres::HuberLoss(options.huber_px), camera.data(), lens.data(),
+                             result.pose.data());
+  problem.SetParameterBlockConstant(camera.data());
+  problem.SetParameterBlockConstant(lens.data());
+  const ceres::Solver::Options solver =
+      RefinerSolverOptions(ceres::DENSE_QR, options.max_iterations, options.threads);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (!summary.IsSolutionUsable())
+    throw Failure("pose refinement failed: " + summary.BriefReport());
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.message = summary.BriefReport();
+  double sum = 0;
+  for (const auto& r : CameraResiduals(view, camera, lens, result.pose)) sum += r.squaredNorm();
+  result.rms_px = std::sqrt(sum / double(view.pixels.size()));
+  return result;
+}
+
 }  // namespace lumislab

@@ -51,4 +51,18 @@ CameraRefinement RefineCamera(const std::vector<CameraViewData>& views,
                               const Eigen::Vector4d& intrinsics, const Vector5d& distortion,
                               const CameraRefinerOptions& options);
 
+// One view's pose with the camera known (calibrate screen with calib/camera.json): the same
+// cost (camera_projection_cost.h), Huber loss and solver settings, the camera held constant.
+struct PoseRefinement {
+  Vector6d pose = Vector6d::Zero();  // camera_from_board: angle-axis (rad), translation mm
+  double rms_px = 0;                 // over the view's corners
+  bool converged = false;
+  std::string message;  // Ceres' one-line summary
+};
+
+// `view` carries the starting pose (e.g. cv::solvePnP's). Throws Failure when Ceres finds no
+// usable solution.
+PoseRefinement RefinePose(const CameraViewData& view, const Eigen::Vector4d& intrinsics,
+                          const Vector5d& distortion, const CameraRefinerOptions& options);
+
 }  // namespace lumislab

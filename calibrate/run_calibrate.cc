@@ -48,13 +48,25 @@ int RunScreen(const ScreenCommand& command, int threads) {
           " % of the photo, local stretch <= ", report.anisotropy, ", condition ",
           report.condition);
   LogDebug("ceres: ", report.refinement.message);
-  std::ostringstream by_terms;
-  for (size_t t = 0; t < report.rms_px_by_terms.size(); ++t)
-    by_terms << (t ? ", " : "") << t << ": " << report.rms_px_by_terms[t] << " px";
-  LogInfo("distortion: k1 = ", c.k1, ", k2 = ", c.k2, " (", report.distortion_terms,
-          " term(s) chosen; RMS by terms ", by_terms.str(), "; scale ", c.scale_px, " px)");
-  LogInfo("rms: ", c.rms_px, " px (OpenCV homography alone: ", report.initial_rms_px, " px), ",
-          c.rms_mm, " mm -> ", out);
+  if (c.camera) {
+    const CameraModel& m = *c.camera;
+    LogInfo("model: camera+pose: the lens of ", c.camera_file, " (fx = ", m.fx, ", fy = ", m.fy,
+            ", cx = ", m.cx, ", cy = ", m.cy, " px; k1 = ", m.k1, ", k2 = ", m.k2, ", p1 = ", m.p1,
+            ", p2 = ", m.p2, ", k3 = ", m.k3, "), the screen's pose solved (rotation ",
+            report.pose.head<3>().transpose(), " rad, translation ",
+            report.pose.tail<3>().transpose(), " mm; solvePnP ", report.pnp_rms_px,
+            " px before Ceres)");
+  } else {
+    std::ostringstream by_terms;
+    for (size_t t = 0; t < report.rms_px_by_terms.size(); ++t)
+      by_terms << (t ? ", " : "") << t << ": " << report.rms_px_by_terms[t] << " px";
+    LogInfo("model: homography+radial2 from the board photo alone (no ",
+            dataset.Path("calib/camera.json"), "): k1 = ", c.k1, ", k2 = ", c.k2, " (",
+            report.distortion_terms, " term(s) chosen; RMS by terms ", by_terms.str(), "; scale ",
+            c.scale_px, " px)");
+  }
+  LogInfo("rms: ", c.rms_px, " px, ", c.rms_mm, " mm on the screen (", c.method,
+          "; OpenCV homography alone: ", report.initial_rms_px, " px) -> ", out);
   return 0;
 }
 

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <opencv2/calib3d.hpp>
 
+#include "calibrate/camera_refiner.h"
 #include "calibrate/gray_stretch.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -163,6 +165,85 @@ void FitDistortionModel(const BoardCorners& corners, const Eigen::Matrix3d& init
   result->rms_px = rms[chosen] == HUGE_VAL ? RmsPx(*result, corners) : rms[chosen];
 }
 
+// The screen's pose under the known camera: cv::solvePnP from the distorted corners (OpenCV
+// undistorts them with the same model), then Ceres on the 6 pose parameters with the Huber loss
+// of the screen refinement. The mapping is then the camera's lens followed by the plane's
+// homography H = (K [r1 r2 t])^-1 (core/screen_calibration.h, model "opencv5").
+void SolveScreenPose(const BoardCorners& corners, const CameraModel& camera,
+                     const ScreenCalibratorOptions& options, const std::string& photo_name,
+                     ScreenCalibration* result, ScreenCalibrationReport* report) {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  CameraViewData view;
+  for (size_t i = 0; i < corners.pixels.size(); ++i) {
+    object.emplace_back(corners.screen_mm[i].x(), corners.screen_mm[i].y(), 0.0);
+    image.emplace_back(corners.pixels[i].x(), corners.pixels[i].y());
+    view.pixels.push_back(corners.pixels[i]);
+    view.board_mm.emplace_back(corners.screen_mm[i].x(), corners.screen_mm[i].y(), 0.0);
+  }
+  const cv::Mat k =
+      (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+  const cv::Mat d =
+      (cv::Mat_<double>(5, 1) << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3);
+  cv::Mat rvec, tvec;
+  try {
+    if (!cv::solvePnP(object, image, k, d, rvec, tvec, false, cv::SOLVEPNP_ITERATIVE))
+      throw BadInput(photo_name + ": degenerate view (no screen pose under the calibrated camera)");
+  } catch (const cv::Exception& e) {
+    throw BadInput(photo_name + ": degenerate view (" + e.what() + ")");
+  }
+  for (int i = 0; i < 3; ++i) {
+    view.pose[i] = rvec.at<double>(i);
+    view.pose[3 + i] = tvec.at<double>(i);
+  }
+  const Eigen::Vector4d intrinsics(camera.fx, camera.fy, camera.cx, camera.cy);
+  Vector5d distortion;
+  distortion << camera.k1, camera.k2, camera.p1, camera.p2, camera.k3;
+  {
+    double sum = 0;
+    for (const auto& r : CameraResiduals(view, intrinsics, distortion, view.pose))
+      sum += r.squaredNorm();
+    report->pnp_rms_px = std::sqrt(sum / double(view.pixels.size()));
+  }
+  CameraRefinerOptions refiner;
+  refiner.huber_px = options.refiner.huber_px;
+  refiner.max_iterations = options.refiner.max_iterations;
+  refiner.threads = options.refiner.threads;
+  PoseRefinement pose;
+  try {
+    pose = RefinePose(view, intrinsics, distortion, refiner);
+  } catch (const Error& e) {
+    throw BadInput(photo_name + ": degenerate view: " + e.what());
+  }
+  report->camera_known = true;
+  report->pose = pose.pose;
+  report->refinement.converged = pose.converged;
+  report->refinement.message = pose.message;
+  if (!(pose.pose[5] > 0))
+    throw BadInput(photo_name + ": degenerate view (the screen's pose puts it behind the camera)");
+  // Camera point of screen point (x, y): R (x, y, 0) + t = [r1 r2 t] (x, y, 1).
+  const double angle = pose.pose.head<3>().norm();
+  const Eigen::Matrix3d r = angle > 0
+                                ? Eigen::AngleAxisd(angle, pose.pose.head<3>() / angle).matrix()
+                                : Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d plane;
+  plane.col(0) = r.col(0);
+  plane.col(1) = r.col(1);
+  plane.col(2) = pose.pose.tail<3>();
+  Eigen::Matrix3d kk = Eigen::Matrix3d::Identity();
+  kk(0, 0) = camera.fx;
+  kk(1, 1) = camera.fy;
+  kk(0, 2) = camera.cx;
+  kk(1, 2) = camera.cy;
+  const Eigen::Matrix3d image_from_screen = kk * plane;
+  result->screen_from_image = image_from_screen.inverse();
+  result->screen_from_image /= result->screen_from_image(2, 2);
+  result->camera = camera;
+  result->camera_file = "calib/camera.json";
+  result->method = "camera+pose";
+  result->rms_px = RmsPx(*result, corners);
+}
+
 }  // namespace
 
 void ScreenCalibratorOptions::Check() const {
@@ -188,7 +269,8 @@ void ScreenCalibratorOptions::Check() const {
 ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTarget& target,
                                        const std::string& photo_name,
                                        const ScreenCalibratorOptions& options,
-                                       ScreenCalibrationReport* report_out) {
+                                       ScreenCalibrationReport* report_out,
+                                       const CameraModel* camera) {
   options.Check();
   target.Check(photo_name, "calibration.target");
   ScreenCalibrationReport report;
@@ -227,7 +309,12 @@ ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTa
     start.screen_from_image = initial;
     report.initial_rms_px = RmsPx(start, corners);
   }
-  FitDistortionModel(corners, initial, options, photo_name, &result, &report);
+  if (camera) {
+    SolveScreenPose(corners, *camera, options, photo_name, &result, &report);
+  } else {
+    FitDistortionModel(corners, initial, options, photo_name, &result, &report);
+    result.method = "homography+radial2";
+  }
   result.rms_mm = RmsMm(result, corners);
   if (!(result.rms_px <= options.max_rms_px))
     throw BadInput(photo_name + ": reprojection RMS " + Num(result.rms_px) + " px exceeds " +
@@ -237,13 +324,30 @@ ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTa
   return result;
 }
 
+std::optional<CameraCalibration> LoadDatasetCamera(const Dataset& dataset, int photo_width,
+                                                   int photo_height, const std::string& photo) {
+  const std::string path = dataset.Path("calib/camera.json");
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  CameraCalibration camera = CameraCalibration::Load(path);
+  if (camera.image_width != photo_width || camera.image_height != photo_height)
+    throw InputError(
+        path, "image_size",
+        "the board photo's size " + std::to_string(photo_width) + "x" +
+            std::to_string(photo_height) + " (" + photo + ")",
+        std::to_string(camera.image_width) + "x" + std::to_string(camera.image_height));
+  return camera;
+}
+
 ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
                                   ScreenCalibrationReport* report) {
   if (dataset.calibration.photo.empty())
     throw InputError(dataset.Path("dataset.json"), "calibration.photo", "a photo file", "\"\"");
   const std::string path = dataset.PhotoPath(dataset.calibration.photo);
   const cv::Mat photo = LinearGray(DecodePhoto(path, CalibrationPhotoSpec(dataset)));
-  ScreenCalibration c = CalibrateScreenPhoto(photo, dataset.calibration, path, options, report);
+  const std::optional<CameraCalibration> camera =
+      LoadDatasetCamera(dataset, photo.cols, photo.rows, path);
+  ScreenCalibration c = CalibrateScreenPhoto(photo, dataset.calibration, path, options, report,
+                                             camera ? &*camera : nullptr);
   c.photo = dataset.calibration.photo;  // relative to the dataset folder
   return c;
 }

@@ -1,14 +1,19 @@
 // lumislab-calibrate screen: the calibration photo of a checkerboard on the screen ->
 // calib/screen.json (core/screen_calibration.h). OpenCV finds the corners and a starting
-// homography; Ceres refines the homography and two radial distortion terms (screen_refiner.h).
+// homography. Without a calibrated camera, Ceres refines the homography and two radial
+// distortion terms (screen_refiner.h); with one (calib/camera.json), the lens is known and only
+// the screen's pose is solved: cv::solvePnP, then Ceres (camera_refiner.h RefinePose).
 #pragma once
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "calibrate/board_detector.h"
 #include "calibrate/screen_refiner.h"
+#include "core/camera_calibration.h"
 #include "core/dataset.h"
 #include "core/screen_calibration.h"
 
@@ -46,17 +51,31 @@ struct ScreenCalibrationReport {
   double scale_ratio = 0;  // max / min local area scale
   double condition = 0;
   double initial_rms_px = 0;  // OpenCV homography, before refinement
+  // With a known camera: the screen's pose (camera_from_screen: angle-axis rad, translation mm;
+  // screen frame = lab x, y on the screen plane) and cv::solvePnP's RMS before Ceres.
+  bool camera_known = false;
+  Eigen::Matrix<double, 6, 1> pose = Eigen::Matrix<double, 6, 1>::Zero();
+  double pnp_rms_px = 0;
 };
 
 // `photo`: CV_32FC1 (lib/photo LinearGray), any value range. `photo_name` names the
-// photo in messages and in the result. Throws BadInput for a missing board or dot and for
+// photo in messages and in the result. `camera`: the calibrated camera (of the photo's size),
+// or null to fit the lens from this photo. Throws BadInput for a missing board or dot and for
 // degenerate views.
 ScreenCalibration CalibrateScreenPhoto(const cv::Mat& photo, const CalibrationTarget& target,
                                        const std::string& photo_name,
                                        const ScreenCalibratorOptions& options,
-                                       ScreenCalibrationReport* report = nullptr);
+                                       ScreenCalibrationReport* report = nullptr,
+                                       const CameraModel* camera = nullptr);
 
-// Loads the dataset's calibration photo and calibrates; the result is not written.
+// The dataset's calibrated camera, calib/camera.json, when it exists. Its image size must be
+// the board photo's (`photo_width` x `photo_height`, of `photo`): otherwise BadInput naming the
+// file and field.
+std::optional<CameraCalibration> LoadDatasetCamera(const Dataset& dataset, int photo_width,
+                                                   int photo_height, const std::string& photo);
+
+// Loads the dataset's calibration photo and calibrates, with calib/camera.json when it exists;
+// the result is not written.
 ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
                                   ScreenCalibrationReport* report = nullptr);
 

@@ -9,14 +9,14 @@ namespace lumislab {
 
 namespace {
 
-const char* const kSigmaNames[9] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
-
 // |coefficient| beyond this is no lens a board calibration can describe: a corrupt file.
 constexpr double kMaxDistortion = 1e3;
 
+const char* const kSigmaNames[9] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
+
 }  // namespace
 
-Eigen::Vector2d CameraCalibration::Distort(const Eigen::Vector2d& n) const {
+Eigen::Vector2d CameraModel::Distort(const Eigen::Vector2d& n) const {
   const double x = n.x(), y = n.y();
   const double r2 = x * x + y * y;
   const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
@@ -24,16 +24,47 @@ Eigen::Vector2d CameraCalibration::Distort(const Eigen::Vector2d& n) const {
           y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
 }
 
-Eigen::Vector2d CameraCalibration::Project(const Eigen::Vector3d& point_camera) const {
+Eigen::Vector2d CameraModel::Project(const Eigen::Vector3d& point_camera) const {
   const Eigen::Vector2d d = Distort(point_camera.head<2>() / point_camera.z());
   return {fx * d.x() + cx, fy * d.y() + cy};
 }
 
-Eigen::Vector2d CameraCalibration::UndistortToNormalised(const Eigen::Vector2d& pixel) const {
+namespace {
+
+// d Distort / d (x, y) of the five-coefficient model.
+Eigen::Matrix2d DistortionJacobian(const CameraModel& m, double x, double y) {
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (m.k1 + r2 * (m.k2 + r2 * m.k3));
+  const double dradial_dr2 = m.k1 + r2 * (2 * m.k2 + 3 * r2 * m.k3);
+  Eigen::Matrix2d j;
+  j(0, 0) = radial + 2 * x * x * dradial_dr2 + 2 * m.p1 * y + 6 * m.p2 * x;
+  j(0, 1) = 2 * x * y * dradial_dr2 + 2 * m.p1 * x + 2 * m.p2 * y;
+  j(1, 0) = 2 * x * y * dradial_dr2 + 2 * m.p1 * x + 2 * m.p2 * y;
+  j(1, 1) = radial + 2 * y * y * dradial_dr2 + 6 * m.p1 * y + 2 * m.p2 * x;
+  return j;
+}
+
+}  // namespace
+
+Eigen::Vector2d CameraModel::UndistortToNormalised(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector2d d((pixel.x() - cx) / fx, (pixel.y() - cy) / fy);
-  // x = (x_d - tangential(x)) / radial(x), iterated from x = x_d (cv::undistortPoints' scheme,
-  // with more iterations and a stop on convergence).
+  // Newton from x = x_d: a few steps to machine precision where the model is invertible. The
+  // synthetic lens undistorts every sample of every photo through here, so speed matters.
   Eigen::Vector2d n = d;
+  for (int it = 0; it < 20; ++it) {
+    const Eigen::Vector2d residual = Distort(n) - d;
+    if (residual.squaredNorm() < 1e-30) return n;
+    const Eigen::Matrix2d j = DistortionJacobian(*this, n.x(), n.y());
+    const double det = j(0, 0) * j(1, 1) - j(0, 1) * j(1, 0);
+    if (!(std::abs(det) > 1e-12)) break;
+    const Eigen::Vector2d step((j(1, 1) * residual.x() - j(0, 1) * residual.y()) / det,
+                               (j(0, 0) * residual.y() - j(1, 0) * residual.x()) / det);
+    n -= step;
+    if (step.squaredNorm() < 1e-30) return n;
+  }
+  // Fallback: x = (x_d - tangential(x)) / radial(x), iterated from x = x_d (cv::undistortPoints'
+  // scheme, with more iterations and a stop on convergence).
+  n = d;
   for (int it = 0; it < 100; ++it) {
     const double x = n.x(), y = n.y();
     const double r2 = x * x + y * y;
@@ -46,6 +77,29 @@ Eigen::Vector2d CameraCalibration::UndistortToNormalised(const Eigen::Vector2d& 
     if (step < 1e-15) break;
   }
   return n;
+}
+
+void ReadCameraModel(const JsonView& camera_matrix, const JsonView& distortion, CameraModel* m) {
+  m->fx = camera_matrix["fx"].NumberIn(1, 1e7);
+  m->fy = camera_matrix["fy"].NumberIn(1, 1e7);
+  // The principal point may lie off the photo (a shifted lens) but not far from it.
+  m->cx = camera_matrix["cx"].NumberIn(-m->image_width, 2.0 * m->image_width);
+  m->cy = camera_matrix["cy"].NumberIn(-m->image_height, 2.0 * m->image_height);
+  distortion["model"].OneOf({"opencv5"});
+  m->k1 = distortion["k1"].NumberIn(-kMaxDistortion, kMaxDistortion);
+  m->k2 = distortion["k2"].NumberIn(-kMaxDistortion, kMaxDistortion);
+  m->p1 = distortion["p1"].NumberIn(-kMaxDistortion, kMaxDistortion);
+  m->p2 = distortion["p2"].NumberIn(-kMaxDistortion, kMaxDistortion);
+  m->k3 = distortion["k3"].NumberIn(-kMaxDistortion, kMaxDistortion);
+}
+
+nlohmann::json CameraMatrixJson(const CameraModel& m) {
+  return {{"fx", m.fx}, {"fy", m.fy}, {"cx", m.cx}, {"cy", m.cy}};
+}
+
+nlohmann::json DistortionJson(const CameraModel& m) {
+  return {{"model", "opencv5"}, {"k1", m.k1}, {"k2", m.k2},
+          {"p1", m.p1},         {"p2", m.p2}, {"k3", m.k3}};
 }
 
 int CameraCalibration::ViewsUsed() const {
@@ -61,19 +115,7 @@ CameraCalibration CameraCalibration::Load(const std::string& path) {
   CameraCalibration c;
   c.image_width = root["image_size"][0].IntIn(1, 1 << 16);
   c.image_height = root["image_size"][1].IntIn(1, 1 << 16);
-  const JsonView k = root["camera_matrix"];
-  c.fx = k["fx"].NumberIn(1, 1e7);
-  c.fy = k["fy"].NumberIn(1, 1e7);
-  // The principal point may lie off the photo (a shifted lens) but not far from it.
-  c.cx = k["cx"].NumberIn(-c.image_width, 2.0 * c.image_width);
-  c.cy = k["cy"].NumberIn(-c.image_height, 2.0 * c.image_height);
-  const JsonView dist = root["distortion"];
-  dist["model"].OneOf({"opencv5"});
-  c.k1 = dist["k1"].NumberIn(-kMaxDistortion, kMaxDistortion);
-  c.k2 = dist["k2"].NumberIn(-kMaxDistortion, kMaxDistortion);
-  c.p1 = dist["p1"].NumberIn(-kMaxDistortion, kMaxDistortion);
-  c.p2 = dist["p2"].NumberIn(-kMaxDistortion, kMaxDistortion);
-  c.k3 = dist["k3"].NumberIn(-kMaxDistortion, kMaxDistortion);
+  ReadCameraModel(root["camera_matrix"], root["distortion"], &c);
 
   const JsonView board = root["board"];
   c.board.type = board["type"].OneOf({"chessboard", "charuco"});
@@ -119,9 +161,8 @@ void CameraCalibration::Save(const std::string& path) const {
   nlohmann::json j;
   j["schema_version"] = kCameraCalibrationSchemaVersion;
   j["image_size"] = {image_width, image_height};
-  j["camera_matrix"] = {{"fx", fx}, {"fy", fy}, {"cx", cx}, {"cy", cy}};
-  j["distortion"] = {{"model", "opencv5"}, {"k1", k1}, {"k2", k2},
-                     {"p1", p1},           {"p2", p2}, {"k3", k3}};
+  j["camera_matrix"] = CameraMatrixJson(*this);
+  j["distortion"] = DistortionJson(*this);
   j["distortion_note"] =
       "OpenCV's model; distortion_coefficients in calib/camera.yaml are (k1, k2, p1, p2, k3)";
   nlohmann::json b = {{"type", board.type},

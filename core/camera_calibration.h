@@ -11,8 +11,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "core/json.h"
 
 namespace lumislab {
 
@@ -40,11 +43,42 @@ struct CameraViewReport {
   Eigen::Vector3d translation_mm{0, 0, 0};  // camera_from_board, board origin in camera mm
 };
 
-struct CameraCalibration {
+// The camera model alone: image size, intrinsics and distortion. One implementation of the
+// model for the calibration (calib/camera.json), the screen calibration that uses it
+// (core/screen_calibration.h) and the synthetic camera's lens (lib/synthetic/camera.h).
+struct CameraModel {
   int image_width = 0;
   int image_height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;          // px
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;  // OpenCV order in distortion_coefficients
+
+  // Camera-frame point (mm, z > 0) -> distorted pixel.
+  Eigen::Vector2d Project(const Eigen::Vector3d& point_camera) const;
+  // Normalised (x, y) -> distorted normalised (x_d, y_d).
+  Eigen::Vector2d Distort(const Eigen::Vector2d& normalised) const;
+  // Distorted pixel -> undistorted normalised coordinates (x, y): Newton's method on the model
+  // from x = x_d (quadratic convergence; exact to ~1e-15 inside the calibrated field of view),
+  // with cv::undistortPoints' fixed-point iteration as the fallback where Newton does not
+  // converge. Exact (x = x_d, bit for bit) without distortion.
+  Eigen::Vector2d UndistortToNormalised(const Eigen::Vector2d& pixel) const;
+  // Undistorted normalised (x, y) -> the ideal pinhole pixel (fx x + cx, fy y + cy), and back.
+  Eigen::Vector2d PinholePixel(const Eigen::Vector2d& normalised) const {
+    return {fx * normalised.x() + cx, fy * normalised.y() + cy};
+  }
+  Eigen::Vector2d Normalised(const Eigen::Vector2d& pinhole_pixel) const {
+    return {(pinhole_pixel.x() - cx) / fx, (pinhole_pixel.y() - cy) / fy};
+  }
+  bool HasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
+};
+
+// calib/camera.json's members for a camera model, also used by calib/screen.json's "opencv5"
+// model: `camera_matrix` {fx, fy, cx, cy} and `distortion` {model "opencv5", k1, k2, p1, p2, k3},
+// with their limits (m's image size must be set before reading).
+void ReadCameraModel(const JsonView& camera_matrix, const JsonView& distortion, CameraModel* m);
+nlohmann::json CameraMatrixJson(const CameraModel& m);
+nlohmann::json DistortionJson(const CameraModel& m);
+
+struct CameraCalibration : CameraModel {
   // Report.
   double rms_px = 0;         // reprojection RMS over the used views' corners (final, Ceres)
   double opencv_rms_px = 0;  // the same for cv::calibrateCamera's start
@@ -54,13 +88,6 @@ struct CameraCalibration {
   CameraBoardInfo board;
   std::vector<CameraViewReport> views;  // every photo given, used or not
 
-  // Camera-frame point (mm, z > 0) -> distorted pixel.
-  Eigen::Vector2d Project(const Eigen::Vector3d& point_camera) const;
-  // Normalised (x, y) -> distorted normalised (x_d, y_d).
-  Eigen::Vector2d Distort(const Eigen::Vector2d& normalised) const;
-  // Distorted pixel -> undistorted normalised coordinates (x, y), by fixed-point iteration as
-  // cv::undistortPoints does (exact to ~1e-12 inside the calibrated field of view).
-  Eigen::Vector2d UndistortToNormalised(const Eigen::Vector2d& pixel) const;
   int ViewsUsed() const;
 
   static CameraCalibration Load(const std::string& path);  // validates calib/camera.json

@@ -37,6 +37,7 @@ bool Applies(const std::string& type, CaptureKind kind) {
   if (kind == CaptureKind::kDark)
     return type != "vignetting" && type != "screen_gain" && type != "ambient";
   if (kind == CaptureKind::kFlat) return type != "ambient";
+  if (kind == CaptureKind::kCameraView) return type != "screen_gain" && type != "ambient";
   return true;
 }
 

@@ -33,9 +33,11 @@ CalibrationCaptures ParseCalibrationCaptures(const JsonView& block, const SynthS
 
 // What a calibration photo is of, and so which effects apply to it.
 enum class CaptureKind {
-  kDark,      // lens capped: no light; the sensor's effects only (no vignetting, screen, ambient)
-  kFlat,      // the screen under uniform irradiance, room lights off: every effect but ambient
-  kResponse,  // the unfiltered luminaire lighting the screen: every effect
+  kDark,        // lens capped: no light; the sensor's effects only (no vignetting, screen, ambient)
+  kFlat,        // the screen under uniform irradiance, room lights off: every effect but ambient
+  kResponse,    // the unfiltered luminaire lighting the screen: every effect
+  kCameraView,  // a board in the room (camera_views.h), not the screen: all but screen_gain,
+                // ambient
 };
 // Applies the scene's effects that act on a photo of `kind`, in list order.
 void ApplyCaptureEffects(const SynthScene& scene, CaptureKind kind, const PhotoContext& context,

@@ -146,6 +146,49 @@ std::shared_ptr<const Effect> MakeStageError(const JsonView& spec, const EffectS
   return std::make_shared<StageErrorEffect>(NumberOr(spec, "max_mm", 0, 5, 0.3), SeedOf(spec));
 }
 
+// The lens must map the photo one to one: the radial map r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6)
+// (undistorted -> distorted normalised radius) must keep rising, with slope > 0.2, until it
+// reaches the farthest photo corner (a lens folding back inside the photo is no lens).
+bool LensMonotonicOverPhoto(const LensSpec& lens, const CameraSpec& camera) {
+  const double cx = 0.5 * (camera.width - 1) + lens.principal_offset_px.x();
+  const double cy = 0.5 * (camera.height - 1) + lens.principal_offset_px.y();
+  const double dx = std::max(cx, camera.width - 1 - cx), dy = std::max(cy, camera.height - 1 - cy);
+  const double corner = std::hypot(dx, dy) / camera.focal_px;  // distorted, normalised
+  for (double r = 0; r < 10; r += 1e-3) {
+    const double r2 = r * r;
+    const double slope = 1 + r2 * (3 * lens.k1 + r2 * (5 * lens.k2 + r2 * 7 * lens.k3));
+    if (!(slope > 0.2)) return false;
+    if (r * (1 + r2 * (lens.k1 + r2 * (lens.k2 + r2 * lens.k3))) > corner) return true;
+  }
+  return false;
+}
+
+std::shared_ptr<const Effect> MakeLens(const JsonView& spec, const EffectSetting& setting) {
+  CheckKeys(spec, {"k1", "k2", "k3", "p1", "p2", "principal_offset_px"});
+  LensSpec lens;
+  lens.k1 = NumberOr(spec, "k1", -1, 1, 0);
+  lens.k2 = NumberOr(spec, "k2", -1, 1, 0);
+  lens.k3 = NumberOr(spec, "k3", -1, 1, 0);
+  lens.p1 = NumberOr(spec, "p1", -0.05, 0.05, 0);
+  lens.p2 = NumberOr(spec, "p2", -0.05, 0.05, 0);
+  if (spec.Has("principal_offset_px")) {
+    const JsonView offset = spec["principal_offset_px"];
+    if (offset.Size() != 2) offset.Fail("[dx, dy] in pixels");
+    // Within a quarter of the photo of its centre, as a real lens's principal point is.
+    lens.principal_offset_px = {
+        offset[0].NumberIn(-0.25 * setting.camera.width, 0.25 * setting.camera.width),
+        offset[1].NumberIn(-0.25 * setting.camera.height, 0.25 * setting.camera.height)};
+  }
+  if (!LensMonotonicOverPhoto(lens, setting.camera))
+    spec[spec.Has("k1")   ? "k1"
+         : spec.Has("k2") ? "k2"
+                          : "k3"]
+        .Fail(
+            "k1, k2, k3 whose radial distortion keeps rising (slope > 0.2) out to the photo's "
+            "corners");
+  return std::make_shared<LensEffect>(lens);
+}
+
 }  // namespace
 
 void SensorNoiseEffect::Apply(ImageF& rgb, const PhotoContext& context) const {
@@ -172,8 +215,15 @@ void QuantizationEffect::Apply(ImageF& rgb, const PhotoContext&) const {
   }
 }
 
+VignettingEffect::VignettingEffect(const CameraSpec& camera, double k1, double k2, bool cos4)
+    : camera_(camera), k1_(k1), k2_(k2), cos4_(cos4) {
+  const PinholeCamera pinhole(camera);
+  cx_ = pinhole.model().cx;
+  cy_ = pinhole.model().cy;
+}
+
 double VignettingEffect::Factor(double px, double py) const {
-  const double cx = 0.5 * (camera_.width - 1), cy = 0.5 * (camera_.height - 1);
+  const double cx = cx_, cy = cy_;
   const double d2 = (px - cx) * (px - cx) + (py - cy) * (py - cy);
   const double f2 = camera_.focal_px * camera_.focal_px;
   const double cos2 = f2 / (f2 + d2);                        // cos^2 of the angle off the axis
@@ -294,11 +344,17 @@ void RawEffect::Apply(ImageF& rgb, const PhotoContext&) const {
 
 const std::map<std::string, EffectFactory>& EffectRegistry() {
   static const std::map<std::string, EffectFactory> registry = {
-      {"sensor_noise", &MakeSensorNoise}, {"quantization", &MakeQuantization},
-      {"vignetting", &MakeVignetting},    {"screen_gain", &MakeScreenGain},
-      {"ambient", &MakeAmbient},          {"dark", &MakeDark},
-      {"brackets", &MakeBrackets},        {"response", &MakeResponse},
-      {"stage_error", &MakeStageError},   {"raw", &MakeRaw},
+      {"sensor_noise", &MakeSensorNoise},
+      {"quantization", &MakeQuantization},
+      {"vignetting", &MakeVignetting},
+      {"screen_gain", &MakeScreenGain},
+      {"ambient", &MakeAmbient},
+      {"dark", &MakeDark},
+      {"brackets", &MakeBrackets},
+      {"response", &MakeResponse},
+      {"stage_error", &MakeStageError},
+      {"raw", &MakeRaw},
+      {"lens", &MakeLens},
   };
   return registry;
 }

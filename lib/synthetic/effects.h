@@ -75,14 +75,14 @@ class QuantizationEffect : public Effect {
 // principal point / its distance to the corner pixel centres.
 class VignettingEffect : public Effect {
  public:
-  VignettingEffect(const CameraSpec& camera, double k1, double k2, bool cos4)
-      : camera_(camera), k1_(k1), k2_(k2), cos4_(cos4) {}
+  VignettingEffect(const CameraSpec& camera, double k1, double k2, bool cos4);
   std::string Type() const override { return "vignetting"; }
   void Apply(ImageF& rgb, const PhotoContext& context) const override;
   double Factor(double px, double py) const;  // at pixel (px, py), OpenCV centres
 
  private:
   CameraSpec camera_;
+  double cx_, cy_;  // the principal point, px (the image centre without a lens)
   double k1_, k2_;
   bool cos4_;
 };
@@ -211,6 +211,21 @@ class RawEffect : public Effect {
 
  private:
   int bit_depth_, black_level_, white_level_;
+};
+
+// The camera's lens: OpenCV's Brown-Conrady distortion and a principal point off the image
+// centre. It changes where each pixel looks, not a photo's values: the scene hands it to the
+// camera (CameraSpec::lens), so it acts on every photo the camera takes (slide photos, the board
+// photo, the calibration frames and views) wherever it is listed.
+class LensEffect : public Effect {
+ public:
+  explicit LensEffect(const LensSpec& lens) : lens_(lens) {}
+  std::string Type() const override { return "lens"; }
+  void Apply(ImageF&, const PhotoContext&) const override {}
+  const LensSpec& lens() const { return lens_; }
+
+ private:
+  LensSpec lens_;
 };
 
 // Builds an effect from its JSON object {"type": ..., params}; `spec` is effects[k] of a scene

@@ -71,10 +71,18 @@ ImageF RenderCalibration(const SynthScene& scene, int threads) {
   const PinholeCamera camera(scene.camera);
   BoardLook look;
   look.screen_half_mm = {0.5 * scene.screen_w_mm, 0.5 * scene.screen_h_mm};
+  if (!scene.camera.lens)  // the ideal pinhole, as it always was (the same photo to the bit)
+    return RenderBoardPhoto(
+        scene.calibration, scene.camera.width, scene.camera.height,
+        [&](const Eigen::Vector2d& px, Eigen::Vector2d* lab) {
+          return camera.PlanePoint(px.x(), px.y(), scene.distance_mm, lab);
+        },
+        look, threads);
+  const PixelRays rays(camera, threads);
   return RenderBoardPhoto(
       scene.calibration, scene.camera.width, scene.camera.height,
       [&](const Eigen::Vector2d& px, Eigen::Vector2d* lab) {
-        return camera.PlanePoint(px.x(), px.y(), scene.distance_mm, lab);
+        return camera.PlanePointOfRay(rays(px.x(), px.y()), scene.distance_mm, lab);
       },
       look, threads);
 }

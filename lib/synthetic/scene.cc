@@ -124,7 +124,6 @@ void ParseCalibration(const JsonView& root, SynthScene* scene) {
   t.origin_mm = {-0.5 * t.squares_x * t.square_mm, -0.5 * t.squares_y * t.square_mm};
   // What lumislab-calibrate would refuse after the capture is refused before it.
   t.Check(scene->source, "calibration");
-  CheckBoardInView(*scene);
 }
 
 // raw (DNG photos) excludes the other effects that choose the photos' format.
@@ -137,6 +136,17 @@ bool RawFormatClash(const std::string& a, const std::string& b) {
 // listed at most once (each sets something of the whole dataset: its photos, their format, its
 // black level), and response (8-bit JPEG) excludes quantization (16-bit PNG).
 void ParseEffects(const JsonView& effects, SynthScene* scene) {
+  // The lens is part of the camera: it is handed to the camera before any effect is built, so
+  // that the effects that depend on the camera's geometry (vignetting, screen gain, ambient) see
+  // it wherever it is listed.
+  for (size_t k = 0; k < effects.Size(); ++k)
+    if (effects[k].raw().is_object() && effects[k].Has("type") &&
+        effects[k]["type"].raw() == "lens") {
+      if (scene->camera.lens) effects[k]["type"].Fail("a type listed once (lens is listed before)");
+      EffectSetting setting;
+      setting.camera = scene->camera;
+      scene->camera.lens = static_cast<const LensEffect&>(*MakeEffect(effects[k], setting)).lens();
+    }
   EffectSetting setting;
   setting.camera = scene->camera;
   setting.distance_mm = scene->distance_mm;
@@ -208,6 +218,7 @@ SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   ParseCamera(root, &scene);
   ParseCalibration(root, &scene);
   if (root.Has("effects")) ParseEffects(root["effects"], &scene);
+  CheckBoardInView(scene);  // through the lens, when one is listed
   if (root.Has("calibration_captures"))
     scene.captures = ParseCalibrationCaptures(root["calibration_captures"], scene);
   return scene;

@@ -69,12 +69,16 @@ void WriteTruthCamera(const SynthScene& scene, const std::string& path) {
   j["focal_px"] = scene.camera.focal_px;
   j["principal_point_px"] = {k(0, 2), k(1, 2)};
   j["K"] = RowMajor(k);
-  j["distortion"] = {{"k1", 0.0}, {"k2", 0.0}};
+  // The lens effect's distortion in calib/camera.json's terms (all 0 without a lens).
+  const CameraModel& m = camera.model();
+  j["distortion"] = {{"model", "opencv5"}, {"k1", m.k1}, {"k2", m.k2},
+                     {"p1", m.p1},         {"p2", m.p2}, {"k3", m.k3}};
   j["position_mm"] = Vec(scene.camera.position_mm);
   j["look_at_mm"] = Vec(scene.camera.look_at_mm);
   // Columns are the camera axes (x right, y down, z forward) in the lab frame.
   j["lab_from_camera"] = RowMajor(camera.lab_from_camera());
   j["screen_plane_z_mm"] = scene.distance_mm;
+  // With a lens: ideal pinhole pixels (K times the undistorted ray), not the photo's pixels.
   j["screen_from_image"] = RowMajor(camera.ScreenFromImage(scene.distance_mm));
   j["image_from_screen"] = RowMajor(camera.ImageFromScreen(scene.distance_mm));
   j["exposure"] = scene.camera.exposure;

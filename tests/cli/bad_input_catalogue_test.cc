@@ -924,6 +924,41 @@ std::vector<Case> PhotoCases() {
   v.push_back(B("png_header_32768").Do(PngHugeHeader(b, 32768, 32768)).Names({b}));
   v.push_back(B("no_board").Do(CopyPath("ds/photos/pos_0_0_p.png", b)).Names({b}));
   v.push_back(B("tiny_32x24").Do(PngResize(b, 32, 24)).Names({b}));
+  // calib/camera.json (lumislab-calibrate camera), which calibrate screen uses when it exists.
+  const std::string cam = "ds/calib/camera.json";
+  auto Cam = [&](const std::string& name, const json& edits) {
+    json camera = {
+        {"schema_version", 1},
+        {"image_size", {320, 240}},
+        {"camera_matrix", {{"fx", 280}, {"fy", 280}, {"cx", 159.5}, {"cy", 119.5}}},
+        {"distortion",
+         {{"model", "opencv5"}, {"k1", 0}, {"k2", 0}, {"p1", 0}, {"p2", 0}, {"k3", 0}}},
+        {"board", {{"type", "chessboard"}, {"inner_corners", {9, 6}}, {"square_mm", 30}}},
+        {"report",
+         {{"rms_px", 0.1},
+          {"opencv_rms_px", 0.1},
+          {"views",
+           {{{"photo", "v.png"},
+             {"used", true},
+             {"corners", 54},
+             {"rms_px", 0.1},
+             {"tilt_deg", 20},
+             {"rotation", {0, 0, 0}},
+             {"translation_mm", {0, 0, 500}}}}}}}};
+    camera.merge_patch(edits);
+    return C("calib_camera_" + name)
+        .Calibrate()
+        .Do(MakeFolder("ds/calib"))
+        .Do(WriteText(cam, camera.dump(2) + "\n"));
+  };
+  // The camera of another photo size: its intrinsics would be wrong for this photo.
+  v.push_back(Cam("size_differs", {{"image_size", {640, 480}}}).Names({cam, "image_size"}));
+  v.push_back(Cam("size_transposed", {{"image_size", {240, 320}}}).Names({cam, "image_size"}));
+  v.push_back(
+      Cam("fx_negative", {{"camera_matrix", {{"fx", -280}}}}).Names({cam, "camera_matrix.fx"}));
+  v.push_back(Cam("unknown_model", {{"distortion", {{"model", "fisheye"}}}})
+                  .Names({cam, "distortion.model"}));
+  v.push_back(Cam("not_json", {}).Do(WriteText(cam, "{\"schema_version\": 1,")).Names({cam}));
   return v;
 }
 

@@ -60,6 +60,14 @@ std::string Number(double v) {
 
 std::vector<NamedPhoto> ManifestPhotos(const std::string& manifest) {
   CheckInputFile(manifest, "manifest");
+  // A row is a short line: a manifest of more than 16 MiB (~250 000 rows) is some other file
+  // given by mistake (a photo, a video), whose first "line" read whole could take gigabytes.
+  constexpr uintmax_t kMaxManifestBytes = 16 << 20;
+  std::error_code ec;
+  const uintmax_t bytes = fs::file_size(manifest, ec);
+  if (!ec && bytes > kMaxManifestBytes)
+    throw InputError(manifest, "size", "a manifest of at most 16 MiB (about 250 000 rows)",
+                     std::to_string(bytes) + " bytes");
   std::ifstream in(manifest);
   std::vector<NamedPhoto> out;
   std::string line;

@@ -38,15 +38,21 @@ std::pair<double, double> Pair(const std::string& text, const std::string& optio
 }
 
 // calib/<name> of the dataset; false (and a log line) when it exists and --force is not given.
+// Nothing is created yet: a step refused for bad input leaves the dataset as it was (MakeCalib
+// creates calib/ once the result is there to write).
 bool Prepare(const Dataset& dataset, const std::string& name, bool force, std::string* out) {
   *out = dataset.Path("calib/" + name);
   if (std::filesystem::exists(*out) && !force) {
     LogInfo(*out, " exists, skipping (use --force to recalibrate)");
     return false;
   }
+  return true;
+}
+
+// calib/ of the dataset, created, without the temporaries of an interrupted run.
+void MakeCalib(const Dataset& dataset) {
   MakeDirectories(dataset.Path("calib"));
   RemoveOrphanedTemporaries(dataset.Path("calib"));
-  return true;
 }
 
 ScreenCalibration LoadScreen(const Dataset& dataset, const char* step) {
@@ -89,6 +95,7 @@ int RunDark(const RadiometricCommand& c, const Dataset& dataset) {
   f.corrections = Corrections(dataset, {false, true, false}, "dark");
   nlohmann::json report;
   const DarkMap map = CalibrateDark(DecodeCalibrationFrames(dataset, f), c.dark_options, &report);
+  MakeCalib(dataset);
   SaveDarkMap(out, map, report);
   LogInfo("dark: ", c.frames.size(), " frame(s), ", report["exposures"].size(), " exposure(s) -> ",
           map.current.empty() ? "constant level" : "offset + current", "; mean level ",
@@ -111,6 +118,7 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
     nlohmann::json report = CheckLinearity(frames);
     report["schema_version"] = kRadiometricCalibrationSchemaVersion;
     report["kind"] = "linearity";
+    MakeCalib(dataset);
     WriteJsonAtomically(out, report);
     LogInfo("response: ", frames[0].photo.pixels.elemSize1() * 8,
             "-bit frames are linear data: no curve recovered; value / exposure deviates from the "
@@ -121,6 +129,7 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
   if (!Prepare(dataset, "response.json", c.force, &out)) return 0;
   nlohmann::json report;
   const ResponseCurve curve = CalibrateResponse(frames, c.response_options, &report);
+  MakeCalib(dataset);
   SaveResponseCurve(out, curve, report);
   LogInfo("response: Debevec on ", report["samples"][1].get<int>(), " sample pixels (green) of ",
           frames.size(), " frames; bracket consistency (RMS log ratio) ",
@@ -140,6 +149,7 @@ int RunFlat(const RadiometricCommand& c, const Dataset& dataset) {
   nlohmann::json report;
   const FlatMap map = CalibrateFlat(DecodeCalibrationFrames(dataset, f), dataset, screen, &report,
                                     c.flat_smooth_px);
+  MakeCalib(dataset);
   SaveFlatMap(out, map, report);
   LogInfo("flat: ", c.frames.size(), " frame(s); gain ", report["min_gain"].get<double>(), " .. ",
           report["max_gain"].get<double>(), " over ", report["screen_pixels"].get<long long>(),
@@ -176,6 +186,7 @@ int RunScale(const RadiometricCommand& c, const Dataset& dataset) {
   nlohmann::json report;
   const RadiometricScale scale =
       CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report);
+  MakeCalib(dataset);
   SaveRadiometricScale(out, scale, report);
   LogInfo("scale: ", scale.scale, " ", scale.units, " per unit (readings ", reference.reading_p,
           " - ", reference.reading_n, " over values ", report["value_p"].get<double>(), " - ",

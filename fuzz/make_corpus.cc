@@ -1,7 +1,9 @@
 // Writes the seed corpus of every fuzz target (fuzz/corpus/<target>/) with lumislab's own
 // writers: small valid files of each kind. The committed corpus was made with
 //   build-fuzz/fuzz/lumislab_fuzz_make_corpus fuzz/corpus
-// (the mesh seeds are hand-written: fuzz/corpus/fuzz_mesh_*; fuzz_camera_calibration's seed is
+// (the mesh seeds are hand-written: fuzz/corpus/fuzz_mesh_*, and so are the manifests and scale
+// references of fuzz_radiometric_calibration, which no lumislab writer makes (a lab writes them;
+// the reference is truth/reference.json's form); fuzz_camera_calibration's seed is
 // lumislab-calibrate camera's output on tests/data/chessboard-opencv-left, photo folder
 // stripped). Rerun it when a file format changes.
 #include <cmath>
@@ -16,6 +18,7 @@
 #include "core/screen_calibration.h"
 #include "core/slab.h"
 #include "lib/photo/photo_io.h"
+#include "lib/photo/radiometric_calibration.h"
 #include "lib/synthetic/scene.h"
 
 namespace fs = std::filesystem;
@@ -224,6 +227,55 @@ void SlabPositions(const std::string& scratch) {
   WriteExr(d + "/float_piz.exr", rgbm, {"R", "G", "B", "mask"}, {}, piz);
 }
 
+// fuzz_radiometric_calibration: the first byte picks the reader ('0' dark.json, '1'
+// response.json, '2' flat.json, '3' scale.json, '4' captures.csv, '5' reference.json), the rest
+// is the file. The maps are 4 x 3, the size of the target's fixed dark.exr and flat.exr.
+void RadiometricCalibrations(const std::string& scratch) {
+  const std::string t = "fuzz_radiometric_calibration";
+  auto take = [&](char kind, const std::string& written, const std::string& name) {
+    Put(t, name, std::string(1, kind) + ReadTextFile(written));
+  };
+  const nlohmann::json report = {{"frames", nlohmann::json::array()}};
+  DarkMap dark;
+  dark.offset = Gradient(4, 3, 3);
+  dark.hot.assign(12, 0);
+  dark.hot[5] = 1;
+  dark.hot_count = 1;
+  SaveDarkMap(scratch + "/dark.json", dark, report);
+  take('0', scratch + "/dark.json", "dark_constant.json");
+  dark.current = Gradient(4, 3, 3);
+  SaveDarkMap(scratch + "/dark.json", dark, report);
+  take('0', scratch + "/dark.json", "dark_offset_current.json");
+  ResponseCurve curve;
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 256; ++k)
+      curve.linear_of_code[c][k] =
+          float(std::pow(k / 255.0, 2.2 + 0.1 * c) + 1e-4 * k) / float(1 + 1e-4 * 255);
+  for (auto& channel : curve.linear_of_code) channel[255] = 1;
+  SaveResponseCurve(scratch + "/response.json", curve, report);
+  take('1', scratch + "/response.json", "response_gamma.json");
+  FlatMap flat;
+  flat.gain = Gradient(4, 3, 3);
+  for (float& g : flat.gain.data) g += 0.5f;
+  SaveFlatMap(scratch + "/flat.json", flat, report);
+  take('2', scratch + "/flat.json", "flat.json");
+  SaveRadiometricScale(scratch + "/scale.json", {"", 12.5, "W/m^2"}, report);
+  take('3', scratch + "/scale.json", "scale_w_m2.json");
+  SaveRadiometricScale(scratch + "/scale.json", {"", 3.4e4, "lux"}, report);
+  take('3', scratch + "/scale.json", "scale_lux.json");
+  Put(t, "captures.csv",
+      "4i,j,slide,file,exposure\n0,0,p,IMG_0001.JPG,0.25\n0,0,p,IMG_0002.JPG,1\n"
+      "0,0,n,IMG_0003.JPG,0.25\n0,0,n,IMG_0004.JPG,1\n# a comment\n1,0,+,IMG_0005.JPG,\n"
+      "1,0,minus,IMG_0006.JPG\n");
+  Put(t, "captures_no_header.csv", "40,0,pos,a.dng,1e-2\n0,0,neg,b.dng,1e-2\n");
+  Put(t, "reference.json",
+      "5{\"schema_version\": 1, \"position\": [1, 0], \"point_mm\": [12.5, -30], "
+      "\"unit\": \"W/m2\", \"reading_p\": 0.42, \"reading_n\": 0.11}\n");
+  Put(t, "reference_lux.json",
+      "5{\"position\": [2, 1], \"point_mm\": [-399, 299], \"unit\": \"lux\", "
+      "\"reading_p\": 1200, \"reading_n\": 0}\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -241,6 +293,7 @@ int main(int argc, char** argv) {
     Calibrations(scratch);
     Photos();
     SlabPositions(scratch);
+    RadiometricCalibrations(scratch);
     fs::remove_all(scratch);
     return 0;
   });

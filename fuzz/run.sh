@@ -26,6 +26,7 @@ mkdir -p "$build/fuzz-logs" "$build/fuzz-corpus" fuzz/findings
 dict_of() {
   case $1 in
     fuzz_scene | fuzz_dataset | fuzz_slab_info | fuzz_screen_calibration | fuzz_camera_calibration) echo fuzz/dict/json.dict ;;
+    fuzz_radiometric_calibration) echo fuzz/dict/radiometric.dict ;;
     fuzz_photo) echo fuzz/dict/photo.dict ;;
     fuzz_slab_position) echo fuzz/dict/exr.dict ;;
     fuzz_mesh_ply) echo fuzz/dict/ply.dict ;;

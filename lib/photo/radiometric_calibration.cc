@@ -18,11 +18,13 @@ std::string Beside(const std::string& json_path, const std::string& file) {
   return (fs::path(json_path).parent_path() / file).string();
 }
 
-// The map file a calibration JSON names: a plain file name beside it (no folders).
+// The map file a calibration JSON names: a plain file name beside it (no folders; "." and ".."
+// name the folders themselves, a NUL byte would end the name early).
 std::string MapFileOf(const JsonView& root) {
   const JsonView map = root["map"];
   const std::string name = map.String();
-  if (name.empty() || name.find('/') != std::string::npos || name.find('\\') != std::string::npos)
+  if (name.empty() || name == "." || name == ".." ||
+      name.find_first_of(std::string("/\\\0", 3)) != std::string::npos)
     map.Fail("a file name beside the JSON (no folder)");
   return name;
 }
@@ -121,10 +123,14 @@ ResponseCurve LoadResponseCurve(const std::string& json_path) {
   for (int c = 0; c < 3; ++c) {
     const JsonView list = curves[kRgb[c]];
     const std::vector<double> values = list.Numbers(256);
+    std::array<float, 256>& out = curve.linear_of_code[c];
     for (int k = 0; k < 256; ++k) {
-      if (!(values[k] >= 0 && values[k] <= 1) || (k > 0 && !(values[k] > values[k - 1])))
-        list[size_t(k)].Fail("a value in [0, 1] above that of code " + std::to_string(k - 1));
-      curve.linear_of_code[c][k] = float(values[k]);
+      // Increasing as the decoder uses it: in single precision (two values closer than a float
+      // apart, e.g. 0.99999999999 and 1, would become one code value).
+      out[k] = float(values[k]);
+      if (!(values[k] >= 0 && values[k] <= 1) || (k > 0 && !(out[k] > out[k - 1])))
+        list[size_t(k)].Fail("a value in [0, 1] above that of code " + std::to_string(k - 1) +
+                             " (as a 32-bit float)");
     }
     if (values[255] != 1) list[255].Fail("1 (the curve is normalised at code 255)");
   }

@@ -413,6 +413,71 @@ Mutation ExrHugeHeader(const std::string& file, std::vector<std::string> channel
   };
 }
 
+// --- radiometric calibration (docs/design.md §5.13 - §5.16)
+
+// A frame (a dark, flat or bracketed photo) of width x height RGB pixels, `bits` 8 or 16:
+// `fill` >= 0 sets every code to that fraction of full scale, otherwise a smooth ramp of codes
+// from 5 % to 75 % of full scale (a lit scene, nothing clipped).
+Mutation WriteFrame(const std::string& file, int width, int height, int bits, double fill = -1) {
+  return [=](const std::string& dir) {
+    const double full = bits == 8 ? 255 : 65535;
+    cv::Mat image(height, width, bits == 8 ? CV_8UC3 : CV_16UC3);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const double f =
+              fill >= 0 ? fill : 0.05 + 0.7 * (x + y + 3.0 * c) / (width + height + 6.0);
+          const double v = std::round(f * full);
+          if (bits == 8)
+            image.at<cv::Vec3b>(y, x)[c] = uchar(v);
+          else
+            image.at<cv::Vec3w>(y, x)[c] = ushort(v);
+        }
+    WriteImage(dir + "/" + file, image);
+  };
+}
+// An EXR map of width x height: FLOAT channels, each filled with its value.
+void WriteMap(const std::string& path, int width, int height,
+              const std::map<std::string, float>& channels) {
+  ExrImage image;
+  image.header = Imf::Header(width, height);
+  image.width = width;
+  image.height = height;
+  for (const auto& [name, value] : channels)
+    image.channels[name].assign(size_t(width) * height, value);
+  WriteAnyExr(path, image);
+}
+// A valid calib/<kind>.json (+ its map) as lumislab-calibrate writes it, for the 320x240
+// photos: "dark" a constant level of 0.001 and no hot pixel, "response" code^2.2 per channel,
+// "flat" gain 1, "scale" 10 W/m^2.
+Mutation WriteCalibration(const std::string& kind) {
+  return [=](const std::string& dir) {
+    const std::string calib = dir + "/ds/calib/";
+    fs::create_directories(calib);
+    json j = {{"schema_version", 1}, {"kind", kind}, {"report", json::object()}};
+    if (kind == "dark" || kind == "flat") {
+      j["image_size"] = {320, 240};
+      j["map"] = kind + ".exr";
+    }
+    if (kind == "dark") {
+      j["model"] = "constant";
+      WriteMap(calib + "dark.exr", 320, 240,
+               {{"R", 1e-3f}, {"G", 1e-3f}, {"B", 1e-3f}, {"hot", 0}});
+    } else if (kind == "flat") {
+      WriteMap(calib + "flat.exr", 320, 240, {{"R", 1}, {"G", 1}, {"B", 1}});
+    } else if (kind == "response") {
+      j["bit_depth"] = 8;
+      std::vector<double> curve(256);
+      for (int k = 0; k < 256; ++k) curve[size_t(k)] = std::pow(k / 255.0, 2.2);
+      j["linear_of_code"] = {{"R", curve}, {"G", curve}, {"B", curve}};
+    } else {
+      j["scale"] = 10.0;
+      j["units"] = "W/m^2";
+    }
+    WriteJson(calib + kind + ".json", j);
+  };
+}
+
 // ------------------------------------------------------------------------------------------
 // The table.
 
@@ -455,6 +520,13 @@ class C {
     c_.tool = "lumislab-calibrate";
     c_.args = "screen --dataset ds" + (extra.empty() ? "" : " " + extra);
     c_.input = Input::kDataset;
+    return *this;
+  }
+  // lumislab-calibrate dark / response / flat / scale (args after the subcommand's name).
+  C& Radiometric(const std::string& args, Input input = Input::kCalibrated) {
+    c_.tool = "lumislab-calibrate";
+    c_.args = args;
+    c_.input = input;
     return *this;
   }
   C& Reconstruct(const std::string& extra = "") {
@@ -1469,10 +1541,223 @@ std::vector<Case> MoreCases() {
   return v;
 }
 
+// lumislab-calibrate dark, response, flat and scale, and the calib/ files they write as
+// reconstruct (and the later steps) read them. Frames are tiny (8x6) where no calib/screen.json
+// fixes their size (Input::kDataset), the photos' 320x240 otherwise.
+std::vector<Case> RadiometricCases() {
+  std::vector<Case> v;
+  const std::string dark = "dark --dataset ds --frames f0.png f1.png";
+  auto D = [&](const std::string& name, const std::string& args = "") {
+    return C("dark_" + name)
+        .Radiometric(args.empty() ? dark : args, Input::kDataset)
+        .Do(WriteFrame("f0.png", 8, 6, 16, 0.01))
+        .Do(WriteFrame("f1.png", 8, 6, 16, 0.01));
+  };
+  v.push_back(D("frame_not_an_image").Do(WriteText("f1.png", Garbage())).Names({"f1.png"}));
+  v.push_back(D("frame_missing", "dark --dataset ds --frames f0.png nope.png").Names({"nope.png"}));
+  v.push_back(D("frame_is_a_folder").Do(MakeFolder("f1.png")).Names({"f1.png"}));
+  v.push_back(D("frames_mixed_sizes")
+                  .Do(WriteFrame("f1.png", 10, 6, 16, 0.01))
+                  .Names({"f1.png", "image size"}));
+  v.push_back(D("frames_mixed_bit_depths")
+                  .Do(WriteFrame("f1.png", 8, 6, 8, 0.01))
+                  .Names({"f1.png", "bit depth"}));
+  // calib/screen.json fixes the camera's size: 8x6 frames are of another camera.
+  v.push_back(D("frame_not_the_camera_size")
+                  .From(Input::kCalibrated)
+                  .Names({"f0.png", "image size", "ds/calib/screen.json"}));
+  v.push_back(D("exposures_count", dark + " --exposures 1").Names({"--exposures"}));
+  v.push_back(D("exposure_nan", dark + " --exposures 1,nan").Names({"--exposures"}));
+  v.push_back(D("exposure_negative", dark + " --exposures 1,-2").Names({"--exposures"}));
+  v.push_back(D("hot_threshold_zero", dark + " --hot-threshold 0").Names({"--hot-threshold"}));
+  v.push_back(D("no_frames", "dark --dataset ds --frames").Names({"--frames"}));
+  // The response curve the frames are decoded through is read first.
+  v.push_back(D("response_json_nan")
+                  .Do(WriteCalibration("response"))
+                  .Do(SetJson("ds/calib/response.json", "/linear_of_code/G/100", "NaN"))
+                  .Names({"ds/calib/response.json", "linear_of_code.G"}));
+
+  const std::string response = "response --dataset ds --frames f0.png f1.png --exposures 1,4";
+  auto R = [&](const std::string& name, const std::string& args = "") {
+    return C("response_" + name)
+        .Radiometric(args.empty() ? response : args, Input::kDataset)
+        .Do(WriteFrame("f0.png", 8, 6, 8))
+        .Do(WriteFrame("f1.png", 8, 6, 8));
+  };
+  v.push_back(R("one_frame", "response --dataset ds --frames f0.png --exposures 1")
+                  .Names({"--frames", "at least 2"}));
+  // Neither EXIF (the frames have none) nor --exposures gives an exposure.
+  v.push_back(R("no_exposure", "response --dataset ds --frames f0.png f1.png")
+                  .Names({"f0.png", "exposure"}));
+  v.push_back(R("one_exposure", "response --dataset ds --frames f0.png f1.png --exposures 2,2")
+                  .Names({"f0.png", "exposure"}));
+  // Uniform frames: no pixel changes over the series, no sample for the curve.
+  v.push_back(R("uniform_frames")
+                  .Do(WriteFrame("f0.png", 8, 6, 8, 0.3))
+                  .Do(WriteFrame("f1.png", 8, 6, 8, 0.3))
+                  .Names({"f0.png", "frames"}));
+  v.push_back(R("frame_not_an_image").Do(WriteText("f1.png", Garbage())).Names({"f1.png"}));
+  v.push_back(
+      R("frames_mixed_sizes").Do(WriteFrame("f1.png", 8, 7, 8)).Names({"f1.png", "image size"}));
+  v.push_back(R("samples_too_few", response + " --samples 5").Names({"--samples"}));
+  v.push_back(R("lambda_nan", response + " --lambda nan").Names({"--lambda"}));
+
+  const std::string flat = "flat --dataset ds --frames f0.png";
+  auto F = [&](const std::string& name, const std::string& args = "") {
+    return C("flat_" + name)
+        .Radiometric(args.empty() ? flat : args)
+        .Do(WriteFrame("f0.png", 320, 240, 16, 0.5));
+  };
+  v.push_back(F("frame_clipped")
+                  .Do(WriteFrame("f0.png", 320, 240, 16, 1.0))
+                  .Names({"f0.png", "pixel data"}));
+  v.push_back(
+      F("frame_black").Do(WriteFrame("f0.png", 320, 240, 16, 0.0)).Names({"f0.png", "pixel data"}));
+  v.push_back(F("frame_not_the_camera_size")
+                  .Do(WriteFrame("f0.png", 8, 6, 16, 0.5))
+                  .Names({"f0.png", "image size"}));
+  v.push_back(F("frame_truncated").Do(Truncate("f0.png", 0.3)).Names({"f0.png"}));
+  v.push_back(F("no_screen_calibration").From(Input::kDataset).Names({"ds/calib/screen.json"}));
+  v.push_back(F("smooth_negative", flat + " --smooth-px -1").Names({"--smooth-px"}));
+  // The dark map the frames are corrected with is read first.
+  v.push_back(F("dark_exr_nan")
+                  .Do(WriteCalibration("dark"))
+                  .Do(ExrPoison("ds/calib/dark.exr", "G", std::numeric_limits<float>::quiet_NaN()))
+                  .Names({"ds/calib/dark.exr", "pixel data"}));
+
+  const std::string reading = "scale --dataset ds --position 0,0 --point-mm 0,0";
+  auto S = [&](const std::string& name, const std::string& args) {
+    return C("scale_" + name).Radiometric(args);
+  };
+  v.push_back(S("point_off_screen",
+                "scale --dataset ds --position 0,0 --point-mm 5000,0 "
+                "--reading-p 1 --reading-n 0.5")
+                  .Names({"command line", "point_mm"}));
+  v.push_back(S("position_outside_grid",
+                "scale --dataset ds --position 2,0 --point-mm 0,0 "
+                "--reading-p 1 --reading-n 0.5")
+                  .Names({"command line", "position"}));
+  v.push_back(S("reading_n_negative", reading + " --reading-p 1 --reading-n -0.5")
+                  .Names({"command line", "reading_n"}));
+  v.push_back(S("reading_p_below_n", reading + " --reading-p 1 --reading-n 2")
+                  .Names({"command line", "reading_p"}));
+  v.push_back(
+      S("reading_p_nan", reading + " --reading-p nan --reading-n 0.5").Names({"--reading-p"}));
+  v.push_back(S("reading_missing", reading + " --reading-p 1").Names({"--reference"}));
+  v.push_back(S("unit_bogus", reading + " --reading-p 1 --reading-n 0.5 --unit cd")
+                  .Names({"--unit", "unit"}));
+  v.push_back(S("no_screen_calibration", reading + " --reading-p 1 --reading-n 0.5")
+                  .From(Input::kDataset)
+                  .Names({"ds/calib/screen.json"}));
+  // Slide n's photo under slide p's name: Y+ = Y-, no scale can come of the readings.
+  v.push_back(S("no_contrast", reading + " --reading-p 1 --reading-n 0.5")
+                  .Do(CopyPath("ds/photos/pos_0_0_n.png", "ds/photos/pos_0_0_p.png"))
+                  .Names({"command line", "point_mm"}));
+  const std::string ref = "scale --dataset ds --reference ref.json";
+  const json valid_ref = {{"position", {0, 0}},
+                          {"point_mm", {0, 0}},
+                          {"reading_p", 1.0},
+                          {"reading_n", 0.5},
+                          {"unit", "W/m2"}};
+  auto Ref = [&](const std::string& name) {
+    return S("reference_" + name, ref).Do(WriteText("ref.json", valid_ref.dump()));
+  };
+  v.push_back(Ref("nan").Do(SetRaw("ref.json", "/reading_p", "NaN")).Names({"ref.json"}));
+  v.push_back(Ref("reading_string")
+                  .Do(SetJson("ref.json", "/reading_n", "0.5"))
+                  .Names({"ref.json", "reading_n"}));
+  v.push_back(
+      Ref("reading_1e999").Do(SetRaw("ref.json", "/reading_p", "1e999")).Names({"ref.json"}));
+  v.push_back(
+      Ref("point_missing").Do(EraseJson("ref.json", "/point_mm")).Names({"ref.json", "point_mm"}));
+  v.push_back(Ref("position_three_values")
+                  .Do(SetJson("ref.json", "/position", {0, 0, 0}))
+                  .Names({"ref.json", "position"}));
+  v.push_back(Ref("position_negative")
+                  .Do(SetJson("ref.json", "/position", {-1, 0}))
+                  .Names({"ref.json", "position"}));
+  v.push_back(
+      Ref("unit_bogus").Do(SetJson("ref.json", "/unit", "cd/m2")).Names({"ref.json", "unit"}));
+  v.push_back(Ref("missing").Do(RemovePath("ref.json")).Names({"ref.json"}));
+
+  // The calib/ files as reconstruct reads them (every one is loaded before the first position).
+  auto Cal = [&](const std::string& kind, const std::string& name) {
+    return C("calib_" + kind + "_" + name).Reconstruct().Do(WriteCalibration(kind));
+  };
+  const std::string rj = "ds/calib/response.json", dj = "ds/calib/dark.json",
+                    de = "ds/calib/dark.exr", fj = "ds/calib/flat.json", fe = "ds/calib/flat.exr",
+                    sj = "ds/calib/scale.json";
+  v.push_back(Cal("response", "schema_version_2")
+                  .Do(SetJson(rj, "/schema_version", 2))
+                  .Names({rj, "schema_version"}));
+  v.push_back(Cal("response", "nan_string")
+                  .Do(SetJson(rj, "/linear_of_code/R/7", "NaN"))
+                  .Names({rj, "linear_of_code.R"}));
+  v.push_back(Cal("response", "nan_raw").Do(SetRaw(rj, "/linear_of_code/B/9", "NaN")).Names({rj}));
+  v.push_back(Cal("response", "decreasing")
+                  .Do(SetJson(rj, "/linear_of_code/G/128", 0.9))
+                  .Names({rj, "linear_of_code.G"}));
+  v.push_back(Cal("response", "code_255_not_1")
+                  .Do(SetJson(rj, "/linear_of_code/R/255", 0.999999))
+                  .Names({rj, "linear_of_code.R"}));
+  v.push_back(Cal("response", "255_values")
+                  .Do(EraseJson(rj, "/linear_of_code/B/0"))
+                  .Names({rj, "linear_of_code.B"}));
+  v.push_back(Cal("response", "channel_missing")
+                  .Do(EraseJson(rj, "/linear_of_code/G"))
+                  .Names({rj, "linear_of_code.G"}));
+  v.push_back(Cal("dark", "schema_version_2")
+                  .Do(SetJson(dj, "/schema_version", 2))
+                  .Names({dj, "schema_version"}));
+  v.push_back(Cal("dark", "model_bogus").Do(SetJson(dj, "/model", "linear")).Names({dj, "model"}));
+  v.push_back(Cal("dark", "image_size_nan").Do(SetRaw(dj, "/image_size/0", "NaN")).Names({dj}));
+  v.push_back(Cal("dark", "image_size_huge")
+                  .Do(SetJson(dj, "/image_size", {1000000, 1000000}))
+                  .Names({dj, "image_size"}));
+  v.push_back(Cal("dark", "map_in_other_folder")
+                  .Do(SetJson(dj, "/map", "../photos/pos_0_0_p.png"))
+                  .Names({dj, "map"}));
+  v.push_back(Cal("dark", "map_is_the_folder").Do(SetJson(dj, "/map", "..")).Names({dj, "map"}));
+  // The map is not the size the JSON says.
+  v.push_back(Cal("dark", "exr_wrong_size").Do(ExrResize(de, 160, 120)).Names({de, "size"}));
+  // JSON and map agree, but on another camera's size than the photos'.
+  v.push_back(Cal("dark", "map_of_another_camera")
+                  .Do(ExrResize(de, 160, 120))
+                  .Do(SetJson(dj, "/image_size", {160, 120}))
+                  .Names({"ds/photos/", "image size", dj}));
+  v.push_back(Cal("dark", "exr_nan")
+                  .Do(ExrPoison(de, "R", std::numeric_limits<float>::quiet_NaN()))
+                  .Names({de, "pixel data"}));
+  v.push_back(Cal("dark", "exr_huge_value").Do(ExrPoison(de, "B", 1e6f)).Names({de, "pixel data"}));
+  v.push_back(Cal("dark", "exr_no_hot_channel").Do(ExrDropChannel(de, "hot")).Names({de, "hot"}));
+  v.push_back(Cal("dark", "current_channels_missing")
+                  .Do(SetJson(dj, "/model", "offset+current"))
+                  .Names({de, "current.R"}));
+  v.push_back(Cal("dark", "exr_missing").Do(RemovePath(de)).Names({de}));
+  v.push_back(Cal("dark", "exr_truncated").Do(Truncate(de, 0.5)).Names({de}));
+  v.push_back(Cal("flat", "exr_zero_gain").Do(ExrPoison(fe, "G", 0.f)).Names({fe, "pixel data"}));
+  v.push_back(Cal("flat", "exr_inf")
+                  .Do(ExrPoison(fe, "R", std::numeric_limits<float>::infinity()))
+                  .Names({fe, "pixel data"}));
+  v.push_back(Cal("flat", "image_size_one_value")
+                  .Do(SetJson(fj, "/image_size", {320}))
+                  .Names({fj, "image_size"}));
+  v.push_back(Cal("flat", "exr_huge_header")
+                  .Do(ExrHugeHeader(fe, {"R", "G", "B"}, 1 << 20, 1 << 20))
+                  .Names({fe}));
+  v.push_back(Cal("scale", "negative").Do(SetJson(sj, "/scale", -10)).Names({sj, "scale"}));
+  v.push_back(Cal("scale", "nan_string").Do(SetJson(sj, "/scale", "NaN")).Names({sj, "scale"}));
+  v.push_back(Cal("scale", "units_bogus").Do(SetJson(sj, "/units", "cd")).Names({sj, "units"}));
+  v.push_back(Cal("scale", "schema_version_missing")
+                  .Do(EraseJson(sj, "/schema_version"))
+                  .Names({sj, "schema_version"}));
+  return v;
+}
+
 std::vector<Case> AllCases() {
   std::vector<Case> all;
   for (auto part : {DatasetCases(), ScreenCalibrationCases(), PhotoCases(), SceneCases(),
-                    CommandLineCases(), SlabCases(), MoreCases()})
+                    CommandLineCases(), SlabCases(), MoreCases(), RadiometricCases()})
     all.insert(all.end(), part.begin(), part.end());
   return all;
 }

@@ -284,6 +284,9 @@ TEST_F(Import, BadFoldersAndDescriptionsAreRefused) {
   testing::WriteFile(root_ + "/bad.csv", manifest_ + manifest_.substr(0, manifest_.find('\n') + 1));
   Refused("--manifest bad.csv",
           {"bad.csv: line 13", names_[0] + ", named before by bad.csv: line 1"});
+  // Not a manifest: 17 MiB without a line end (read whole, its first line would be all of it).
+  testing::WriteFile(root_ + "/bad.csv", std::string(17 << 20, 'x'));
+  Refused("--manifest bad.csv", {"bad.csv", "size", "16 MiB"});
   // No exposure anywhere.
   testing::WriteFile(root_ + "/bad.csv", "0,0,p," + names_[0] + "\n");
   Refused("--manifest bad.csv", {"bad.csv: line 1", "no exposure"});

@@ -130,6 +130,15 @@ TEST(Corrections, CalibrationFilesRoundTripAndAreChecked) {
   EXPECT_TRUE(ThrowsBadInputNaming([&] { LoadResponseCurve(dir + "/response.json"); },
                                    dir + "/response.json", &message));
   EXPECT_NE(message.find("linear_of_code.G[100]"), std::string::npos) << message;
+  // fuzz_radiometric_calibration: values increasing as doubles but equal as the floats the
+  // decoder keeps (code 254 at 1 - 1e-11 is 1.0f, as code 255) were accepted, and the saved
+  // curve was then refused.
+  j["linear_of_code"]["G"][100] = j["linear_of_code"]["G"][99].get<double>() + 0.5 / 256;
+  j["linear_of_code"]["R"][254] = 0.99999999999;
+  WriteJsonAtomically(dir + "/response.json", j);
+  EXPECT_TRUE(ThrowsBadInputNaming([&] { LoadResponseCurve(dir + "/response.json"); },
+                                   dir + "/response.json", &message));
+  EXPECT_NE(message.find("linear_of_code.R[255]"), std::string::npos) << message;
   SaveRadiometricScale(dir + "/scale.json", {"", 2.5, "lux"}, {});
   EXPECT_EQ(LoadRadiometricScale(dir + "/scale.json").units, "lux");
   j = JsonDocument::Load(dir + "/scale.json").raw();

@@ -2,14 +2,12 @@
 // analytic truth/ that the synthetic acquisition writes.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "core/dataset.h"
-#include "core/exr_io.h"
-#include "core/screen_calibration.h"
 #include "core/slab_compare.h"
+#include "noise_floor.h"
 #include "test_util.h"
 
 namespace lumislab {
@@ -89,62 +87,6 @@ TEST(EndToEnd, ObliqueViewAsAccurateAsFrontal) {
   CleanUp({frontal, oblique});
 }
 
-// Noise floor predicted from the sensor model: per photo pixel the normalised value v has
-// variance (v FW + read^2) / FW^2 + q^2/12; a texel averages N = texel area / pixel area pixels;
-// E = peak (E+ - E-) adds the two slides; the deconvolution with the stencil [b, a, b]
-// (a = 5/6, b = 1/12) multiplies white-noise variance by (a / (a^2 - 4 b^2)^1.5)^2 in 2D.
-double PredictedNoiseFloor(const std::string& noisy, const std::string& clean) {
-  const Dataset ds = Dataset::Load(clean);
-  const ScreenCalibration cal = ScreenCalibration::Load(clean + "/calib/screen.json");
-  const SlabInfo truth_info = SlabInfo::Load(clean + "/truth");
-  const SlabInfo info = SlabInfo::Load(noisy + "/slab");
-  const double a = 5.0 / 6, b = 1.0 / 12;
-  const double gain_1d = a / std::pow(a * a - 4 * b * b, 1.5);
-  const double deconv_gain = gain_1d * gain_1d;
-  const double q = 1.0 / 65535;
-  const double scale = *ds.radiometric_scale, peak = ds.filter.peak;
-  const double texel_area = info.layout.TexelW() * info.layout.TexelH();
-  double var_sum = 0, ref2 = 0;
-  for (const auto& [i, j] : info.present) {
-    const SlabPosition truth = ReadSlabPosition(clean + "/truth", truth_info, i, j);
-    const SlabPosition slab = ReadSlabPosition(noisy + "/slab", info, i, j);
-    const ImageF plus = ReadExr(clean + "/" + ds.PhotosOf(i, j)[0].file, {"R", "G", "B"});
-    const ImageF minus = ReadExr(clean + "/" + ds.PhotosOf(i, j)[1].file, {"R", "G", "B"});
-    float max_ref = 0;
-    for (float v : truth.irradiance.data) max_ref = std::max(max_ref, std::abs(v));
-    const Eigen::Vector2d c = ds.grid.Centre(i, j);
-    for (int row = 0; row < info.layout.res_y; ++row)
-      for (int col = 0; col < info.layout.res_x; ++col) {
-        const size_t k = size_t(row) * info.layout.res_x + col;
-        float mag = 0;
-        for (int ch = 0; ch < 3; ++ch)
-          mag = std::max(mag, std::abs(truth.irradiance.data[k * 3 + ch]));
-        if (mag < 0.01 * max_ref || slab.mask.data[k] < 0.5f) continue;
-        const Eigen::Vector2d lab = info.layout.TexelCentre(col, row) - c;
-        const Eigen::Vector2d px = cal.ImageFromScreen(lab);
-        // Pixel footprint on the screen (mm^2) from the calibration's Jacobian.
-        const Eigen::Vector2d dx = cal.ScreenFromImage(px + Eigen::Vector2d(0.5, 0)) -
-                                   cal.ScreenFromImage(px - Eigen::Vector2d(0.5, 0));
-        const Eigen::Vector2d dy = cal.ScreenFromImage(px + Eigen::Vector2d(0, 0.5)) -
-                                   cal.ScreenFromImage(px - Eigen::Vector2d(0, 0.5));
-        const double pixel_area = std::abs(dx.x() * dy.y() - dx.y() * dy.x());
-        const double n = texel_area / pixel_area;
-        const int x = int(std::lround(px.x())), y = int(std::lround(px.y()));
-        for (int ch = 0; ch < 3; ++ch) {
-          double var = 0;
-          for (const ImageF* photo : {&plus, &minus}) {
-            const double v = std::max(0.0f, photo->at(x, y, ch));
-            var += (v * kFullWell + kReadNoise * kReadNoise) / (kFullWell * kFullWell) + q * q / 12;
-          }
-          var_sum += peak * peak * scale * scale * var / n * deconv_gain;
-          const double t = truth.irradiance.data[k * 3 + ch];
-          ref2 += t * t;
-        }
-      }
-  }
-  return std::sqrt(var_sum / ref2);
-}
-
 TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
   if (testing::kSanitized)
     GTEST_SKIP() << "full-size accuracy run: the Release build's (the sanitized build runs the "
@@ -152,7 +94,15 @@ TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
   const std::string clean = RunPipeline("e2e_clean", SceneJson(3, 3, kFrontalCamera, "[]"));
   const std::string noisy = RunPipeline("e2e_noisy", SceneJson(3, 3, kFrontalCamera, kNoise));
   const SlabComparison c = CompareSlabs(noisy + "/slab", noisy + "/truth");
-  const double floor = PredictedNoiseFloor(noisy, clean);
+  // The sensor of kNoise, one 16-bit exposure per slide (tests/cli/noise_floor.h).
+  testing::SensorNoiseModel sensor;
+  sensor.full_well_e = kFullWell;
+  sensor.read_noise_e = kReadNoise;
+  sensor.code_step = [](double) { return 1.0 / 65535; };
+  const double floor =
+      testing::PredictNoiseFloor(noisy + "/slab", clean, clean + "/calib/screen.json",
+                                 clean + "/truth", sensor)
+          .overall;
   std::printf("noisy 3x3: %s; predicted noise floor %.3f %%, ratio %.2f\n", c.Summary().c_str(),
               100 * floor, c.overall_relative_l2 / floor);
   EXPECT_GT(floor, 0.0);

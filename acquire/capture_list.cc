@@ -19,8 +19,6 @@ namespace fs = std::filesystem;
 namespace lumislab {
 namespace {
 
-constexpr double kMinExposure = 1e-9, kMaxExposure = 1e9;  // as dataset.json's photos[].exposure
-
 std::string Trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\r");
   if (a == std::string::npos) return "";
@@ -97,7 +95,7 @@ std::vector<NamedPhoto> ManifestPhotos(const std::string& manifest) {
     n.file = cells[3];
     if (cells.size() == 5 && !cells[4].empty()) {
       n.exposure = ParseNumber(cells[4]);
-      if (!n.exposure || *n.exposure < kMinExposure || *n.exposure > kMaxExposure)
+      if (!n.exposure || *n.exposure < kMinPhotoExposure || *n.exposure > kMaxPhotoExposure)
         throw InputError(manifest, field + ", column exposure",
                          "a relative exposure in [1e-9, 1e9]", cells[4]);
     }
@@ -153,7 +151,7 @@ std::optional<NamedPhoto> FilePattern::Match(const std::string& file) const {
       n.positive = *ParseSlide(value);
     } else if (name == "exposure") {
       n.exposure = ParseNumber(value);
-      if (!n.exposure || *n.exposure < kMinExposure || *n.exposure > kMaxExposure)
+      if (!n.exposure || *n.exposure < kMinPhotoExposure || *n.exposure > kMaxPhotoExposure)
         throw InputError(file, "{exposure}", "a relative exposure in [1e-9, 1e9]", value);
     } else {
       const auto index = ParseIndex(value);
@@ -259,7 +257,7 @@ void CaptureList::Add(const NamedPhoto& n) {
   if (n.exposure) {
     e.exposure = *n.exposure;
   } else if (const auto relative = exif.RelativeExposure()) {
-    if (!(*relative >= kMinExposure && *relative <= kMaxExposure))
+    if (!(*relative >= kMinPhotoExposure && *relative <= kMaxPhotoExposure))
       throw InputError(path, "EXIF exposure t ISO / N^2", "a value in [1e-9, 1e9]",
                        std::to_string(*relative));
     e.exposure = *relative;

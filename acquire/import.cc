@@ -18,8 +18,6 @@ namespace fs = std::filesystem;
 namespace lumislab {
 namespace {
 
-constexpr double kMinExposure = 1e-9, kMaxExposure = 1e9;  // as dataset.json's photos[].exposure
-
 // The files sorted by the time their EXIF gives (DateTimeOriginal, to the second; equal times,
 // as in a fast bracket, keep name order). A photo without one is refused: its place is unknown.
 std::vector<std::string> ByCaptureTime(const std::string& dir,
@@ -119,7 +117,7 @@ void ImportOptions::Check() const {
   if (order.empty() && !exposures.empty())
     throw BadInput("--exposures: only with --order (a manifest or pattern names each exposure)");
   for (const double e : exposures)
-    if (!(e >= kMinExposure && e <= kMaxExposure))
+    if (!(e >= kMinPhotoExposure && e <= kMaxPhotoExposure))
       throw InputError("--exposures", "", "relative exposures in [1e-9, 1e9]", std::to_string(e));
   if (brackets < 0 || brackets > 100)
     throw InputError("--brackets", "", "1 .. 100 photos per slide", std::to_string(brackets));

@@ -9,13 +9,12 @@
 
 #include "calibrate/saddle_refiner.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/log.h"
 
 namespace lumislab {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Bilinear sample of an 8-bit image; NaN outside.
 double Sample(const cv::Mat& gray8, const cv::Point2d& p) {
@@ -47,12 +46,6 @@ double RingMean(const cv::Mat& gray8, const cv::Matx33d& image_from_board, doubl
     }
   }
   return sum / n;
-}
-
-std::string Num(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3g", v);
-  return buffer;
 }
 
 std::string SizeText(const CalibrationTarget& t) {
@@ -191,8 +184,8 @@ int FindDot(const cv::Mat& gray8, const cv::Matx33d& image_from_index,
   if (!(out->dot_contrast >= options.min_dot_contrast) ||
       out->runner_up_contrast > 0.5 * out->dot_contrast)
     throw BadInput(photo + ": the orientation dot in board square (0, 0) was not found (best " +
-                   Num(out->dot_contrast) + ", runner-up " + Num(out->runner_up_contrast) +
-                   " of the black/white contrast; need >= " + Num(options.min_dot_contrast) +
+                   Num(out->dot_contrast, 3) + ", runner-up " + Num(out->runner_up_contrast, 3) +
+                   " of the black/white contrast; need >= " + Num(options.min_dot_contrast, 3) +
                    " and a clear winner)");
   return order[0];
 }

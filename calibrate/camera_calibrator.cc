@@ -13,6 +13,7 @@
 #include "calibrate/gray_stretch.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/input_file.h"
 #include "core/log.h"
 #include "core/parallel.h"
@@ -21,14 +22,6 @@
 namespace lumislab {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-std::string Num(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.4g", v);
-  return buffer;
-}
 
 std::string SizeText(const cv::Size& s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);

@@ -18,12 +18,6 @@ namespace lumislab {
 
 namespace {
 
-std::string Num(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.4g", v);
-  return buffer;
-}
-
 Eigen::Matrix3d ToEigen(const cv::Mat& h) {
   Eigen::Matrix3d m;
   for (int r = 0; r < 3; ++r)

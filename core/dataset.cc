@@ -180,7 +180,8 @@ Dataset Dataset::Parse(const JsonDocument& doc, const std::string& dir, bool wit
     e.file = p["file"].String();
     if (!IsRelativeInside(e.file))
       p["file"].Fail("a path relative to the photo folder, without \"..\"");
-    e.exposure = p.Has("exposure") ? p["exposure"].NumberIn(1e-9, 1e9) : 1.0;
+    e.exposure =
+        p.Has("exposure") ? p["exposure"].NumberIn(kMinPhotoExposure, kMaxPhotoExposure) : 1.0;
     slides.insert({e.i, e.j, e.positive});
     // The same photo twice, or two photos of one slide at one exposure, would be merged as if
     // they were different measurements.

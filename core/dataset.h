@@ -70,6 +70,9 @@ double ParseDistance(const JsonView& value);
 // The truncation K of a filter (scene files, the printer's --k-max).
 int ParseFilterTruncation(const JsonView& k_max);
 
+// The range of dataset.json's photos[].exposure (relative exposure t ISO / N^2, any unit).
+constexpr double kMinPhotoExposure = 1e-9, kMaxPhotoExposure = 1e9;
+
 struct PhotoEntry {
   int i = 0;
   int j = 0;

@@ -5,6 +5,8 @@
 
 namespace lumislab {
 
+inline constexpr double kPi = 3.14159265358979323846;
+
 // g = cos^2(theta) / R^2 = d^2 / R^4 between (u,v) on S and (s,t) on M, in mm^-2.
 double GeometryTerm(double d, double u, double v, double s, double t);
 // Shift-invariant g_ij(s,t): the geometry term frozen at the filter centre c.

@@ -24,6 +24,12 @@ const char* LevelName(LogLevel level) {
 }
 }  // namespace
 
+std::string Num(double v, int digits) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.*g", digits, v);
+  return buffer;
+}
+
 void SetLogLevel(LogLevel level) { g_level = static_cast<int>(level); }
 LogLevel GetLogLevel() { return static_cast<LogLevel>(g_level.load()); }
 void SetLogTool(const std::string& tool) {

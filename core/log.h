@@ -22,6 +22,9 @@ void Append(std::ostringstream& os, const T& v, const Rest&... rest) {
 }
 }  // namespace internal
 
+// A number for a message: %g with `digits` significant digits ("0.0123", "1.5e+04").
+std::string Num(double v, int digits = 4);
+
 template <typename... Args>
 void Log(LogLevel level, const Args&... args) {
   if (level < GetLogLevel()) return;

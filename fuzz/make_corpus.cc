@@ -180,6 +180,18 @@ void Calibrations(const std::string& scratch) {
   plain.scale_px = 400;
   plain.Save(scratch + "/screen.json");
   Take(scratch + "/screen.json", "fuzz_screen_calibration", "plain.json");
+  // The screen's pose under a camera calibrated from many views (distortion model "opencv5").
+  ScreenCalibration posed = plain;
+  CameraModel camera;
+  camera.image_width = 640;
+  camera.image_height = 480;
+  camera.fx = 650, camera.fy = 651, camera.cx = 328, camera.cy = 234;
+  camera.k1 = -0.25, camera.k2 = 0.05, camera.p1 = 0.001, camera.p2 = -0.0008;
+  posed.camera = camera;
+  posed.camera_file = "calib/camera.json";
+  posed.method = "camera+pose";
+  posed.Save(scratch + "/screen.json");
+  Take(scratch + "/screen.json", "fuzz_screen_calibration", "camera_pose.json");
 }
 
 void Photos() {

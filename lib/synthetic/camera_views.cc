@@ -4,14 +4,13 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/geometry.h"
 #include "lib/synthetic/board.h"
 #include "lib/synthetic/camera.h"
 #include "lib/synthetic/scene.h"
 
 namespace lumislab {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 BoardLook ViewBoardLook() {
   BoardLook look;

@@ -6,6 +6,7 @@
 #include <cfloat>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numeric>
 
@@ -160,6 +161,10 @@ MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gai
 
 namespace {
 
+// A clipped value in the merge's rows: NaN, which fails every comparison, so that a clipped value
+// is neither well exposed nor near-black, and x == x tells whether a value is unclipped.
+constexpr float kClipped = std::numeric_limits<float>::quiet_NaN();
+
 // d(curve value) / d(code / code_max) of the photo's transfer curve at curve value l: the size
 // of one code step in curve units is this / code_max.
 float TransferSlope(Transfer transfer, float l) {
@@ -188,11 +193,10 @@ struct Exposure {
   const Photo* source = nullptr;
   bool linear_codes = false;
   float u_gain = 0, u_offset = 0, saturation_code = 0;
-  // 8-bit photos: u and clipped per code and channel (R, G, B), read through the reader from a
-  // 256-pixel photo holding every code, so the table is the decoder's own linearisation. Valid
-  // because LinearReader maps a code the same way at every pixel.
+  // 8-bit photos: u per code and channel (R, G, B), NaN where clipped, read through the reader
+  // from a 256-pixel photo holding every code, so the table is the decoder's own
+  // linearisation. Valid because LinearReader maps a code the same way at every pixel.
   std::vector<float> code_u[3];
-  std::vector<uint8_t> code_clipped[3];
   int slide = 0;        // 0: p, 1: n
   float recorded = 1;   // exposure in dataset.json
   float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
@@ -223,7 +227,7 @@ struct Exposure {
         for (int c = 0; c < codes.pixels.channels(); ++c)
           codes.pixels.ptr<uint8_t>(0)[v * codes.pixels.channels() + c] = uint8_t(v);
       const LinearReader code_reader(codes);
-      for (int c = 0; c < 3; ++c) code_u[c].resize(256), code_clipped[c].resize(256);
+      for (auto& table : code_u) table.resize(256);
       for (int v = 0; v < 256; ++v) {
         float rgb[3];
         bool clipped[3];
@@ -231,8 +235,7 @@ struct Exposure {
         for (int c = 0; c < 3; ++c) {
           const float value = rgb[c] * recorded;
           const bool ok = !clipped[c] && std::isfinite(value);
-          code_u[c][v] = ok ? value : 0.f;
-          code_clipped[c][v] = !ok;
+          code_u[c][v] = ok ? value : kClipped;
         }
       }
     }
@@ -290,35 +293,95 @@ std::vector<size_t> SlideOrder(const std::vector<Exposure>& exposures, int slide
   return order;
 }
 
+// The merge's readers: `pixels` pixels of row y from x0 into uk as the recorded value above black
+// u (R, G, B; NaN where clipped). 16-bit or float linear codes (CodesAreLinear):
+template <typename T>
+void ReadLinear(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
+  const Photo& photo = *e.source;
+  const T* __restrict row = photo.pixels.ptr<T>(y) + 3 * x0;
+  const float gain = e.u_gain, offset = e.u_offset, saturation = e.saturation_code;
+  // In storage order first (a plain loop that vectorises), then blue and red swapped.
+  for (int j = 0; j < 3 * pixels; ++j) {
+    const float code = float(row[j]);
+    const float value = code * gain - offset;
+    const bool ok = (code < saturation) & (std::abs(value) <= FLT_MAX);  // NaN: clipped
+    uk[j] = ok ? value : kClipped;
+  }
+  if (!photo.rgb_order)
+    for (int j = 0; j < 3 * pixels; j += 3) std::swap(uk[j], uk[j + 2]);
+}
+
+// 8-bit codes (1 or 3 channels) through the exposure's per-code tables:
+void ReadCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
+  const cv::Mat& m = e.source->pixels;
+  const float* __restrict r = e.code_u[0].data();
+  const float* __restrict g = e.code_u[1].data();
+  const float* __restrict b = e.code_u[2].data();
+  if (m.channels() == 1) {
+    const uint8_t* __restrict row = m.ptr<uint8_t>(y) + x0;
+    for (int x = 0; x < pixels; ++x)
+      uk[3 * x] = r[row[x]], uk[3 * x + 1] = g[row[x]], uk[3 * x + 2] = b[row[x]];
+    return;
+  }
+  const uint8_t* __restrict row = m.ptr<uint8_t>(y) + 3 * x0;
+  const int ri = e.source->rgb_order ? 0 : 2;  // storage position of red (blue: 2 - ri)
+  for (int x = 0; x < pixels; ++x, row += 3, uk += 3) {
+    uk[0] = r[row[ri]];
+    uk[1] = g[row[1]];
+    uk[2] = b[row[2 - ri]];
+  }
+}
+
+// Any other photo (calib/'s dark map, hot pixels or flat field), pixel by pixel:
+void ReadPixels(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
+  for (int x = 0; x < pixels; ++x) {
+    float v[3];
+    bool c[3];
+    e.reader.Read(y, x0 + x, v, c);
+    for (int ch = 0; ch < 3; ++ch) {
+      const float value = v[ch] * e.recorded;
+      uk[x * 3 + ch] = !c[ch] && std::isfinite(value) ? value : kClipped;
+    }
+  }
+}
+
 std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w, int h) {
   // A grid of at most ~2^18 pixels: the median of that many ratios is precise to ~1e-4.
   const int stride = std::max(1, int(std::ceil(std::sqrt(double(w) * h / 262144.0))));
+  const size_t grid = size_t((h - stride / 2 + stride - 1) / stride) *
+                      size_t((w - stride / 2 + stride - 1) / stride);
   std::vector<BracketRatio> ratios;
   for (int slide : {0, 1}) {
     const std::vector<size_t> order = SlideOrder(exposures, slide);
     if (order.size() < 2) continue;
-    std::vector<std::vector<float>> log_ratios(order.size() - 1);
-    std::vector<float> u(order.size() * 3);
-    std::vector<char> clipped(order.size() * 3);
+    // The ratios long / short; their median is taken, then its log (the median of the logs,
+    // as the log is monotonic, with one log instead of one per sample).
+    std::vector<std::vector<float>> sample_ratios(order.size() - 1);
+    for (auto& v : sample_ratios) v.reserve(3 * grid);
+    std::vector<float> u(order.size() * 3);  // NaN where clipped
     for (int y = stride / 2; y < h; y += stride)
       for (int x = stride / 2; x < w; x += stride) {
         for (size_t k = 0; k < order.size(); ++k) {
           const Exposure& e = exposures[order[k]];
+          float* uk = &u[k * 3];
+          if (!e.code_u[0].empty()) {  // the reader's values (all finite) through its table
+            ReadCodes(e, y, x, 1, uk);
+            continue;
+          }
           float v[3];
           bool c[3];
           e.reader.Read(y, x, v, c);
-          for (int ch = 0; ch < 3; ++ch)
-            u[k * 3 + ch] = v[ch] * e.recorded, clipped[k * 3 + ch] = c[ch];
+          for (int ch = 0; ch < 3; ++ch) uk[ch] = c[ch] ? kClipped : v[ch] * e.recorded;
         }
         for (size_t k = 0; k + 1 < order.size(); ++k)
           for (int ch = 0; ch < 3; ++ch) {
-            // Well exposed in both, and well above the near-black floor: the ratio of two
-            // values a few codes above black is dominated by their quantisation.
+            // Well exposed in both (not clipped: NaN fails the tests), and well above the
+            // near-black floor: the ratio of two values a few codes above black is dominated by
+            // their quantisation.
             const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
-            if (clipped[k * 3 + ch] || clipped[(k + 1) * 3 + ch]) continue;
             if (!(a >= 4 * exposures[order[k]].floor_u && a > 0)) continue;
             if (!(b >= 4 * exposures[order[k + 1]].floor_u && b > 0)) continue;
-            log_ratios[k].push_back(std::log(b / a));
+            sample_ratios[k].push_back(b / a);
           }
       }
     for (size_t k = 0; k + 1 < order.size(); ++k) {
@@ -327,10 +390,10 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
       r.recorded_short = exposures[order[k]].recorded;
       r.recorded_long = exposures[order[k + 1]].recorded;
       r.estimated = r.Recorded();
-      std::vector<float>& v = log_ratios[k];
+      std::vector<float>& v = sample_ratios[k];
       if (v.size() >= size_t(kMinRatioSamples)) {
         std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-        r.estimated = std::exp(double(v[v.size() / 2]));
+        r.estimated = std::exp(double(std::log(v[v.size() / 2])));
         r.samples = (long long)v.size();
       }
       ratios.push_back(r);
@@ -367,174 +430,293 @@ struct MergeStats {
 // Bits, so that the states of a pixel's channels combine with OR.
 enum : uint8_t { kMeasured = 0, kNearBlackEverywhere = 1, kClippedEverywhere = 2 };
 
-// Merges one photo row of both slides, channel by channel, in passes over the row (one per
-// exposure) that the compiler vectorises, rather than branching per pixel and exposure.
+// GCC on x86-64: the row kernels below are compiled for the SSE2 baseline and for AVX2, and the
+// loader picks the one the processor runs (glibc ifunc). Both do the same IEEE operations in the
+// same order (AVX2 without FMA, so nothing is contracted): the same numbers on every machine.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(LUMISLAB_NO_TARGET_CLONES)
+#define LUMISLAB_ROW_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define LUMISLAB_ROW_KERNEL
+#endif
+#define LUMISLAB_INLINE inline __attribute__((always_inline))
+
+// A row is merged in chunks of this many values (256 pixels x 3 channels), so that the
+// per-exposure values and the scratch of the passes below stay in the L1/L2 cache.
+constexpr int kChunk = 3 * 256;
+// Slides with up to this many exposures get kernels with the exposure loop unrolled (vectorised
+// over the values); more take the same code with a run-time count.
+constexpr int kMaxUnrolled = 4;
+
+// One slide's exposures as the kernels read them, longest effective exposure first.
+struct SlideParams {
+  int n = 0;
+  bool curved = false;  // some exposure's quantisation term varies (a table over the curve)
+  float inv_full_well = 0;
+  std::vector<float> eff, inv_eff, floor_u;
+  // var(u) = (u / FW + constant) + table term: constant = read_var + quant_var[0] where the
+  // term is constant (and the table term 0), read_var where it comes from the table.
+  std::vector<float> constant, range, black;
+  std::vector<const float*> quant_var;  // the exposure's table, nullptr where constant
+};
+
+// The per-chunk scratch of one slide: the pilot estimate, the longest unclipped value over its
+// exposure, the sum of the well-exposed exposures (> 0: measured), whether any value was
+// unclipped, and each exposure's table term of the variance.
+struct SlideScratch {
+  float pilot[kChunk], longest[kChunk], sum_e[kChunk], found[kChunk];
+  float quant[kMaxUnrolled * kChunk];
+  int entry[kChunk];
+  std::vector<float> quant_more;  // [n * kChunk] for slides with more exposures
+};
+
+// A slide's per-exposure parameters, copied to the stack when the count is a constant: the
+// loops over the values may then load them unconditionally (if-converted and vectorised) where
+// they are only used under a condition.
+template <int kN>
+struct Local {
+  float local[kN > 0 ? kN : 1];
+  const float* values;
+  explicit Local(const std::vector<float>& v) : values(kN > 0 ? local : v.data()) {
+    if (kN > 0) std::copy_n(v.data(), kN, local);
+  }
+  float operator[](int k) const { return values[k]; }
+};
+
+// Pilot: over the well-exposed values (Exposure::floor_u), sum u / sum exposure, the
+// maximum-likelihood estimate under shot noise alone (weights = exposures). Longest first, so
+// the first unclipped value met is the longest exposure's (used where all are near-black).
+// u: the slide's values, [k * kChunk + i], NaN where clipped.
+template <int kN>
+LUMISLAB_INLINE void PilotPass(const SlideParams& p, const float* __restrict u, int m,
+                               SlideScratch& __restrict s) {
+  const int n = kN > 0 ? kN : p.n;
+  Local<kN> eff(p.eff), inv_eff(p.inv_eff), floor_u(p.floor_u);
+  for (int i = 0; i < m; ++i) {
+    float su = 0, se = 0, lg = 0, found = 0;
+    for (int k = 0; k < n; ++k) {
+      const float x = u[k * kChunk + i];
+      const float unclipped = x == x ? 1.f : 0.f;
+      const bool well = (x >= floor_u[k]) & (x > 0.f);  // false where clipped (NaN)
+      su += well ? x : 0.f;
+      se += well ? eff[k] : 0.f;
+      // lg is 0 until the first unclipped value, then stays.
+      lg += (1.f - found) * unclipped > 0.f ? x * inv_eff[k] : 0.f;
+      found = std::max(found, unclipped);
+    }
+    s.pilot[i] = su / se;  // 0 / 0 where nothing is well exposed: never used
+    s.longest[i] = lg;
+    s.sum_e[i] = se;
+    s.found[i] = found;
+  }
+}
+
+// The table term of each curved exposure's variance at the pilot's expected u = e * pilot (the
+// curve value's 1/1024 step, as Exposure::Variance); 0 for the others. A NaN pilot (an unused
+// lane) reads entry 0.
+LUMISLAB_INLINE void QuantPass(const SlideParams& p, int m, SlideScratch& __restrict s,
+                               float* __restrict quant) {
+  constexpr int kLast = Exposure::kQuantTable - 1;
+  for (int k = 0; k < p.n; ++k) {
+    float* __restrict q = quant + k * kChunk;
+    const float* __restrict table = p.quant_var[k];
+    if (!table) {
+      std::fill_n(q, m, 0.f);
+      continue;
+    }
+    // The entries first (vectorised), then the lookups.
+    int* __restrict entry = s.entry;
+    const float eff = p.eff[k], range = p.range[k], black = p.black[k];
+    for (int i = 0; i < m; ++i) {
+      const float l = eff * s.pilot[i] * range + black;
+      entry[i] = l >= 1.f ? kLast : l > 0.f ? int(l * kLast + 0.5f) : 0;
+    }
+    for (int i = 0; i < m; ++i) q[i] = table[entry[i]];
+  }
+}
+
+// Inverse-variance weights e^2 / var(u) at the pilot's expected u = e * pilot: the read-noise
+// and quantisation terms favour the longer exposures more than the shot-noise weights do. (Each
+// exposure's own u would bias the weights towards values that read low.) With one well-exposed
+// value this is that value / its exposure. Computed on every lane and selected (where the value
+// is not well exposed, 0 / 0 pilots and zero variances may give NaN or inf, never used). Then
+// the merged value and state, and per lane the brightest and faintest measured values.
+template <int kN, bool kCurved>
+LUMISLAB_INLINE void WeightPass(const SlideParams& p, const float* __restrict u, int m,
+                                const SlideScratch& __restrict s, const float* __restrict quant,
+                                float* __restrict value, uint8_t* __restrict state,
+                                float* __restrict brightest, float* __restrict faintest) {
+  const int n = kN > 0 ? kN : p.n;
+  Local<kN> eff(p.eff), floor_u(p.floor_u), constant(p.constant);
+  const float inv_full_well = p.inv_full_well;
+  for (int i = 0; i < m; ++i) {
+    const float pilot = s.pilot[i];
+    float sw = 0, swx = 0;
+    for (int k = 0; k < n; ++k) {
+      const float x = u[k * kChunk + i];
+      const bool well = (x >= floor_u[k]) & (x > 0.f);
+      const float u_expected = eff[k] * pilot;
+      float variance = u_expected * inv_full_well + constant[k];
+      if (kCurved) variance += quant[k * kChunk + i];
+      // w / e = e / var(u), applied to u: sum_wx = sum w * (u / e).
+      const float w_over_e = eff[k] / variance;
+      sw += well ? w_over_e * eff[k] : 0.f;
+      swx += well ? w_over_e * x : 0.f;
+    }
+    const bool measured = s.sum_e[i] > 0.f;
+    const bool any = s.found[i] != 0.f;
+    const float v = !any ? 0.f : measured ? swx / sw : s.longest[i];
+    value[i] = v;
+    state[i] = !any ? kClippedEverywhere : measured ? kMeasured : kNearBlackEverywhere;
+    // As std::max / std::min, lane by lane (a NaN value is never taken).
+    const float b = measured ? v : 0.f;
+    brightest[i] = brightest[i] < b ? b : brightest[i];
+    const float f = measured & (v > 0.f) ? v : faintest[i];
+    faintest[i] = f < faintest[i] ? f : faintest[i];
+  }
+}
+
+template <int kN>
+LUMISLAB_INLINE void MergeSlideChunkN(const SlideParams& p, const float* u, int m, SlideScratch& s,
+                                      float* value, uint8_t* state, float* brightest,
+                                      float* faintest) {
+  PilotPass<kN>(p, u, m, s);
+  if (!p.curved) {
+    WeightPass<kN, false>(p, u, m, s, nullptr, value, state, brightest, faintest);
+    return;
+  }
+  float* quant = p.n <= kMaxUnrolled ? s.quant : s.quant_more.data();
+  QuantPass(p, m, s, quant);
+  WeightPass<kN, true>(p, u, m, s, quant, value, state, brightest, faintest);
+}
+
+// One slide over a chunk of m values (m <= kChunk): u as in PilotPass, value and state out,
+// brightest and faintest updated lane by lane.
+LUMISLAB_ROW_KERNEL void MergeSlideChunk(const SlideParams& p, const float* u, int m,
+                                         SlideScratch& s, float* value, uint8_t* state,
+                                         float* brightest, float* faintest) {
+  static_assert(kMaxUnrolled == 4, "MergeSlideChunk: one case per unrolled count");
+  switch (p.n) {
+    case 1:
+      return MergeSlideChunkN<1>(p, u, m, s, value, state, brightest, faintest);
+    case 2:
+      return MergeSlideChunkN<2>(p, u, m, s, value, state, brightest, faintest);
+    case 3:
+      return MergeSlideChunkN<3>(p, u, m, s, value, state, brightest, faintest);
+    case 4:
+      return MergeSlideChunkN<4>(p, u, m, s, value, state, brightest, faintest);
+    default:
+      return MergeSlideChunkN<0>(p, u, m, s, value, state, brightest, faintest);
+  }
+}
+
+// Both slides of `pixels` pixels into gain * (v+ - v-) per value, 0 where the pixel is saturated
+// (a channel of a slide clipped in every exposure: the states are bits, so one OR over the six
+// channels tells), and 1 / 0 per pixel for saturated; counts the saturated and the near-black
+// pixels.
+LUMISLAB_ROW_KERNEL void CombineSlides(const float* __restrict v0, const float* __restrict v1,
+                                       const uint8_t* __restrict s0, const uint8_t* __restrict s1,
+                                       int pixels, float gain, float* __restrict difference,
+                                       float* __restrict saturated, int* saturated_count,
+                                       int* near_black_count) {
+  int n_saturated = 0, n_near_black = 0;
+  for (int x = 0; x < pixels; ++x) {
+    const int i = 3 * x;
+    const int any = s0[i] | s0[i + 1] | s0[i + 2] | s1[i] | s1[i + 1] | s1[i + 2];
+    const bool sat = any & kClippedEverywhere;
+    n_saturated += sat;
+    n_near_black += !sat & ((any & kNearBlackEverywhere) != 0);
+    saturated[x] = sat ? 1.f : 0.f;
+    for (int c = 0; c < 3; ++c) difference[i + c] = sat ? 0.f : gain * (v0[i + c] - v1[i + c]);
+  }
+  *saturated_count += n_saturated;
+  *near_black_count += n_near_black;
+}
+
+// Merges one photo row of both slides. Each exposure's values of a chunk of the row are read
+// once (linear codes or per-code tables, NaN where clipped), then each slide is merged in three
+// passes over the chunk (pilot, the table term of curved photos, weighted sums) whose loops over
+// the slide's exposures are unrolled so that the compiler vectorises over the values.
 struct MergeRows {
   const std::vector<Exposure>& exposures;
-  const std::vector<int>* members;  // [2]: each slide's photos, longest exposure first
-  int n3;                           // 3 * width
-  // [photo][x * 3 + c]: recorded value above black, and 1 where clipped (0 otherwise). All
-  // per-row arrays are float, so that the passes below vectorise without conversions.
-  std::vector<std::vector<float>> u, clip;
-  // Per slide: the merged exposure-normalised value and how it was merged.
+  int width, n3;  // n3 = 3 * width
+  SlideParams params[2];
+  std::vector<int> slot_of;  // exposure -> its row of `u`: slide 0's, then slide 1's, longest first
+  int first_slot[2] = {0, 0};
+  std::vector<float> u;  // [slot * kChunk + i]: recorded value above black, NaN where clipped
+  std::unique_ptr<SlideScratch> scratch;
+  // Per slide: the merged exposure-normalised value and how it was merged, the whole row.
   std::vector<float> value[2];
   std::vector<uint8_t> state[2];
-  // Scratch: pilot sums, the longest unclipped value and whether one was met, weighted sums.
-  std::vector<float> sum_u, sum_e, longest, found, sum_w, sum_wx;
+  // The row's gain * (v+ - v-) (0 where saturated) and saturated flags, for the box average.
+  std::vector<float> difference, saturated;
+  // Per lane of a chunk: the brightest and the faintest measured value so far.
+  std::vector<float> brightest, faintest;
 
-  MergeRows(const std::vector<Exposure>& e, const std::vector<int>* m, int width)
-      : exposures(e), members(m), n3(3 * width) {
-    u.assign(e.size(), std::vector<float>(n3));
-    clip.assign(e.size(), std::vector<float>(n3));
+  MergeRows(const std::vector<Exposure>& e, const std::vector<int>* members, int w,
+            float inv_full_well)
+      : exposures(e), width(w), n3(3 * w), slot_of(e.size()), scratch(new SlideScratch) {
+    int slot = 0;
+    for (int sl = 0; sl < 2; ++sl) {
+      first_slot[sl] = slot;
+      SlideParams& p = params[sl];
+      p.n = int(members[sl].size());
+      p.inv_full_well = inv_full_well;
+      for (const int k : members[sl]) {
+        const Exposure& x = e[k];
+        slot_of[k] = slot++;
+        p.eff.push_back(x.effective);
+        p.inv_eff.push_back(1.f / x.effective);
+        p.floor_u.push_back(x.floor_u);
+        p.constant.push_back(x.curved ? x.read_var : x.read_var + x.quant_var[0]);
+        p.range.push_back(x.range);
+        p.black.push_back(x.black);
+        p.quant_var.push_back(x.curved ? x.quant_var.data() : nullptr);
+        p.curved |= x.curved;
+      }
+      if (p.curved && p.n > kMaxUnrolled)  // (the scratch serves both slides)
+        scratch->quant_more.resize(std::max(scratch->quant_more.size(), size_t(p.n) * kChunk));
+    }
+    u.resize(e.size() * kChunk);
     for (int s = 0; s < 2; ++s) value[s].resize(n3), state[s].resize(n3);
-    for (auto* v : {&sum_u, &sum_e, &longest, &found, &sum_w, &sum_wx}) v->resize(n3);
+    difference.resize(n3), saturated.resize(w);
+    brightest.assign(kChunk, 0.f);
+    faintest.assign(kChunk, std::numeric_limits<float>::infinity());
   }
 
-  // One row of 16-bit or float linear codes (CodesAreLinear) into u and clip, RGB order.
-  template <typename T>
-  void ReadLinearRow(const Exposure& e, int y, float* __restrict uk, float* __restrict ck) {
-    const Photo& photo = *e.source;
-    const T* __restrict row = photo.pixels.ptr<T>(y);
-    const int r = photo.rgb_order ? 0 : 2;
-    const float gain = e.u_gain, offset = e.u_offset, saturation = e.saturation_code;
-    // In storage order first (a plain loop that vectorises), then blue and red swapped.
-    for (int j = 0; j < n3; ++j) {
-      const float code = float(row[j]);
-      const float value = code * gain - offset;
-      const bool ok = (code < saturation) & (std::abs(value) <= FLT_MAX);  // NaN: clipped
-      uk[j] = ok ? value : 0.f;
-      ck[j] = ok ? 0.f : 1.f;
-    }
-    if (r != 0)
-      for (int j = 0; j < n3; j += 3) std::swap(uk[j], uk[j + 2]), std::swap(ck[j], ck[j + 2]);
-  }
-
-  // One row of 8-bit codes through the exposure's tables, RGB order (1 or 3 channels).
-  void ReadCodeRow(const Exposure& e, int y, float* __restrict uk, float* __restrict ck) {
-    const cv::Mat& m = e.source->pixels;
-    const uint8_t* row = m.ptr<uint8_t>(y);
-    const int channels = m.channels();
-    const int offsets[3] = {channels == 1         ? 0
-                            : e.source->rgb_order ? 0
-                                                  : 2,
-                            channels == 1 ? 0 : 1,
-                            channels == 1         ? 0
-                            : e.source->rgb_order ? 2
-                                                  : 0};
-    for (int c = 0; c < 3; ++c) {
-      const float* table = e.code_u[c].data();
-      const uint8_t* clipped = e.code_clipped[c].data();
-      for (int x = 0; x < n3 / 3; ++x) {
-        const uint8_t code = row[x * channels + offsets[c]];
-        uk[x * 3 + c] = table[code];
-        ck[x * 3 + c] = clipped[code];
-      }
-    }
-  }
-
-  void Merge(int y, float inv_full_well, MergeStats* stats) {
-    for (size_t k = 0; k < exposures.size(); ++k) {
-      const Exposure& e = exposures[k];
-      float* uk = u[k].data();
-      float* ck = clip[k].data();
-      if (e.linear_codes) {
-        if (e.source->pixels.depth() == CV_16U)
-          ReadLinearRow<uint16_t>(e, y, uk, ck);
+  // Row y: value, state, difference and saturated for the whole row; stats counted.
+  void Merge(int y, float gain, MergeStats* stats) {
+    for (int x0 = 0; x0 < width; x0 += kChunk / 3) {
+      const int pixels = std::min(kChunk / 3, width - x0), m = 3 * pixels;
+      for (size_t k = 0; k < exposures.size(); ++k) {
+        const Exposure& e = exposures[k];
+        float* uk = u.data() + size_t(slot_of[k]) * kChunk;
+        if (e.linear_codes && e.source->pixels.depth() == CV_16U)
+          ReadLinear<uint16_t>(e, y, x0, pixels, uk);
+        else if (e.linear_codes)
+          ReadLinear<float>(e, y, x0, pixels, uk);
+        else if (!e.code_u[0].empty())
+          ReadCodes(e, y, x0, pixels, uk);
         else
-          ReadLinearRow<float>(e, y, uk, ck);
-        continue;
+          ReadPixels(e, y, x0, pixels, uk);
       }
-      if (!e.code_u[0].empty()) {
-        ReadCodeRow(e, y, uk, ck);
-        continue;
-      }
-      for (int x = 0; x < n3 / 3; ++x) {
-        float v[3];
-        bool c[3];
-        e.reader.Read(y, x, v, c);
-        for (int ch = 0; ch < 3; ++ch) {
-          const float value = v[ch] * e.recorded;
-          const bool ok = !c[ch] && std::isfinite(value);
-          uk[x * 3 + ch] = ok ? value : 0.f;
-          ck[x * 3 + ch] = ok ? 0.f : 1.f;
-        }
-      }
+      for (int s = 0; s < 2; ++s)
+        MergeSlideChunk(params[s], u.data() + size_t(first_slot[s]) * kChunk, m, *scratch,
+                        value[s].data() + 3 * x0, state[s].data() + 3 * x0, brightest.data(),
+                        faintest.data());
+      CombineSlides(value[0].data() + 3 * x0, value[1].data() + 3 * x0, state[0].data() + 3 * x0,
+                    state[1].data() + 3 * x0, pixels, gain, difference.data() + 3 * x0,
+                    saturated.data() + x0, &stats->saturated, &stats->near_black);
     }
-    for (int s = 0; s < 2; ++s) MergeSlide(s, inv_full_well, stats);
   }
 
-  void MergeSlide(int s, float inv_full_well, MergeStats* stats) {
-    float* __restrict su = sum_u.data();
-    float* __restrict se = sum_e.data();
-    float* __restrict lg = longest.data();
-    float* __restrict fd = found.data();
-    float* __restrict sw = sum_w.data();
-    float* __restrict swx = sum_wx.data();
-    std::fill_n(su, n3, 0.f);
-    std::fill_n(se, n3, 0.f);
-    std::fill_n(lg, n3, 0.f);
-    std::fill_n(fd, n3, 0.f);
-    // Pilot: over the well-exposed values (Exposure::floor_u), sum u / sum exposure, the
-    // maximum-likelihood estimate under shot noise alone (weights = exposures). Longest first,
-    // so the first unclipped value met is the longest exposure's (used where all are
-    // near-black).
-    for (const int k : members[s]) {
-      const Exposure& e = exposures[k];
-      const float* __restrict uk = u[k].data();
-      const float* __restrict ck = clip[k].data();
-      const float floor_u = e.floor_u, eff = e.effective, inv_eff = 1.f / e.effective;
-      // 0/1 masks multiplied in (u is finite, 0 where clipped), no branches.
-      for (int i = 0; i < n3; ++i) {
-        const float unclipped = 1.f - ck[i];
-        const float well = (uk[i] >= floor_u) & (uk[i] > 0.f) ? unclipped : 0.f;
-        su[i] += well * uk[i];
-        se[i] += well * eff;
-        lg[i] += (1.f - fd[i]) * unclipped * uk[i] * inv_eff;  // lg is 0 until the first
-        fd[i] = std::max(fd[i], unclipped);
-      }
+  // The brightest and faintest measured values of every row merged (std::max / std::min over
+  // the lanes: the same as in pixel order).
+  void Finish(MergeStats* stats) const {
+    for (int i = 0; i < kChunk; ++i) {
+      stats->brightest = std::max(stats->brightest, brightest[i]);
+      stats->faintest = std::min(stats->faintest, faintest[i]);
     }
-    // Inverse-variance weights e^2 / var(u) at the pilot's expected u = e * pilot: the
-    // read-noise and quantisation terms favour the longer exposures more than the shot-noise
-    // weights do. (Each exposure's own u would bias the weights towards values that read low.)
-    // With one well-exposed value this is that value / its exposure. Computed on every lane and
-    // selected (a value that is not well exposed may give inf or NaN here, never used).
-    std::fill_n(sw, n3, 0.f);
-    std::fill_n(swx, n3, 0.f);
-    for (int i = 0; i < n3; ++i) su[i] /= se[i];  // su: the pilot from here on
-    for (const int k : members[s]) {
-      const Exposure& e = exposures[k];
-      const float* __restrict uk = u[k].data();
-      const float* __restrict ck = clip[k].data();
-      const float floor_u = e.floor_u, eff = e.effective;
-      const float constant = e.read_var + e.quant_var[0];
-      const auto accumulate = [&](auto variance) {
-        for (int i = 0; i < n3; ++i) {
-          const bool well = (ck[i] == 0.f) & (uk[i] >= floor_u) & (uk[i] > 0.f);
-          // A select, not a product: where the pixel is not well exposed, 0 / 0 pilots and
-          // zero variances may give NaN or inf here.
-          // w / e = e / var(u), applied to u: sum_wx = sum w * (u / e).
-          const float w_over_e = eff / variance(eff * su[i]);
-          sw[i] += well ? w_over_e * eff : 0.f;
-          swx[i] += well ? w_over_e * uk[i] : 0.f;
-        }
-      };
-      if (e.curved)
-        accumulate([&](float u_expected) { return e.Variance(u_expected, inv_full_well); });
-      else  // the quantisation term is a constant: Variance without the table
-        accumulate([&](float u_expected) { return u_expected * inv_full_well + constant; });
-    }
-    float* v = value[s].data();
-    uint8_t* st = state[s].data();
-    float brightest = stats->brightest, faintest = stats->faintest;
-    for (int i = 0; i < n3; ++i) {
-      const bool measured = se[i] > 0;
-      const bool any = fd[i] != 0.f;
-      v[i] = !any ? 0.f : measured ? swx[i] / sw[i] : lg[i];
-      st[i] = !any ? kClippedEverywhere : measured ? kMeasured : kNearBlackEverywhere;
-      brightest = std::max(brightest, measured ? v[i] : 0.f);
-      faintest = std::min(faintest, measured & (v[i] > 0) ? v[i] : faintest);
-    }
-    stats->brightest = brightest, stats->faintest = faintest;
   }
 };
 
@@ -578,39 +760,29 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
   const int bands = (h + f - 1) / f;
   cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
     MergeStats stats;
-    MergeRows rows(exposures, members, w);
+    MergeRows rows(exposures, members, w, inv_full_well);
     std::vector<float> acc(size_t(ow) * 4);
     for (int band = range.start; band < range.end; ++band) {
       std::fill(acc.begin(), acc.end(), 0.f);
       for (int y = band * f; y < std::min(h, (band + 1) * f); ++y) {
-        rows.Merge(y, inv_full_well, &stats);
-        const float* v0 = rows.value[0].data();
-        const float* v1 = rows.value[1].data();
-        const uint8_t* s0 = rows.state[0].data();
-        const uint8_t* s1 = rows.state[1].data();
-        const bool in_band = band < oh;
-        for (int x = 0, ox = 0, dx = 0; x < w; ++x) {
-          // A pixel is saturated (near-black) when a channel of a slide is, in every exposure:
-          // the states are bits, so one OR over the six channels tells.
-          const int i = x * 3;
-          const uint8_t any = s0[i] | s0[i + 1] | s0[i + 2] | s1[i] | s1[i + 1] | s1[i + 2];
-          const bool saturated = any & kClippedEverywhere;
-          stats.saturated += saturated;
-          stats.near_black += !saturated && (any & kNearBlackEverywhere);
-          if (in_band && ox < ow) {
-            float* o = &acc[size_t(ox) * 4];
-            if (saturated)
-              o[3] += 1.f;
-            else
-              for (int ch = 0; ch < 3; ++ch) o[ch] += g * (v0[i + ch] - v1[i + ch]);
+        rows.Merge(y, g, &stats);
+        if (band >= oh) continue;  // merged for the counts only
+        // The F x F box sums, in the order of the pixels (x, then y).
+        const float* d = rows.difference.data();
+        const float* sat = rows.saturated.data();
+        for (int ox = 0; ox < ow; ++ox) {
+          float* o = &acc[size_t(ox) * 4];
+          for (int x = ox * f; x < (ox + 1) * f; ++x) {
+            for (int ch = 0; ch < 3; ++ch) o[ch] += d[x * 3 + ch];
+            o[3] += sat[x];
           }
-          if (++dx == f) dx = 0, ++ox;  // the output pixel of x (x / f, without dividing)
         }
       }
       if (band >= oh) continue;
       float* o = out.signal.ptr<float>(band);
       for (size_t k = 0; k < acc.size(); ++k) o[k] = acc[k] * inv_area;
     }
+    rows.Finish(&stats);
     std::lock_guard<std::mutex> lock(total_mutex);
     total.saturated += stats.saturated;
     total.near_black += stats.near_black;

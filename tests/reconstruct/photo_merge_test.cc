@@ -218,6 +218,54 @@ TEST(BracketMerge, EightBitAndFloatBracketsAgreeWithTruth) {
   }
 }
 
+// Slides of more exposures than the merge's unrolled kernels (up to 4) take the same code with a
+// run-time count: five deliberately inconsistent float exposures against the hand-computed
+// inverse-variance weights, and six 8-bit sRGB exposures (each with its own quantisation term)
+// against the truth, as in EightBitAndFloatBracketsAgreeWithTruth.
+TEST(BracketMerge, MoreExposuresThanTheUnrolledKernels) {
+  const double e[] = {1, 2, 4, 8, 16}, u[] = {0.1, 0.25, 0.42, 0.8, 0.95};
+  std::vector<DecodedPhoto> photos;
+  for (int k = 0; k < 5; ++k) photos.push_back(Constant(true, e[k], u[k]));
+  photos.push_back(Constant(false, 1, 0.07));
+  MergeOptions options;
+  options.noise = {1000, 20};
+  const double pilot = (0.1 + 0.25 + 0.42 + 0.8 + 0.95) / 31, r2 = 0.02 * 0.02;
+  double sw = 0, swx = 0;
+  for (int k = 0; k < 5; ++k) {
+    const double w = e[k] * e[k] / (e[k] * pilot / 1000 + r2);
+    sw += w, swx += w * u[k] / e[k];
+  }
+  const MergedPosition m = MergeFullResolution(photos, 1.0, 1, options);
+  EXPECT_EQ(m.exposures, 5);
+  EXPECT_NEAR(At(m, 2, 1)[1], swx / sw - 0.07, 1e-6);
+
+  const int w = 256, h = 8;
+  auto truth = [](int x, int, int c) {
+    return 2e-3 * std::pow(2.0, 9.0 * x / 255) * (1 - 0.2 * c);
+  };
+  std::vector<DecodedPhoto> srgb;
+  for (int k = 0; k < 6; ++k) {
+    const double exposure = std::pow(2.0, k - 3);  // 1/8 .. 4
+    srgb.push_back(MakePhoto(
+        w, h, true, exposure, CV_8U, Transfer::kSrgb,
+        [&](int x, int y, int c) { return Srgb(std::min(1.0, exposure * truth(x, y, c))); }));
+  }
+  srgb.push_back(Constant(false, 1, 0, w, h));
+  const MergedPosition s = MergeFullResolution(srgb, 1.0);
+  EXPECT_EQ(s.exposures, 6);
+  double max_rel = 0;
+  int count = 0;
+  for (int x = 0; x < w; ++x)
+    for (int c = 0; c < 3; ++c) {
+      const double t = truth(x, 0, c);
+      if (std::lround(Srgb(std::min(1.0, t / 8)) * 255) >= 255 || 4 * t < 0.01) continue;
+      max_rel = std::max(max_rel, std::abs(At(s, x, 3)[c] - t) / t);
+      ++count;
+    }
+  EXPECT_GT(count, 500);
+  EXPECT_LE(max_rel, 0.04);
+}
+
 // A calibrated response curve (calib/response.json) that happens to be the sRGB curve merges
 // exactly as sRGB photos do: the same quantisation noise per code, so the same weights. (The
 // merge once took the quantisation term of a response curve at black for every value, which

@@ -1,6 +1,12 @@
 #include "acquire_test_util.h"
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "core/error.h"
 
 namespace lumislab::acquire_test {
 
@@ -27,6 +33,34 @@ std::string FreshDir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+SynthOptions SmallSynthOptions(const std::string& out) {
+  SynthOptions options;
+  options.out_dir = out;
+  options.threads = 2;
+  options.truth_resolution = 20;
+  options.photo_format = "float";
+  return options;
+}
+
+void ExpectEffectsRefused(const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (const auto& [effects, field] : cases) {
+    try {
+      SmallScene(effects);
+      ADD_FAILURE() << "accepted: " << effects;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ExitCode::kBadInput) << effects;
+      const std::string message = e.what();
+      EXPECT_EQ(message.rfind("small.json: " + field + ": expected ", 0), 0u)
+          << effects << " -> " << message;
+    }
+  }
 }
 
 }  // namespace lumislab::acquire_test

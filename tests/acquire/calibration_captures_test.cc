@@ -23,8 +23,10 @@ namespace fs = std::filesystem;
 namespace lumislab {
 namespace {
 
+using acquire_test::FileBytes;
 using acquire_test::FreshDir;
 using acquire_test::SmallSceneJson;
+using acquire_test::SmallSynthOptions;
 
 const char* kEffects =
     R"([{"type": "vignetting", "k1": -0.1}, {"type": "ambient", "level": 0.03},
@@ -39,27 +41,13 @@ std::string WithCaptures(const std::string& effects, const std::string& captures
   return SmallSceneJson(effects + ", \"calibration_captures\": " + captures);
 }
 
-std::string FileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-SynthOptions Options(const std::string& out) {
-  SynthOptions options;
-  options.out_dir = out;
-  options.threads = 2;
-  options.truth_resolution = 20;
-  options.photo_format = "float";
-  return options;
-}
-
 // Without the block nothing of it is made; with it, every file the capture wrote without it is
 // the same to the byte (the frames' noise streams come after the slide photos').
 TEST(CalibrationCaptures, AbsentBlockChangesNothing) {
   const std::string without = FreshDir("captures_without") + "/ds";
   const std::string with = FreshDir("captures_with") + "/ds";
-  RunSynth(ParseScene(SmallSceneJson(kEffects), "small.json"), Options(without));
-  RunSynth(ParseScene(WithCaptures(kEffects, kCaptures), "small.json"), Options(with));
+  RunSynth(ParseScene(SmallSceneJson(kEffects), "small.json"), SmallSynthOptions(without));
+  RunSynth(ParseScene(WithCaptures(kEffects, kCaptures), "small.json"), SmallSynthOptions(with));
   EXPECT_FALSE(fs::exists(without + "/calibration"));
   for (const char* f : {"flat.exr", "dark.exr", "reference.json"})
     EXPECT_FALSE(fs::exists(without + "/truth/" + f)) << f;
@@ -96,7 +84,7 @@ TEST(CalibrationCaptures, FramesAreTheirModels) {
                                "flat_level": 0.4})"),
                  "small.json");
   const std::string ds = FreshDir("captures_models") + "/ds";
-  RunSynth(scene, Options(ds));
+  RunSynth(scene, SmallSynthOptions(ds));
   const ImageF dark = ReadExr(ds + "/calibration/dark/dark_ev+1_00.exr", {"R", "G", "B"});
   const ImageF flat = ReadExr(ds + "/calibration/flat/flat_00.exr", {"R", "G", "B"});
   const ImageF truth_dark = ReadExr(ds + "/truth/dark.exr", {"black", "current", "hot"});

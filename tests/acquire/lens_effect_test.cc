@@ -12,7 +12,6 @@
 
 #include "acquire/synth.h"
 #include "acquire_test_util.h"
-#include "core/error.h"
 #include "core/exr_io.h"
 #include "core/json.h"
 #include "lib/synthetic/calibration_captures.h"

@@ -11,7 +11,6 @@
 #include "acquire/synth.h"
 #include "acquire_test_util.h"
 #include "core/dataset.h"
-#include "core/error.h"
 #include "lib/photo/exif.h"
 #include "lib/photo/photo_io.h"
 #include "lib/synthetic/effects.h"
@@ -74,16 +73,7 @@ TEST(RawEffect, ParametersRefusedNamingTheField) {
       {R"([{"type": "raw"}, {"type": "response"}])", "effects[1].type"},
       {R"([{"type": "quantization"}, {"type": "raw"}])", "effects[1].type"},
   };
-  for (const auto& [effects, field] : cases) {
-    try {
-      SmallScene(effects);
-      ADD_FAILURE() << "accepted: " << effects;
-    } catch (const Error& e) {
-      EXPECT_EQ(e.code(), ExitCode::kBadInput) << effects;
-      EXPECT_EQ(std::string(e.what()).rfind("small.json: " + field + ": expected ", 0), 0u)
-          << effects << " -> " << e.what();
-    }
-  }
+  acquire_test::ExpectEffectsRefused(cases);
 }
 
 }  // namespace

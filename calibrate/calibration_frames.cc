@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "core/screen_calibration.h"
 #include "lib/photo/exif.h"
 
@@ -73,6 +74,14 @@ std::vector<CalibrationFrame> DecodeCalibrationFrames(const Dataset& dataset,
     frames.push_back(std::move(f));
   }
   return frames;
+}
+
+// Says when the decoder linearised `photo`'s codes through the sRGB curve (8- or 16-bit codes,
+// no calibrated response for them); RAW and float frames are linear and say nothing.
+void NoteSrgbCurve(const char* step, const Photo& photo) {
+  if (photo.transfer == Transfer::kSrgb && photo.pixels.depth() != CV_32F)
+    LogInfo(step, ": ", photo.pixels.elemSize1() * 8, "-bit ", PhotoFormatName(photo.format),
+            " photos linearised through the sRGB curve (no calib/response.json for them)");
 }
 
 }  // namespace lumislab

@@ -38,4 +38,8 @@ std::vector<CalibrationFrame> DecodeCalibrationFrames(const Dataset& dataset,
 // Parses "e1,e2,..." (each finite and > 0); BadInput naming --exposures otherwise.
 std::vector<double> ParseExposureList(const std::string& text);
 
+// Logs (info) that `photo`'s codes went through the sRGB curve when they did (8- or 16-bit codes
+// without a calibrated response); `step` starts the line. Linear RAW and float photos: nothing.
+void NoteSrgbCurve(const char* step, const Photo& photo);
+
 }  // namespace lumislab

@@ -70,10 +70,7 @@ std::shared_ptr<const PhotoCorrections> Corrections(const Dataset& dataset, Corr
   if (c->response) what += " response curve (" + c->response->file + ")";
   if (c->dark) what += " dark map (" + c->dark->file + ")";
   if (c->flat) what += " flat field (" + c->flat->file + ")";
-  LogInfo(step, ": decoding with", what.empty() ? " no radiometric calibration" : what,
-          which.response && !c->response ? "; 8-bit photos through the sRGB curve: no "
-                                           "calib/response.json"
-                                         : "");
+  LogInfo(step, ": decoding with", what.empty() ? " no radiometric calibration" : what);
   return c;
 }
 
@@ -93,8 +90,10 @@ int RunDark(const RadiometricCommand& c, const Dataset& dataset) {
   // The dark level is measured in the decoder's linear units: through the calibrated response
   // when there is one, never through an older dark or flat map.
   f.corrections = Corrections(dataset, {false, true, false}, "dark");
+  const std::vector<CalibrationFrame> frames = DecodeCalibrationFrames(dataset, f);
+  NoteSrgbCurve("dark", frames[0].photo);
   nlohmann::json report;
-  const DarkMap map = CalibrateDark(DecodeCalibrationFrames(dataset, f), c.dark_options, &report);
+  const DarkMap map = CalibrateDark(frames, c.dark_options, &report);
   MakeCalib(dataset);
   SaveDarkMap(out, map, report);
   LogInfo("dark: ", c.frames.size(), " frame(s), ", report["exposures"].size(), " exposure(s) -> ",
@@ -146,9 +145,10 @@ int RunFlat(const RadiometricCommand& c, const Dataset& dataset) {
   FrameOptions f = Frames(c, "flat frames");
   f.per_unit_exposure = true;
   f.corrections = Corrections(dataset, {true, true, false}, "flat");
+  const std::vector<CalibrationFrame> frames = DecodeCalibrationFrames(dataset, f);
+  NoteSrgbCurve("flat", frames[0].photo);
   nlohmann::json report;
-  const FlatMap map = CalibrateFlat(DecodeCalibrationFrames(dataset, f), dataset, screen, &report,
-                                    c.flat_smooth_px);
+  const FlatMap map = CalibrateFlat(frames, dataset, screen, &report, c.flat_smooth_px);
   MakeCalib(dataset);
   SaveFlatMap(out, map, report);
   LogInfo("flat: ", c.frames.size(), " frame(s); gain ", report["min_gain"].get<double>(), " .. ",

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "calibrate/calibration_frames.h"
 #include "core/error.h"
 #include "core/json.h"
 #include "lib/photo/photo_io.h"
@@ -111,10 +112,13 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
                          std::to_string(pixel.x()) + ", " + std::to_string(pixel.y()) + ")",
                      "a point outside the photo");
   SlideValue slides[2];
+  bool noted = false;  // the sRGB-curve note, once
   for (const PhotoEntry& e : dataset.PhotosOf(reference.i, reference.j)) {
     PhotoSpec spec = PhotoSpecOf(dataset, e);
     spec.corrections = corrections;
     const Photo photo = DecodePhoto(dataset.PhotoPath(e.file), spec);
+    if (!noted) NoteSrgbCurve("scale", photo);
+    noted = true;
     if (photo.pixels.cols != screen.image_width || photo.pixels.rows != screen.image_height)
       throw InputError(photo.path, "image size",
                        std::to_string(screen.image_width) + "x" +

@@ -244,8 +244,12 @@ void SlabPositions(const std::string& scratch) {
 // is the file. The maps are 4 x 3, the size of the target's fixed dark.exr and flat.exr.
 void RadiometricCalibrations(const std::string& scratch) {
   const std::string t = "fuzz_radiometric_calibration";
+  // The dark and flat JSON name their map by its content (dark-<hash>.exr); the target provides
+  // dark.exr and flat.exr beside the JSON, so the seeds name those.
   auto take = [&](char kind, const std::string& written, const std::string& name) {
-    Put(t, name, std::string(1, kind) + ReadTextFile(written));
+    nlohmann::json j = nlohmann::json::parse(ReadTextFile(written));
+    if (j.contains("map")) j["map"] = j["kind"].get<std::string>() + ".exr";
+    Put(t, name, std::string(1, kind) + j.dump(2) + "\n");
   };
   const nlohmann::json report = {{"frames", nlohmann::json::array()}};
   DarkMap dark;

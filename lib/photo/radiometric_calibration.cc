@@ -1,6 +1,8 @@
 #include "lib/photo/radiometric_calibration.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 
 #include "core/error.h"
@@ -16,6 +18,48 @@ const char* kRgb[3] = {"R", "G", "B"};
 
 std::string Beside(const std::string& json_path, const std::string& file) {
   return (fs::path(json_path).parent_path() / file).string();
+}
+
+// The map of a calibration JSON and the JSON are one result, written in two files; the JSON's
+// rename is the commit. The map is written first under a name of its own content
+// (<stem>-<16 hex digits of the FNV-1a hash of its channel names and values>.exr), so that until
+// the JSON is renamed into place the previous JSON still names the previous map, intact: an
+// interrupted recalibration (--force) leaves the old pair, never a new map under an old JSON.
+// Once the JSON is in place, the maps of the stem that it does not name (the previous one, and
+// those of interrupted runs) are removed. Returns the map's file name.
+std::string WriteMapBeside(const std::string& json_path, const ImageF& map,
+                           const std::vector<std::string>& names) {
+  uint64_t hash = 1469598103934665603ull;
+  auto mix = [&hash](const void* data, size_t bytes) {
+    for (size_t k = 0; k < bytes; ++k) {
+      hash ^= static_cast<const unsigned char*>(data)[k];
+      hash *= 1099511628211ull;
+    }
+  };
+  for (const std::string& n : names) mix(n.c_str(), n.size() + 1);
+  mix(&map.width, sizeof map.width);
+  mix(&map.height, sizeof map.height);
+  mix(map.data.data(), map.data.size() * sizeof(float));
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  const std::string file = fs::path(json_path).stem().string() + "-" + hex + ".exr";
+  WriteExr(Beside(json_path, file), map, names, {}, {false, ExrCompression::kPiz});
+  return file;
+}
+
+// After the JSON is in place: removes <stem>.exr and <stem>-<hex>.exr beside it other than `keep`.
+void RemoveOtherMaps(const std::string& json_path, const std::string& keep) {
+  const std::string stem = fs::path(json_path).stem().string();
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(fs::path(json_path).parent_path(), ec)) {
+    const std::string name = e.path().filename().string();
+    const bool plain = name == stem + ".exr";
+    const bool hashed =
+        name.size() == stem.size() + 21 && name.rfind(stem + "-", 0) == 0 &&
+        name.compare(name.size() - 4, 4, ".exr") == 0 &&
+        name.find_first_not_of("0123456789abcdef", stem.size() + 1) == name.size() - 4;
+    if ((plain || hashed) && name != keep) fs::remove(e.path(), ec);
+  }
 }
 
 // The map file a calibration JSON names: a plain file name beside it (no folders; "." and ".."
@@ -104,14 +148,14 @@ void SaveDarkMap(const std::string& json_path, const DarkMap& map, const nlohman
     if (current)
       for (int c = 0; c < 3; ++c) o[4 + c] = map.current.data[p * 3 + c];
   }
-  const std::string exr = fs::path(json_path).stem().string() + ".exr";
-  WriteExr(Beside(json_path, exr), all, names, {}, {false, ExrCompression::kPiz});
+  const std::string exr = WriteMapBeside(json_path, all, names);
   nlohmann::json j = Header("dark", w, h);
   j["map"] = exr;
   j["model"] = current ? "offset+current" : "constant";
   j["units"] = "decoder linear units before the exposure division; current per unit exposure";
   j["report"] = report;
   WriteJsonAtomically(json_path, j);
+  RemoveOtherMaps(json_path, exr);
 }
 
 ResponseCurve LoadResponseCurve(const std::string& json_path) {
@@ -161,12 +205,12 @@ FlatMap LoadFlatMap(const std::string& json_path) {
 }
 
 void SaveFlatMap(const std::string& json_path, const FlatMap& map, const nlohmann::json& report) {
-  const std::string exr = fs::path(json_path).stem().string() + ".exr";
-  WriteExr(Beside(json_path, exr), map.gain, {"R", "G", "B"}, {}, {false, ExrCompression::kPiz});
+  const std::string exr = WriteMapBeside(json_path, map.gain, {"R", "G", "B"});
   nlohmann::json j = Header("flat", map.gain.width, map.gain.height);
   j["map"] = exr;
   j["report"] = report;
   WriteJsonAtomically(json_path, j);
+  RemoveOtherMaps(json_path, exr);
 }
 
 RadiometricScale LoadRadiometricScale(const std::string& json_path) {

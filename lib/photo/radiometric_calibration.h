@@ -25,8 +25,9 @@ namespace lumislab {
 
 constexpr int kRadiometricCalibrationSchemaVersion = 1;
 
-// calib/dark.exr: value = offset + current * exposure (exposure as dataset.json's relative
-// exposure, the photo's t ISO / N^2), RGB per pixel; hot pixels are left out of every merge.
+// The map of calib/dark.json (dark-<hash>.exr): value = offset + current * exposure (exposure as
+// dataset.json's relative exposure, the photo's t ISO / N^2), RGB per pixel; hot pixels are left
+// out of every merge.
 struct DarkMap {
   std::string file;          // the JSON it was read from (for messages)
   ImageF offset;             // 3 channels, RGB
@@ -42,7 +43,8 @@ struct ResponseCurve {
   std::array<std::array<float, 256>, 3> linear_of_code{};
 };
 
-// calib/flat.exr: RGB gain per pixel, mean 1 over the pixels that see the screen (1 elsewhere).
+// The map of calib/flat.json (flat-<hash>.exr): RGB gain per pixel, mean 1 over the pixels that see
+// the screen (1 elsewhere).
 struct FlatMap {
   std::string file;
   ImageF gain;
@@ -70,8 +72,10 @@ ResponseCurve LoadResponseCurve(const std::string& json_path);
 FlatMap LoadFlatMap(const std::string& json_path);
 RadiometricScale LoadRadiometricScale(const std::string& json_path);
 
-// Writers (atomic). `report` members are added to the JSON under "report"; the JSON names the
-// map file, written beside it.
+// Writers (atomic). `report` members are added to the JSON under "report". The dark and flat
+// JSON name their map, written beside them first under a name of its content
+// (<stem>-<16 hex digits>.exr): the JSON's rename commits the pair, and the stem's other maps
+// are then removed, so an interrupted rewrite leaves the previous pair whole.
 void SaveDarkMap(const std::string& json_path, const DarkMap& map, const nlohmann::json& report);
 void SaveResponseCurve(const std::string& json_path, const ResponseCurve& curve,
                        const nlohmann::json& report);

@@ -224,6 +224,23 @@ TEST(Radiometry, FlatMatchesTruth) {
               on.size(), worst);
   EXPECT_LT(worst, 1e-4);  // float photos, no noise: exact to float rounding
   EXPECT_LT(lo, 0.8);      // vignetting and screen gain do show
+  const double smooth_structure =
+      JsonDocument::Load(ds + "/calib/flat.json").root()["report"]["structured_fraction"].Number();
+  EXPECT_LT(smooth_structure, 1e-3);
+  // A position's slide photos given as flats by mistake: the luminaire's pattern is not a flat
+  // field. Still calibrated (a lab may mean it), with a warning and the report saying how much.
+  const JsonDocument dataset = JsonDocument::Load(ds + "/dataset.json");
+  const std::string slide = ds + "/" + dataset.root()["photos"][size_t(0)]["file"].String();
+  const auto mistaken = RunTool(
+      "lumislab-calibrate", "flat --force --exposures 1 --dataset " + ds + " --frames " + slide);
+  EXPECT_EQ(mistaken.exit_code, 0) << mistaken.output;
+  EXPECT_NE(mistaken.output.find("may not show the uniformly lit screen"), std::string::npos)
+      << mistaken.output;
+  const double structure =
+      JsonDocument::Load(ds + "/calib/flat.json").root()["report"]["structured_fraction"].Number();
+  std::printf("flat: structured fraction %.2e (flat frames), %.3f (a slide photo)\n",
+              smooth_structure, structure);
+  EXPECT_GT(structure, 0.01);
 }
 
 TEST(Radiometry, ScaleMatchesTruthAndRefusesBadReadings) {
@@ -274,9 +291,8 @@ namespace {
 // chain's order, each decoding with the ones before it); then reconstruct.
 SlabComparison ChainRow(const std::string& ds, bool response, const std::string& response_file,
                         const std::vector<std::string>& steps) {
-  for (const char* f :
-       {"dark.json", "dark.exr", "response.json", "flat.json", "flat.exr", "scale.json"})
-    fs::remove(ds + "/calib/" + f);
+  for (const auto& e : fs::directory_iterator(ds + "/calib"))  // all but the screen's
+    if (e.path().filename() != "screen.json") fs::remove(e.path());
   if (response) fs::copy_file(response_file, ds + "/calib/response.json");
   for (const std::string& step : steps) {
     const auto r = RunTool(

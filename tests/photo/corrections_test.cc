@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/json.h"
@@ -117,6 +118,29 @@ TEST(Corrections, CalibrationFilesRoundTripAndAreChecked) {
   EXPECT_EQ(dark.current.data, c->dark->current.data);
   SaveFlatMap(dir + "/flat.json", *c->flat, {});
   EXPECT_EQ(LoadFlatMap(dir + "/flat.json").gain.data, c->flat->gain.data);
+  // The JSON and its map are one result: the map is written first under a name of its content,
+  // the JSON's rename commits the pair, and only then are the stem's other maps removed. A
+  // rewrite that stops before the JSON (here: a stray map of another content, as an interrupted
+  // --force leaves) keeps the previous pair readable; the next rewrite removes the stray map
+  // and the previous one.
+  const std::string first = JsonDocument::Load(dir + "/flat.json").root()["map"].String();
+  EXPECT_EQ(first.rfind("flat-", 0), 0u) << first;
+  WriteTextAtomically(dir + "/flat-0123456789abcdef.exr", "interrupted");
+  WriteTextAtomically(dir + "/flat.exr", "an older lumislab's map");
+  EXPECT_EQ(LoadFlatMap(dir + "/flat.json").gain.data, c->flat->gain.data);
+  FlatMap other = *c->flat;
+  other.gain.data[0] *= 1.5f;
+  SaveFlatMap(dir + "/flat.json", other, {});
+  const std::string second = JsonDocument::Load(dir + "/flat.json").root()["map"].String();
+  EXPECT_NE(second, first);
+  EXPECT_EQ(LoadFlatMap(dir + "/flat.json").gain.data, other.gain.data);
+  std::vector<std::string> maps;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".exr" && e.path().filename().string().rfind("flat", 0) == 0)
+      maps.push_back(e.path().filename().string());
+  EXPECT_EQ(maps, std::vector<std::string>{second});
+  EXPECT_TRUE(std::filesystem::exists(
+      dir + "/" + JsonDocument::Load(dir + "/dark.json").root()["map"].String()));
   ResponseCurve curve;
   for (int ch = 0; ch < 3; ++ch)
     for (int k = 0; k < 256; ++k) curve.linear_of_code[ch][k] = (k + 1) / 256.f;

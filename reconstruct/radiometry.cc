@@ -14,7 +14,7 @@ ReconstructRadiometry LoadReconstructRadiometry(const Dataset& dataset) {
   if (c.dark)
     LogInfo("dark: subtracting ", c.dark->file, " (",
             c.dark->current.empty() ? "constant level" : "offset + current x exposure", ", ",
-            c.dark->hot_count, " hot pixel(s) masked)");
+            c.dark->hot_count, " hot pixel(s) read as their neighbours' mean)");
   if (c.response) LogInfo("response: 8-bit photos linearised through ", c.response->file);
   if (c.flat) LogInfo("flat: dividing out ", c.flat->file);
   const std::string scale_file = calib + "/scale.json";

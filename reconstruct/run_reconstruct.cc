@@ -105,17 +105,11 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
   const auto t0 = std::chrono::steady_clock::now();
   writer.Write(pos);
   r.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Hot pixels of calib/dark.json count as clipped in every photo (said once at the start):
-  // warn only about the pixels the light saturated.
-  const auto& corrections = config.options.radiometry->corrections;
-  const int hot = corrections && corrections->dark ? corrections->dark->hot_count : 0;
-  if (r.saturated_pixels > hot)
-    LogWarning("position ", Name(position), ": ", r.saturated_pixels - hot,
-               " saturated photo pixels", hot ? " (and " + std::to_string(hot) + " hot ones)" : "",
-               "; ", r.saturated_texels, " texels left out of the fit (mask 0)");
-  else if (r.saturated_texels > 0)
-    LogDebug("position ", Name(position), ": ", r.saturated_texels,
-             " texels left out of the fit around hot pixels (mask 0)");
+  // Hot pixels of calib/dark.json read as their neighbours' mean (said once at the start): what
+  // is saturated here, the light saturated.
+  if (r.saturated_pixels > 0)
+    LogWarning("position ", Name(position), ": ", r.saturated_pixels, " saturated photo pixels; ",
+               r.saturated_texels, " texels left out of the fit (mask 0)");
   if (r.exposures > 1) ReportBrackets(position, r, config);
   LogDebug("position ", Name(position), ": seen ", r.seen_texels,
            " texels, K=", r.samples_per_texel, ", fit ", r.fit_iterations, " it (residual ",

@@ -299,8 +299,8 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
   const int offsets[3] = {r_, channels_ == 1 ? 0 : 1, b_};
   const bool srgb = photo_.transfer == Transfer::kSrgb;
   const size_t pixel = size_t(y) * m.cols + x;
-  // A hot pixel's value is its own dark current, not light: it leaves every merge as if clipped.
-  const bool hot = dark_ && dark_->hot[pixel];
+  // A hot pixel's value is its own dark current, not light: it reads as its neighbours do.
+  if (dark_ && dark_->hot[pixel]) return ReadHot(y, x, rgb, clipped);
   for (int c = 0; c < 3; ++c) {
     float v;
     if (m.depth() == CV_32F) {
@@ -311,7 +311,7 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
     } else {
       v = curve8_[c][m.ptr<uint8_t>(y)[size_t(x) * channels_ + offsets[c]]];
     }
-    clipped[c] = hot || !(v < saturation_);  // NaN counts as clipped
+    clipped[c] = !(v < saturation_);  // NaN counts as clipped
     // Linear value before the exposure division, less the sensor's dark signal at this exposure;
     // then per unit exposure, less the pixel's gain.
     float linear;
@@ -324,6 +324,36 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
     }
     if (flat_) linear /= flat_->gain.data[pixel * 3 + c];
     rgb[c] = linear * white_balance_[c];
+  }
+}
+
+void LinearReader::ReadHot(int y, int x, float rgb[3], bool clipped[3]) const {
+  // The defect correction of a camera's pipeline: the mean of the fully corrected values of the
+  // nearest pixels that are not hot themselves: the 8 neighbours, or when all of them are hot
+  // (a demosaic spreads a hot Bayer site into its 3 x 3 neighbourhood) the 16 around them.
+  // Light varies little over a few pixels, so the texels around a hot pixel stay in the fit
+  // instead of leaving a hole (mask 0). A channel is clipped when one of those pixels' is, or
+  // when there is none.
+  const cv::Mat& m = photo_.pixels;
+  double sum[3] = {0, 0, 0};
+  int n = 0;
+  for (int c = 0; c < 3; ++c) clipped[c] = false;
+  for (int ring = 1; ring <= 2 && n == 0; ++ring)
+    for (int dy = -ring; dy <= ring; ++dy)
+      for (int dx = -ring; dx <= ring; ++dx) {
+        const int yy = y + dy, xx = x + dx;
+        if (std::max(std::abs(dx), std::abs(dy)) != ring || yy < 0 || xx < 0 || yy >= m.rows ||
+            xx >= m.cols || dark_->hot[size_t(yy) * m.cols + xx])
+          continue;
+        float v[3];
+        bool clip[3];
+        Read(yy, xx, v, clip);
+        for (int c = 0; c < 3; ++c) sum[c] += v[c], clipped[c] = clipped[c] || clip[c];
+        ++n;
+      }
+  for (int c = 0; c < 3; ++c) {
+    rgb[c] = n ? float(sum[c] / n) : 0.f;
+    if (n == 0) clipped[c] = true;
   }
 }
 

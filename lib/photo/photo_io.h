@@ -54,7 +54,7 @@ struct PhotoSpec {
   // Radiometric calibration (calib/: dark map and hot pixels, response curve, flat field),
   // applied by LinearReader: the response replaces the transfer curve of 8-bit photos, the dark
   // level (offset + current x exposure) is subtracted before the exposure division, hot pixels
-  // count as clipped, and the flat gain is divided out. Null: none.
+  // read as the mean of their neighbours, and the flat gain is divided out. Null: none.
   std::shared_ptr<const PhotoCorrections> corrections;
   void Check(const std::string& where) const;  // BadInput naming `where` and the field
 };
@@ -105,6 +105,8 @@ class LinearReader {
   void Read(int y, int x, float rgb[3], bool clipped[3]) const;
 
  private:
+  // A hot pixel (calib/dark.json): the mean of the nearest pixels that are not hot.
+  void ReadHot(int y, int x, float rgb[3], bool clipped[3]) const;
   const Photo& photo_;
   int channels_;
   int r_, b_;             // offsets of red and blue in a pixel

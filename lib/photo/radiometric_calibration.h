@@ -26,13 +26,13 @@ namespace lumislab {
 constexpr int kRadiometricCalibrationSchemaVersion = 1;
 
 // The map of calib/dark.json (dark-<hash>.exr): value = offset + current * exposure (exposure as
-// dataset.json's relative exposure, the photo's t ISO / N^2), RGB per pixel; hot pixels are left
-// out of every merge.
+// dataset.json's relative exposure, the photo's t ISO / N^2), RGB per pixel; a hot pixel reads as
+// the mean of its neighbours that are not hot (LinearReader).
 struct DarkMap {
   std::string file;          // the JSON it was read from (for messages)
   ImageF offset;             // 3 channels, RGB
   ImageF current;            // 3 channels per unit exposure; empty: a constant dark level
-  std::vector<uint8_t> hot;  // width * height, 1 = hot (treated as clipped)
+  std::vector<uint8_t> hot;  // width * height, 1 = hot (its neighbours' mean replaces it)
   int hot_count = 0;
 };
 

@@ -1,7 +1,7 @@
 // The radiometric corrections the one decoder applies (docs/design.md §3.5, §5.13 - §5.15): the
-// dark level subtracted before the exposure division, hot pixels clipped, the flat gain divided
-// out, the calibrated response curve for 8-bit photos; and the calibration files' round trips
-// and checks.
+// dark level subtracted before the exposure division, hot pixels read as their neighbours' mean,
+// the flat gain divided out, the calibrated response curve for 8-bit photos; and the calibration
+// files' round trips and checks.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -44,7 +44,7 @@ std::shared_ptr<PhotoCorrections> Corrections() {
   return c;
 }
 
-TEST(Corrections, DarkThenExposureThenFlatAndHotPixelsClip) {
+TEST(Corrections, DarkThenExposureThenFlatAndHotPixelsReadAsTheirNeighbours) {
   const std::string dir = ScratchDir();
   ImageF image(kW, kH, 3);
   for (int y = 0; y < kH; ++y)
@@ -65,12 +65,42 @@ TEST(Corrections, DarkThenExposureThenFlatAndHotPixelsClip) {
       bool clipped[3];
       reader.Read(y, x, v, clipped);
       for (int c = 0; c < 3; ++c) {
-        const double expected =
-            ((Value(x, y, c) - 0.02) - 0.01 - 0.005 * 2) / 2 / (y == 1 ? 0.8 : 1.0);
-        EXPECT_NEAR(v[c], expected, 1e-6) << x << "," << y;
-        EXPECT_EQ(clipped[c], x == 3 && y == 2) << x << "," << y;
+        auto expected = [c](int xx, int yy) {
+          return ((Value(xx, yy, c) - 0.02) - 0.01 - 0.005 * 2) / 2 / (yy == 1 ? 0.8 : 1.0);
+        };
+        // The hot pixel (3, 2) reads as the mean of its 8 neighbours' corrected values.
+        double want = 0;
+        if (x == 3 && y == 2) {
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+              if (dx || dy) want += expected(x + dx, y + dy) / 8;
+        } else {
+          want = expected(x, y);
+        }
+        EXPECT_NEAR(v[c], want, 1e-6) << x << "," << y;
+        EXPECT_FALSE(clipped[c]) << x << "," << y;
       }
     }
+  // A hot pixel whose neighbours are all hot has nothing to read: clipped. One beside a clipped
+  // neighbour is clipped in that channel.
+  {
+    auto all_hot = Corrections();
+    auto dark = std::make_shared<DarkMap>(*all_hot->dark);
+    dark->hot.assign(kW * kH, 1);
+    all_hot->dark = dark;
+    PhotoSpec hot_spec = spec;
+    hot_spec.corrections = all_hot;
+    const Photo hot_photo = DecodePhoto(dir + "/p.exr", hot_spec);
+    float v[3];
+    bool clipped[3];
+    LinearReader(hot_photo).Read(2, 3, v, clipped);
+    EXPECT_TRUE(clipped[0] && clipped[1] && clipped[2]);
+    PhotoSpec low_saturation = spec;
+    low_saturation.saturation_level = Value(4, 3, 0) - 1e-4;  // (4, 3) and beyond clip
+    const Photo clipping = DecodePhoto(dir + "/p.exr", low_saturation);
+    LinearReader(clipping).Read(2, 3, v, clipped);
+    EXPECT_TRUE(clipped[0]);
+  }
   // Maps of another size than the photo: exit 2 naming the photo and the map.
   auto other = Corrections();
   auto small_flat = std::make_shared<FlatMap>();

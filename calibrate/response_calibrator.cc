@@ -83,8 +83,9 @@ std::vector<float> Observations(const std::vector<cv::Mat>& codes, int channel, 
   return out;
 }
 
-// RMS and mean of log((v_b / e_b) / (v_a / e_a)) over pixels with every channel's code in
-// [10, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent.
+// RMS and mean of log((v_b / e_b) / (v_a / e_a)) over the channel values whose codes are in
+// [32, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent. (Below
+// code 32 a dark offset, which the curve absorbs (docs/design.md §5.14), and noise dominate.)
 nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<double>& exposure,
                            const std::array<std::array<float, 256>, 3>& curve_rgb) {
   double sum = 0, sum2 = 0;
@@ -96,7 +97,7 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
       for (int x = 0; x < codes[a].cols; ++x) {
         const cv::Vec3b ca = codes[a].at<cv::Vec3b>(y, x), cb = codes[b].at<cv::Vec3b>(y, x);
         for (int c = 0; c < 3; ++c) {  // BGR -> curve index 2 - c
-          if (ca[c] < 10 || ca[c] > 245 || cb[c] < 10 || cb[c] > 245) continue;
+          if (ca[c] < 32 || ca[c] > 245 || cb[c] < 32 || cb[c] > 245) continue;
           const double va = curve_rgb[2 - c][ca[c]] / exposure[a];
           const double vb = curve_rgb[2 - c][cb[c]] / exposure[b];
           const double r = std::log(vb / va);

@@ -3,16 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/photo.hpp>
 
+#include "calibrate/response_fit.h"
 #include "core/error.h"
 #include "core/log.h"
 
 namespace lumislab {
 
 void ResponseOptions::Check() const {
-  if (samples < 50 || samples > 1000)
-    throw BadInput("--samples: expected 50 .. 1000, got " + std::to_string(samples));
+  if (samples < 50 || samples > 1000000)
+    throw BadInput("--samples: expected 50 .. 1000000, got " + std::to_string(samples));
   if (!(lambda > 0 && lambda <= 1000))
     throw BadInput("--lambda: expected a number in (0, 1000], got " + std::to_string(lambda));
 }
@@ -31,27 +31,31 @@ std::vector<cv::Mat> BgrCodes(const std::vector<CalibrationFrame>& frames) {
   return out;
 }
 
-// Sample pixels for channel `channel` (BGR index; the solver's other channels are not used):
-// its code in [1, 254] in every frame (a clipped code says only "at least", which the least squares
-// would read as "equal") and a code that changes over the series (a pixel the same in every frame
-// sees no light), spread evenly over the channel's code range in the middle frame, in a fixed
-// scattered order so that they cover the image; bins left short are topped up from the others.
-std::vector<cv::Point> ChooseSamples(const std::vector<cv::Mat>& codes, int channel, int count) {
-  const int w = codes[0].cols, h = codes[0].rows;
+// The observations of channel `channel` (BGR index) for the fit (calibrate/response_fit.h):
+// up to `count` pixels, taken in a fixed scattered order so that they cover the image, in smooth
+// regions only (the channel's codes range over at most kMaxLocalRange in the pixel's 5 x 5
+// neighbourhood of the middle frame: JPEG's chroma subsampling and block artefacts move codes
+// near edges between frames in ways no response curve explains). A sample's code in a frame is
+// its 3 x 3 mean, unrounded (JPEG's and the sensor's per-pixel errors average out; in a smooth
+// region the mean code is the code of the mean light to well under a code), usable when no code
+// of the 5 x 5 neighbourhood is clipped or black in that frame (JPEG's error spreads a clipped
+// 255, or a black 0, over the nearby codes: a clipped code says only "at least", which the
+// least squares would read as "equal"). A pixel whose code hardly changes over the series sees
+// no light (the dark level, off the screen) and is left out.
+std::vector<float> Observations(const std::vector<cv::Mat>& codes, int channel, int count,
+                                size_t* samples) {
+  const int w = codes[0].cols, h = codes[0].rows, frames = int(codes.size());
   const size_t n = size_t(w) * h;
   const cv::Mat& middle = codes[codes.size() / 2];
-  constexpr int kBins = 32;
-  constexpr int kMaxLocalRange = 12;  // codes over the 5 x 5 neighbourhood
-  // A clipped code says only "at least", which the least squares would read as "equal"; JPEG's
-  // error spreads a clipped 255 (or a black 0) over the nearby codes, so those count as clipped.
-  constexpr int kLowestCode = 5, kHighestCode = 245;
-  std::vector<std::vector<cv::Point>> bins(kBins);
+  constexpr int kMaxLocalRange = 12;
+  constexpr int kLowestCode = 3, kHighestCode = 252;
+  std::vector<float> out;
+  *samples = 0;
   const size_t stride = 7919;  // a prime: visits every pixel once, scattered
-  for (size_t k = 0, p = 0; k < n; ++k, p = (p + stride) % n) {
+  std::vector<float> z(frames);
+  for (size_t k = 0, p = 0; k < n && int(*samples) < count; ++k, p = (p + stride) % n) {
     const int x = int(p % w), y = int(p / w);
     if (x < 2 || y < 2 || x >= w - 2 || y >= h - 2) continue;
-    // In a smooth region only: JPEG's chroma subsampling and block artefacts move codes near
-    // edges (the screen's border) between frames in ways no response curve explains.
     int lo = 255, hi = 0;
     for (int dy = -2; dy <= 2; ++dy)
       for (int dx = -2; dx <= 2; ++dx) {
@@ -59,29 +63,29 @@ std::vector<cv::Point> ChooseSamples(const std::vector<cv::Mat>& codes, int chan
         lo = std::min(lo, v), hi = std::max(hi, v);
       }
     if (hi - lo > kMaxLocalRange) continue;
-    bool ok = true;
-    for (const cv::Mat& m : codes) {
-      const int v = m.at<cv::Vec3b>(y, x)[channel];
-      ok &= v >= kLowestCode && v <= kHighestCode;
+    int usable = 0;
+    float zmin = 255, zmax = 0;
+    for (int j = 0; j < frames; ++j) {
+      int flo = 255, fhi = 0, sum = 0;
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int v = codes[j].at<cv::Vec3b>(y + dy, x + dx)[channel];
+          flo = std::min(flo, v), fhi = std::max(fhi, v);
+          if (std::abs(dx) <= 1 && std::abs(dy) <= 1) sum += v;
+        }
+      z[j] = flo >= kLowestCode && fhi <= kHighestCode ? float(sum) / 9 : -1.f;
+      if (z[j] >= 0) ++usable, zmin = std::min(zmin, z[j]), zmax = std::max(zmax, z[j]);
     }
-    const int first = codes.front().at<cv::Vec3b>(y, x)[channel];
-    const int last = codes.back().at<cv::Vec3b>(y, x)[channel];
-    if (ok && std::abs(last - first) >= 4)
-      bins[middle.at<cv::Vec3b>(y, x)[channel] * kBins / 256].push_back({x, y});
-  }
-  // Round robin over the bins: as even as the codes allow.
-  std::vector<cv::Point> out;
-  for (size_t round = 0; int(out.size()) < count; ++round) {
-    bool any = false;
-    for (const auto& b : bins)
-      if (round < b.size() && int(out.size()) < count) out.push_back(b[round]), any = true;
-    if (!any) break;
+    if (usable < 2 || zmax - zmin < 8) continue;
+    out.insert(out.end(), z.begin(), z.end());
+    ++*samples;
   }
   return out;
 }
 
-// RMS and mean of log((v_b / e_b) / (v_a / e_a)) over pixels with every channel's code in
-// [10, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent.
+// RMS and mean of log((v_b / e_b) / (v_a / e_a)) over the channel values whose codes are in
+// [32, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent. (Below
+// code 32 a dark offset, which the curve absorbs (docs/design.md §5.14), and noise dominate.)
 nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<double>& exposure,
                            const std::array<std::array<float, 256>, 3>& curve_rgb) {
   double sum = 0, sum2 = 0;
@@ -93,7 +97,7 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
       for (int x = 0; x < codes[a].cols; ++x) {
         const cv::Vec3b ca = codes[a].at<cv::Vec3b>(y, x), cb = codes[b].at<cv::Vec3b>(y, x);
         for (int c = 0; c < 3; ++c) {  // BGR -> curve index 2 - c
-          if (ca[c] < 10 || ca[c] > 245 || cb[c] < 10 || cb[c] > 245) continue;
+          if (ca[c] < 32 || ca[c] > 245 || cb[c] < 32 || cb[c] > 245) continue;
           const double va = curve_rgb[2 - c][ca[c]] / exposure[a];
           const double vb = curve_rgb[2 - c][cb[c]] / exposure[b];
           const double r = std::log(vb / va);
@@ -134,46 +138,54 @@ ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
   std::vector<CalibrationFrame> copies;
   for (const auto* f : sorted) copies.push_back(*f);
   const std::vector<cv::Mat> codes = BgrCodes(copies);
-  // The solver sees each sample's 3 x 3 mean (rounded to a code): JPEG's per-pixel error
-  // averages out, and samples lie in smooth regions (ChooseSamples), where the mean code is the
-  // code of the mean light to well under a code.
-  std::vector<cv::Mat> smooth(codes.size());
-  for (size_t k = 0; k < codes.size(); ++k) cv::blur(codes[k], smooth[k], cv::Size(3, 3));
-  // Per channel: its own samples, spread over its codes. OpenCV's solver samples a grid;
-  // handed a 1-row image of our samples with `samples` equal to its width, it takes exactly
-  // every one of them.
-  ResponseCurve curve;
+  std::vector<double> log_exposure;
+  for (double e : sorted_exposure) log_exposure.push_back(std::log(e));
+  // Each channel's samples. A JPEG engine applies one tone curve to the three channels (after
+  // white balance): by default one curve is fitted to all of them. It has three times the data,
+  // and above all it is normalised at code 255 alike in every channel: that normalisation is
+  // an extrapolation beyond the last unclipped codes, and separate fits extrapolate differently,
+  // a colour error (1-2 % between channels on noisy frames) that no later step removes (the
+  // flat is normalised per channel, the scale is one number). --per-channel fits each alone.
+  const int n_frames = int(codes.size());
+  std::array<std::vector<float>, 3> obs;
   size_t sample_count[3];
-  for (int c = 0; c < 3; ++c) {  // R, G, B; OpenCV's images and response are BGR
-    const int bgr = 2 - c;
-    const std::vector<cv::Point> samples = ChooseSamples(codes, bgr, options.samples);
-    sample_count[c] = samples.size();
-    if (samples.size() < 20)
+  for (int c = 0; c < 3; ++c)  // R, G, B; the frames are BGR
+    obs[c] = Observations(codes, 2 - c, options.samples, &sample_count[c]);
+  const auto fit = [&](const std::vector<float>& o, size_t count) {
+    size_t used = 0;
+    std::array<double, 256> g{};
+    if (count >= 20) g = FitLogInverseResponse(o, n_frames, log_exposure, options.lambda, &used);
+    if (used < 20)
       throw InputError(frames[0].photo.path, "frames",
-                       "at least 20 pixels unclipped in every frame and changing over the series "
-                       "(use exposures closer together, or a scene with more mid-tones)",
-                       std::to_string(samples.size()));
-    std::vector<cv::Mat> rows;
-    for (const cv::Mat& m : smooth) {
-      cv::Mat row(1, int(samples.size()), CV_8UC3);
-      for (size_t k = 0; k < samples.size(); ++k)
-        row.at<cv::Vec3b>(0, int(k)) = m.at<cv::Vec3b>(samples[k]);
-      rows.push_back(row);
-    }
-    std::vector<float> times(sorted_exposure.begin(), sorted_exposure.end());
-    cv::Mat response;
-    cv::createCalibrateDebevec(int(samples.size()), float(options.lambda), false)
-        ->process(rows, response, times);
+                       "at least 20 pixels unclipped in two frames or more and changing over the "
+                       "series (use exposures closer together, or a scene with more mid-tones)",
+                       std::to_string(used));
+    return g;
+  };
+  std::array<std::array<double, 256>, 3> g;
+  if (options.per_channel) {
+    for (int c = 0; c < 3; ++c) g[c] = fit(obs[c], sample_count[c]);
+  } else {
+    std::vector<float> all;
+    for (const auto& o : obs) all.insert(all.end(), o.begin(), o.end());
+    g[0] = g[1] = g[2] = fit(all, sample_count[0] + sample_count[1] + sample_count[2]);
+  }
+  ResponseCurve curve;
+  nlohmann::json deviation = nlohmann::json::array();
+  for (int c = 0; c < 3; ++c) {
     std::array<float, 256>& out = curve.linear_of_code[c];
-    const double top = response.at<cv::Vec3f>(255, 0)[bgr];
-    if (!(top > 0) || !std::isfinite(top))
-      throw Failure("response: the solver returned no usable curve (value at code 255: " +
-                    std::to_string(top) + ")");
-    for (int k = 0; k < 256; ++k) out[k] = float(response.at<cv::Vec3f>(k, 0)[bgr] / top);
+    for (int k = 0; k < 256; ++k) out[k] = float(std::exp(g[c][k]));
     out[255] = 1;
     // Strictly increasing from the top down (the curve is pinned to 1 at code 255).
     for (int k = 254; k >= 0; --k)
       if (!(out[k] < out[k + 1]) || !std::isfinite(out[k])) out[k] = out[k + 1] * (1 - 1e-6f);
+    // How far the channel's own data sit from its curve: the largest mean log residual over
+    // 16-code bins from code 32 on that hold at least 100 observations.
+    const ResidualBins bins = ResidualsByCode(obs[c], n_frames, log_exposure, g[c], 16);
+    double worst = 0;
+    for (size_t b = 2; b < bins.mean.size(); ++b)
+      if (bins.count[b] >= 100) worst = std::max(worst, std::abs(bins.mean[b]));
+    deviation.push_back(worst);
   }
   std::array<std::array<float, 256>, 3> srgb{};
   for (int c = 0; c < 3; ++c)
@@ -182,10 +194,12 @@ ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
       srgb[c][k] = float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
     }
   nlohmann::json& r = *report;
-  r["method"] = "debevec";
-  r["solver"] = "OpenCV CalibrateDebevec on chosen samples";
+  r["method"] = "debevec-continuous";
+  r["solver"] = "weighted least squares of ln(inverse response), continuous codes";
+  r["curves"] = options.per_channel ? "per channel" : "one for R, G, B";
   r["samples"] = {sample_count[0], sample_count[1], sample_count[2]};
   r["lambda"] = options.lambda;
+  r["channel_deviation"] = deviation;
   r["frames"] = nlohmann::json::array();
   for (size_t k = 0; k < sorted.size(); ++k)
     r["frames"].push_back({{"file", sorted[k]->photo.path}, {"exposure", sorted_exposure[k]}});

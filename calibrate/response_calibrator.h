@@ -12,17 +12,19 @@
 namespace lumislab {
 
 struct ResponseOptions {
-  int samples = 200;   // sample pixels per channel handed to the solver (dense SVD: ~n^3)
-  double lambda = 50;  // smoothness of the curve (CalibrateDebevec's lambda; JPEG data is noisy)
-  void Check() const;  // BadInput naming the option
+  int samples = 30000;       // sample pixels per channel (the solve is 256 x 256 whatever their
+                             // number; the time goes into choosing them)
+  double lambda = 30;        // smoothness of the curve (response_fit.h `smoothness`)
+  bool per_channel = false;  // a curve per channel instead of one for R, G, B
+  void Check() const;        // BadInput naming the option
 };
 
-// Debevec and Malik's least squares (OpenCV's CalibrateDebevec) on sample pixels chosen here:
-// pixels spread over the code range whose codes stay unclipped (1 .. 254) in every frame.
-// Frames must be 8-bit with known exposures, at least two of them different (BadInput naming
-// the frame and field). The curve is normalised to 1 at code 255 and made strictly increasing;
-// `report` gets how consistent the frames become after linearisation (and with the sRGB curve,
-// for comparison).
+// Debevec and Malik's least squares on continuous codes (calibrate/response_fit.h) over sample
+// pixels chosen here: 3 x 3 means in smooth regions, in the frames where their neighbourhood is
+// neither clipped nor black; one curve for R, G, B unless `per_channel`. Frames must be 8-bit with
+// known exposures, at least two of them different (BadInput naming the frame and field). The curve
+// is normalised to 1 at code 255 and made strictly increasing; `report` gets how consistent the
+// frames become after linearisation (and with the sRGB curve, for comparison).
 ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
                                 const ResponseOptions& options, nlohmann::json* report);
 

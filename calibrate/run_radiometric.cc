@@ -130,8 +130,13 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
   const ResponseCurve curve = CalibrateResponse(frames, c.response_options, &report);
   MakeCalib(dataset);
   SaveResponseCurve(out, curve, report);
-  LogInfo("response: Debevec on ", report["samples"][1].get<int>(), " sample pixels (green) of ",
-          frames.size(), " frames; bracket consistency (RMS log ratio) ",
+  const nlohmann::json& dev = report["channel_deviation"];
+  LogInfo("response: ", report["curves"].get<std::string>(), " from ",
+          report["samples"][0].get<int>() + report["samples"][1].get<int>() +
+              report["samples"][2].get<int>(),
+          " sample pixels of ", frames.size(), " frames; channel data off the curve by at most ",
+          dev[0].get<double>(), ", ", dev[1].get<double>(), ", ", dev[2].get<double>(),
+          " (log, R G B); bracket consistency (RMS log ratio) ",
           report["consistency"]["rms_log_ratio"].get<double>(),
           " (sRGB curve: ", report["consistency_srgb_curve"]["rms_log_ratio"].get<double>(),
           ") -> ", out);
@@ -216,13 +221,19 @@ void AddRadiometricCommands(CLI::App* app, CommonOptions* common, RadiometricCom
   c->response = app->add_subcommand(
       "response",
       "bracketed frames of a still scene -> calib/response.json (8-bit frames: the camera "
-      "response per channel, Debevec; used to linearise 8-bit photos) or calib/linearity.json "
+      "response, a least-squares fit; used to linearise 8-bit photos) or calib/linearity.json "
       "(16-bit, float, RAW frames: a linearity check)");
   AddCommon(c->response, common, c, true);
-  c->response->add_option("--samples", c->response_options.samples, "sample pixels for the solver")
+  c->response
+      ->add_option("--samples", c->response_options.samples,
+                   "sample pixels per channel for the fit (smooth regions, 3 x 3 means)")
       ->capture_default_str();
   c->response->add_option("--lambda", c->response_options.lambda, "smoothness of the curve")
       ->capture_default_str();
+  c->response->add_flag("--per-channel", c->response_options.per_channel,
+                        "fit a curve per channel (default: one curve for R, G and B, as a JPEG "
+                        "engine applies one tone curve; report.channel_deviation says whether "
+                        "a channel's data disagree with it)");
   c->flat = app->add_subcommand(
       "flat",
       "frames of the screen under uniform irradiance -> calib/flat.json + flat.exr: per-pixel "

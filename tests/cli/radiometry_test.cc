@@ -142,11 +142,19 @@ TEST(Radiometry, DarkRefusesBadFrames) {
   EXPECT_FALSE(fs::exists(ds + "/calib/dark.json"));
 }
 
-TEST(Radiometry, ResponseCurveMatchesTruth) {
-  const std::string ds = Synth(
-      "radiometry_response",
-      R"([{"type": "response", "curve": "gamma", "gamma": 2.2, "shoulder": 0.5, "quality": 95}])",
-      R"({"response_stops": [-2, -1, 0, 1, 2]})");
+// The response recovered from five JPEG frames (gamma 2.2 + shoulder, quality 95) against the
+// true curve, with sensor noise (a full well of 30000 e-, as tests/cli/real_camera_test.cc's
+// camera; it dithers the codes) or without; `rms` and `max` are the tolerances.
+void CheckResponseCurve(bool noisy, double rms, double max) {
+  const std::string ds =
+      Synth(std::string("radiometry_response_") + (noisy ? "noisy" : "clean"),
+            std::string("[") +
+                (noisy ? R"({"type": "sensor_noise", "full_well_e": 30000, "read_noise_e": 4,
+                       "seed": 5}, )"
+                       : "") +
+                R"({"type": "response", "curve": "gamma", "gamma": 2.2, "shoulder": 0.5,
+              "quality": 95}])",
+            R"({"response_stops": [-2, -1, 0, 1, 2]})");
   ASSERT_EQ(Calibrate("response --dataset " + ds + FramesOf(ds, "response")), 0);
   const ResponseCurve curve = LoadResponseCurve(ds + "/calib/response.json");
   const std::vector<double> truth =
@@ -167,13 +175,20 @@ TEST(Radiometry, ResponseCurveMatchesTruth) {
       "bracket consistency RMS log ratio %.4f (sRGB curve %.4f)\n",
       std::sqrt(sum2 / n), worst, report["consistency"]["rms_log_ratio"].get<double>(),
       report["consistency_srgb_curve"]["rms_log_ratio"].get<double>());
-  // JPEG's own error (about 3 % between brackets after linearisation) bounds what the curve
-  // can learn.
-  EXPECT_LT(std::sqrt(sum2 / n), 0.02);
-  EXPECT_LT(worst, 0.06);
+  EXPECT_LT(std::sqrt(sum2 / n), rms);
+  EXPECT_LT(worst, max);
   EXPECT_LT(report["consistency"]["rms_log_ratio"].get<double>(),
             0.5 * report["consistency_srgb_curve"]["rms_log_ratio"].get<double>());
 }
+
+// Without noise JPEG's rounding is not dithered: the 3 x 3 means carry it, in wiggles over
+// tens of codes that the smoothness term irons out only in part. Measured RMS 0.61 %, max 2.2 %
+// (OpenCV's Debevec on 200 samples: 1.1 %, 4.3 %).
+TEST(Radiometry, ResponseCurveMatchesTruth) { CheckResponseCurve(false, 0.008, 0.03); }
+
+// Noise dithers the codes and the fit's tens of thousands of samples average it: measured RMS
+// 0.45 %, max 2.0 % (at code 32).
+TEST(Radiometry, ResponseCurveMatchesTruthWithNoise) { CheckResponseCurve(true, 0.007, 0.03); }
 
 // 16-bit frames are linear: `response` reports their linearity instead of failing.
 TEST(Radiometry, ResponseOfLinearFramesIsALinearityReport) {

@@ -221,14 +221,14 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   const auto rows = Evidence("JPEG camera, noise-free", {"response", "dark", "flat", "scale"});
   ASSERT_EQ(rows.size(), 5u);
   ASSERT_EQ(rows[0].positions.size(), 9u);
-  // 0.98 % overall, 1.11 % worst position: JPEG's colour coding leaves a systematic error in
-  // the photos (docs/design.md §5.16). Held at 1.5 % so that a regression shows.
+  // 0.95 % overall, 1.06 % worst position: without noise the 8-bit rounding of the curve's
+  // output and of JPEG's decoder is not dithered, and 4 x 4-pixel means keep it
+  // (docs/design.md §5.16). Held at 1.2 % so that a regression shows.
   for (const auto& p : rows[0].positions)
-    EXPECT_LE(p.relative_l2, 0.015) << "position " << p.i << "," << p.j;
-  // Each correction matters; the dark map least here (1.3 % without it): the dark signal is
+    EXPECT_LE(p.relative_l2, 0.012) << "position " << p.i << "," << p.j;
+  // Each correction matters; the dark map least here (1.2 % without it): the dark signal is
   // the same through T+ and T- and cancels in their difference except through the flat, the
-  // scale and the hot pixels. With sensor noise the curve recovered from noisy frames costs
-  // more than the dark map does, which is why the table is taken without noise.
+  // scale and the hot pixels (the table is taken on the noise-free capture).
   for (size_t k = 1; k < rows.size(); ++k)
     EXPECT_GT(rows[k].overall_relative_l2, 1.2 * rows[0].overall_relative_l2) << "row " << k;
 
@@ -252,15 +252,20 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   while (response.Inverse(first_clipped / 255.0) < 0.95) ++first_clipped;
   sensor.saturation = response.Inverse((first_clipped - 0.5) / 255);
   const testing::NoiseFloor floor = CompareWithNoiseFloor("ds_noisy", noisy, sensor);
-  // Issue 8 asks for 1 % per position and 1.5x the noise floor; the JPEG camera misses both
-  // (1.31 % overall, 1.39 % worst position, 2.8x its floor of 0.48 %; docs/design.md §5.16):
-  // the curve that calibrate response recovers from the noisy frames is off by 2-3 % in R and
-  // B at mid codes (with the true curve 0.86 % / 1.02 %), and JPEG's colour coding (YCbCr,
-  // 4:2:0 chroma) leaves a systematic 0.5-1 % in 4 x 4-pixel means that noise does not dither
-  // (0.82 % / 1.00 % at quality 100 with the true curve). Held at 1.5 % per position, as the
-  // noise-free chain, so that a regression shows; the DNG camera below holds both.
+  // Issue 8 asks for 1 % per position and 1.5x the noise floor. Measured: 0.87 % overall,
+  // 1.02 % worst position (2,2), 1.8x the floor of 0.48 % (docs/design.md §5.16). The curve
+  // that calibrate response recovers is within 0.4 % RMS of the true one, and the true curve
+  // gives the same (0.86 % / 1.02 %): what is left is the 8-bit coding. JPEG's chroma
+  // subsampling costs little (4:4:4: 0.84 % / 0.99 %), its compression more (quality 100,
+  // 4:4:4: 0.72 % / 0.88 %), and so does the decoder's rounding of its YCbCr -> RGB conversion
+  // to 8-bit codes (converted in floating point and linearised at the fractional code:
+  // 0.77 % / 0.89 %; not done yet: the photo pipeline carries 8-bit photos as integer codes).
+  // Held at 1.1 % per position, 0.95 % overall and 2x the floor so that a regression shows;
+  // the DNG camera below holds both of the issue's bounds.
   for (const auto& p : noisy.positions)
-    EXPECT_LE(p.relative_l2, 0.015) << "position " << p.i << "," << p.j;
+    EXPECT_LE(p.relative_l2, 0.011) << "position " << p.i << "," << p.j;
+  EXPECT_LE(noisy.overall_relative_l2, 0.0095);
+  EXPECT_LE(noisy.overall_relative_l2, 2 * floor.overall);
   // The noise is there: not below its floor.
   EXPECT_GE(noisy.overall_relative_l2, floor.overall);
 }

@@ -85,6 +85,18 @@ void WriteTruthCamera(const SynthScene& scene, const std::string& path) {
   WriteJsonAtomically(path, j);
 }
 
+void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
+  nlohmann::json emitters = nlohmann::json::array();
+  for (const Emitter& e : luminaire.emitters)
+    emitters.push_back({{"position_mm", Vec(e.position_mm)},
+                        {"intensity_w_sr", Vec(e.intensity_w_sr)},
+                        {"lobe_exponent", e.lobe_exponent}});
+  nlohmann::json j;
+  j["schema_version"] = 1;
+  j["luminaire"] = {{"emitters", emitters}};
+  WriteJsonAtomically(path, j);
+}
+
 void WriteTruthResponse(const ResponseEffect& response, const std::string& path) {
   nlohmann::json j;
   j["schema_version"] = 1;

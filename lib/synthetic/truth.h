@@ -32,6 +32,10 @@ SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution);
 // plane (screen_from_image: pixel -> lab mm, row-major, and its inverse).
 void WriteTruthCamera(const SynthScene& scene, const std::string& path);
 
+// truth/luminaire.json (schema 1): {"schema_version": 1, "luminaire": {"emitters": [...]}}, the
+// scene file's luminaire block, so that the analytic image (lumislab-preview --analytic) can be
+// asked for from the dataset folder (LoadLuminaire reads it back).
+void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path);
 // truth/response.json (scenes with a `response` effect): the camera curve's parameters and, for
 // each 8-bit code k, the linear value it stands for (the curve's inverse at k / 255), so that a
 // test can hand a decoder the true curve.

@@ -14,6 +14,7 @@
 #include "core/basis.h"
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/stop_signal.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
@@ -266,6 +267,17 @@ TEST(ReferenceRenderTest, DeterministicAcrossThreads) {
   many.threads = 3;
   EXPECT_EQ(RenderReference(view, f.info, f.irradiance, one).image.data,
             RenderReference(view, f.info, f.irradiance, many).image.data);
+}
+
+// A stop signal ends the render between rows: the image says it is incomplete.
+TEST(ReferenceRenderTest, StopsWhenAsked) {
+  const Fixture& f = Data();
+  const ReferenceScene view(MakeSceneSetup("plane", f.info), 16, 16);
+  RequestStop();
+  const ReferenceImage stopped = RenderReference(view, f.info, f.irradiance, Options(2));
+  { const StopSignalScope clear; }  // a scope starts with the flag cleared
+  EXPECT_FALSE(stopped.complete);
+  EXPECT_TRUE(RenderReference(view, f.info, f.irradiance, Options(1)).complete);
 }
 
 // A room: the camera sees surfaces (finite, non-negative radiance where lit) and the reference

@@ -75,9 +75,9 @@ struct ReferenceImage {
 
 // The slab of a view: E_ij of each position by linear index j * nu + i (3 channels, the layout
 // of info); an empty image is an absent position (it gives no light, as in the preview).
-// The exact model: for each position, N x N sample points (u, v) at the cell centres of the
-// support [-h, h]^2 of Phi_ij, weighted by Phi_ij and normalised so that the weights of one
-// position sum to h^2 exactly (N = 1: one sample at c_ij with weight h^2, the paper's eq. 14).
+// The exact model: for each position, N x N sample points (u, v) over the support [-h, h]^2 of
+// Phi_ij, the tensor product of BellQuadrature, so that the weights of one position integrate
+// Phi_ij exactly (h^2; N = 1: one sample at c_ij with weight h^2, the paper's eq. 14).
 // A sample (u, v) with weight w, delta = x - (u, v, 0), and (s, t) where the ray from (u, v, 0)
 // through x meets M, adds
 //   (w / h^2) (R^2 / cos^2 theta) E_ij(s, t) * cos(theta) cos(theta') / |delta|^2 * V
@@ -106,8 +106,11 @@ ReferenceImage RenderPointSources(const ReferenceScene& view,
                                   const std::vector<PointSource>& sources,
                                   const ReferenceOptions& options);
 
-// Sample offsets (units of h, in [-1, 1]) and normalised weights (sum 1) of the 1D rule of
-// RenderReference: cell centres of N cells over the bell's support, weights proportional to phi.
+// Sample offsets (units of h, in (-1, 1)) and weights (sum 1) of the 1D rule of
+// RenderReference: the bell's support cut into N equal cells (strata), each sampled once at its
+// centroid under phi with the weight of its exact integral of phi. Exact for integrands linear
+// in each cell; N = 1 is one sample at the centre with weight 1. (Plain cell centres weighted by
+// phi are not monotone: N = 2 then errs on the second moment twice as much as N = 1.)
 void BellQuadrature(int n, std::vector<double>* offsets, std::vector<double>* weights);
 
 }  // namespace lumislab

@@ -1,8 +1,10 @@
 #include "lib/synthetic/truth.h"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/geometry.h"
 #include "core/json.h"
 #include "core/parallel.h"
 #include "lib/synthetic/camera.h"
@@ -25,6 +27,24 @@ SlabPosition TruthPosition(const Luminaire& luminaire, const SlabInfo& info, int
       for (int ch = 0; ch < 3; ++ch) p.irradiance.at(col, row, ch) = float(e[ch]);
     }
   return p;
+}
+
+bool GridCovers(const Luminaire& luminaire, const SlabInfo& info, const Eigen::Vector3d& x) {
+  const int k = int(info.filter.dual_coefficients.size()) - 1;
+  const double h = info.grid.spacing_mm, d = info.distance_mm;
+  const double umax = ((info.grid.nu - 1) / 2.0 - k) * h;
+  const double vmax = ((info.grid.nv - 1) / 2.0 - k) * h;
+  if (!(x.z() > 0)) return false;
+  const double spread = std::abs(1 - d / x.z()) * (k + 2) * h;
+  const double smax = 0.5 * info.layout.window_w_mm - spread;
+  const double tmax = 0.5 * info.layout.window_h_mm - spread;
+  for (const Emitter& e : luminaire.emitters) {
+    const Eigen::Vector2d uv = IntersectPlaneZ(e.position_mm, x, 0);
+    const Eigen::Vector2d st = IntersectPlaneZ(e.position_mm, x, d);
+    if (!(std::abs(uv.x()) <= umax && std::abs(uv.y()) <= vmax)) return false;
+    if (!(std::abs(st.x()) <= smax && std::abs(st.y()) <= tmax)) return false;
+  }
+  return true;
 }
 
 void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir,

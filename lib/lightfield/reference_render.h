@@ -110,7 +110,8 @@ ReferenceImage RenderPointSources(const ReferenceScene& view,
 // RenderReference: the bell's support cut into N equal cells (strata), each sampled once at its
 // centroid under phi with the weight of its exact integral of phi. Exact for integrands linear
 // in each cell; N = 1 is one sample at the centre with weight 1. (Plain cell centres weighted by
-// phi are not monotone: N = 2 then errs on the second moment twice as much as N = 1.)
+// phi are not monotone: N = 2 then errs on the second moment as much as N = 1, with the
+// opposite sign.)
 void BellQuadrature(int n, std::vector<double>* offsets, std::vector<double>* weights);
 
 }  // namespace lumislab

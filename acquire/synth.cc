@@ -183,6 +183,7 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
     dataset.Save(dir);
   WriteCalibrationPhoto(scene, dir + "/" + dataset.calibration.photo, threads);
   WriteTruthCamera(scene, dir + "/truth/camera.json");
+  WriteTruthLuminaire(scene.luminaire, dir + "/truth/luminaire.json");
   if (scene.Response()) WriteTruthResponse(*scene.Response(), dir + "/truth/response.json");
   WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
                  dir + "/truth", threads);

@@ -11,6 +11,8 @@ packages=(
   # calibrate camera: ChArUco boards (OpenCV 4.6's aruco module)
   libopencv-contrib-dev
   libglfw3-dev libosmesa6-dev python3-glad libassimp-dev
+  # lib/lightfield: the exact CPU reference's ray casting (Embree 3)
+  libembree-dev
   # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), DNG and TIFF writing (libtiff)
   libraw-dev libexif-dev libtiff-dev
   xvfb xauth x11-apps

@@ -17,6 +17,7 @@
 #include "lib/lightfield/light_field.h"
 #include "lib/synthetic/truth.h"
 #include "preview/headless.h"
+#include "preview/reference_mode.h"
 #include "preview/window.h"
 
 namespace lumislab {
@@ -66,6 +67,20 @@ void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ext
                  "--window: save the window to this PNG once all positions are in, then quit");
   app.add_flag("--bench", config.bench, "time frames with a moving camera");
   app.add_option("--bench-frames", config.bench_frames)->capture_default_str();
+  auto* reference = app.add_flag(
+      "--reference", config.reference,
+      "exact CPU reference instead of OpenGL (docs/design.md §4.5): eq. 12 integrated over S with "
+      "the exact model, --samples N per basis support, visibility by ray casting (Embree); slow, "
+      "on --threads threads");
+  app.add_option("--samples", config.samples,
+                 "--reference: N x N samples per basis support (1 = the paper's eq. 14), 1..64")
+      ->capture_default_str()
+      ->needs(reference);
+  app.add_option("--analytic", config.analytic,
+                 "analytic image straight from a synthetic luminaire (no slab; the slab's d and "
+                 "window only place the plane): default | dataset folder (its "
+                 "truth/luminaire.json) | scene file")
+      ->excludes(reference);
   app.add_flag("--write-test-slab", extras.write_test_slab,
                "first write the exact slab of the built-in synthetic luminaire (the default scene "
                "of lumislab-acquire synth: 9x7, h=5, "
@@ -80,6 +95,20 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   if (config.shadow_size < 16 || config.shadow_size > 4096) {
     throw InputError("--shadow-size", "shadow-size", "16..4096",
                      std::to_string(config.shadow_size));
+  }
+  if (config.reference || !config.analytic.empty()) {
+    const char* mode = config.reference ? "--reference" : "--analytic";
+    for (const auto& [set, option] : {std::pair{config.window, "--window"},
+                                      {config.watch, "--watch"},
+                                      {config.bench, "--bench"},
+                                      {config.srgbe, "--srgbe"},
+                                      {config.report_srgbe_error, "--srgbe-error"},
+                                      {config.shadow_pcf, "--shadow-pcf"}})
+      if (set)
+        throw BadInput(std::string(mode) + " renders on the CPU: " + option + " is not for it");
+    if (config.out.empty()) throw BadInput(std::string(mode) + " needs --out <file.exr|.png>");
+    if (config.samples < 1 || config.samples > 64)
+      throw InputError("--samples", "", "1 .. 64", std::to_string(config.samples));
   }
   if (!config.window && config.out.empty() && !config.bench) {
     throw BadInput("headless mode needs --out <file.exr|.png> (or --bench, or --window)");
@@ -122,6 +151,7 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     LogInfo("stopped before ", config.slab_dir, "/slab.json appeared");
     return 0;
   }
+  if (config.reference || !config.analytic.empty()) return RunReferenceMode(config, *info);
   return config.window ? RunWindow(config, *info) : RunHeadless(config, *info);
 }
 
@@ -183,7 +213,8 @@ int RunPreview(int argc, char** argv) {
       "(OSMesa, --out) or in a window (--window)"};
   app.footer(
       "--threads sizes lumislab's own CPU work (deriving E' of the slab positions as they are "
-      "loaded). The renderer's threads are llvmpipe's: set them with the LP_NUM_THREADS "
+      "loaded; the whole render with --reference or --analytic). The OpenGL renderer's threads are "
+      "llvmpipe's: set them with the LP_NUM_THREADS "
       "environment variable (default: all cores).");
   PreviewConfig config;
   CommonOptions common;

@@ -33,6 +33,11 @@ struct PreviewConfig {
   std::string screenshot;  // window: save this file after the first complete frame, then quit
   bool report_srgbe_error = false;
   int threads = 1;  // lumislab's own CPU work (E' of the positions loaded), resolved --threads
+  // CPU reference instead of OpenGL (preview/reference_mode.h): the exact model from the slab
+  // with N x N samples per basis support, or the analytic image of a synthetic luminaire.
+  bool reference = false;
+  int samples = 4;
+  std::string analytic;  // default | dataset folder | scene or truth/luminaire.json file
 };
 
 // The whole tool: command line, then the window or the headless run.

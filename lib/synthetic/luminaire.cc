@@ -19,6 +19,11 @@ double PowCos(double c, double p) {
 
 }  // namespace
 
+Eigen::Vector3d Emitter::Intensity(const Eigen::Vector3d& w) const {
+  if (!(w.z() > 0)) return Eigen::Vector3d::Zero();
+  return PowCos(w.z(), lobe_exponent) * intensity_w_sr;
+}
+
 double EmitterIrradianceFactor(const Emitter& e, double d_mm, double s_mm, double t_mm,
                                double* u_mm, double* v_mm) {
   const Eigen::Vector3d& p = e.position_mm;

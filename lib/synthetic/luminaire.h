@@ -16,6 +16,8 @@ struct Emitter {
   Eigen::Vector3d position_mm;     // luminaire frame, z < 0 (behind S)
   Eigen::Vector3d intensity_w_sr;  // I0 per RGB channel, W/sr
   double lobe_exponent = 0;        // n >= 0
+  // I0 cos^n(angle of the unit direction w to +z), zero for w_z <= 0 (W/sr).
+  Eigen::Vector3d Intensity(const Eigen::Vector3d& w) const;
 };
 
 struct Luminaire {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "core/error.h"
 #include "core/json.h"
@@ -42,7 +43,9 @@ void ParseSetup(const JsonView& root, SynthScene* scene) {
     scene->k_max = ParseFilterTruncation(root["filter"]["k_max"]);
 }
 
-void ParseLuminaire(const JsonView& root, SynthScene* scene) {
+// The "luminaire" block of a scene file (also the whole of truth/luminaire.json).
+Luminaire ParseLuminaire(const JsonView& root) {
+  Luminaire luminaire;
   const JsonView emitters = root["luminaire"]["emitters"];
   if (emitters.Size() == 0) emitters.Fail("a non-empty array of emitters");
   for (size_t k = 0; k < emitters.Size(); ++k) {
@@ -55,8 +58,9 @@ void ParseLuminaire(const JsonView& root, SynthScene* scene) {
     for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
     if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr");
     emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
-    scene->luminaire.emitters.push_back(emitter);
+    luminaire.emitters.push_back(emitter);
   }
+  return luminaire;
 }
 
 void ParseCamera(const JsonView& root, SynthScene* scene) {
@@ -214,7 +218,7 @@ SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   SynthScene scene;
   scene.source = name;
   ParseSetup(root, &scene);
-  ParseLuminaire(root, &scene);
+  scene.luminaire = ParseLuminaire(root);
   ParseCamera(root, &scene);
   ParseCalibration(root, &scene);
   if (root.Has("effects")) ParseEffects(root["effects"], &scene);
@@ -236,6 +240,17 @@ SynthScene DefaultScene() {
 }
 
 std::string DefaultSceneJson() { return kDefaultSceneJson; }
+
+Luminaire LoadLuminaire(const std::string& source) {
+  if (source == "default") return DefaultScene().luminaire;
+  const std::string path =
+      std::filesystem::is_directory(source)
+          ? (std::filesystem::path(source) / "truth" / "luminaire.json").string()
+          : source;
+  const JsonDocument doc = JsonDocument::Load(path);
+  doc.CheckSchemaVersion(kSceneSchemaVersion);
+  return ParseLuminaire(doc.root());
+}
 
 Dataset DatasetSkeleton(const SynthScene& scene) {
   Dataset ds;

@@ -55,6 +55,10 @@ SynthScene ParseScene(const std::string& json_text, const std::string& name);
 SynthScene ParseScene(const JsonDocument& doc, const std::string& name);
 SynthScene DefaultScene();
 std::string DefaultSceneJson();  // the built-in scene as a scene file
+// The luminaire of `source`: "default" (the built-in scene's), a synthetic dataset folder (its
+// truth/luminaire.json), or a JSON file with a scene file's "luminaire" block and schema_version
+// 1 (a scene file or truth/luminaire.json). Errors name the file and the field (exit 2).
+Luminaire LoadLuminaire(const std::string& source);
 
 // dataset.json without photos or radiometric scale: setup, filter, calibration, synthetic.
 Dataset DatasetSkeleton(const SynthScene& scene);

@@ -1,8 +1,10 @@
 #include "lib/synthetic/truth.h"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/geometry.h"
 #include "core/json.h"
 #include "core/parallel.h"
 #include "lib/synthetic/camera.h"
@@ -25,6 +27,24 @@ SlabPosition TruthPosition(const Luminaire& luminaire, const SlabInfo& info, int
       for (int ch = 0; ch < 3; ++ch) p.irradiance.at(col, row, ch) = float(e[ch]);
     }
   return p;
+}
+
+bool GridCovers(const Luminaire& luminaire, const SlabInfo& info, const Eigen::Vector3d& x) {
+  const int k = int(info.filter.dual_coefficients.size()) - 1;
+  const double h = info.grid.spacing_mm, d = info.distance_mm;
+  const double umax = ((info.grid.nu - 1) / 2.0 - k) * h;
+  const double vmax = ((info.grid.nv - 1) / 2.0 - k) * h;
+  if (!(x.z() > 0)) return false;
+  const double spread = std::abs(1 - d / x.z()) * (k + 2) * h;
+  const double smax = 0.5 * info.layout.window_w_mm - spread;
+  const double tmax = 0.5 * info.layout.window_h_mm - spread;
+  for (const Emitter& e : luminaire.emitters) {
+    const Eigen::Vector2d uv = IntersectPlaneZ(e.position_mm, x, 0);
+    const Eigen::Vector2d st = IntersectPlaneZ(e.position_mm, x, d);
+    if (!(std::abs(uv.x()) <= umax && std::abs(uv.y()) <= vmax)) return false;
+    if (!(std::abs(st.x()) <= smax && std::abs(st.y()) <= tmax)) return false;
+  }
+  return true;
 }
 
 void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir,
@@ -82,6 +102,18 @@ void WriteTruthCamera(const SynthScene& scene, const std::string& path) {
   j["screen_from_image"] = RowMajor(camera.ScreenFromImage(scene.distance_mm));
   j["image_from_screen"] = RowMajor(camera.ImageFromScreen(scene.distance_mm));
   j["exposure"] = scene.camera.exposure;
+  WriteJsonAtomically(path, j);
+}
+
+void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
+  nlohmann::json emitters = nlohmann::json::array();
+  for (const Emitter& e : luminaire.emitters)
+    emitters.push_back({{"position_mm", Vec(e.position_mm)},
+                        {"intensity_w_sr", Vec(e.intensity_w_sr)},
+                        {"lobe_exponent", e.lobe_exponent}});
+  nlohmann::json j;
+  j["schema_version"] = 1;
+  j["luminaire"] = {{"emitters", emitters}};
   WriteJsonAtomically(path, j);
 }
 

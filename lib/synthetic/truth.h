@@ -28,10 +28,21 @@ SlabInfo TruthSlabInfo(const SynthScene& scene, int resolution);
 // h: the slab layout the preview's tests and benchmarks light scenes with.
 SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution);
 
+// True when the slab holds all the light of every emitter towards point x (luminaire frame, mm):
+// the ray crosses S where the grid's dual filters sum to 1, |u| <= ((nu - 1)/2 - K) h and
+// |v| <= ((nv - 1)/2 - K) h for a truncated dual with K + 1 coefficients, and meets M inside the
+// slab window, less the spread |1 - d / x_z| (K + 2) h of the rays a reconstruction draws from
+// the supports around it (docs/design.md §4.5). Elsewhere images from the slab fall short of the
+// analytic truth however exact the renderer.
+bool GridCovers(const Luminaire& luminaire, const SlabInfo& info, const Eigen::Vector3d& x);
 // truth/camera.json: intrinsics, pose (lab frame), and the exact homographies of the screen
 // plane (screen_from_image: pixel -> lab mm, row-major, and its inverse).
 void WriteTruthCamera(const SynthScene& scene, const std::string& path);
 
+// truth/luminaire.json (schema 1): {"schema_version": 1, "luminaire": {"emitters": [...]}}, the
+// scene file's luminaire block, so that the analytic image (lumislab-preview --analytic) can be
+// asked for from the dataset folder (LoadLuminaire reads it back).
+void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path);
 // truth/response.json (scenes with a `response` effect): the camera curve's parameters and, for
 // each 8-bit code k, the linear value it stands for (the curve's inverse at k / 255), so that a
 // test can hand a decoder the true curve.

@@ -179,6 +179,15 @@ TEST(Synth, WritesACompleteDatasetAndSkipsItAfterwards) {
   EXPECT_NEAR((h[0] * u + h[1] * v + h[2]) / w, 0, 1e-6);
   EXPECT_NEAR((h[3] * u + h[4] * v + h[5]) / w, 0, 1e-6);
 
+  // truth/luminaire.json: the scene's emitters, read back from the dataset folder (--analytic).
+  const Luminaire luminaire = LoadLuminaire(options.out_dir);
+  ASSERT_EQ(luminaire.emitters.size(), scene.luminaire.emitters.size());
+  for (size_t k = 0; k < luminaire.emitters.size(); ++k) {
+    EXPECT_EQ(luminaire.emitters[k].position_mm, scene.luminaire.emitters[k].position_mm);
+    EXPECT_EQ(luminaire.emitters[k].intensity_w_sr, scene.luminaire.emitters[k].intensity_w_sr);
+    EXPECT_EQ(luminaire.emitters[k].lobe_exponent, scene.luminaire.emitters[k].lobe_exponent);
+  }
+
   // A second run skips the complete dataset; --force redoes it.
   EXPECT_TRUE(RunSynth(scene, options).skipped);
   options.force = true;

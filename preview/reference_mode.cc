@@ -1,0 +1,73 @@
+#include "preview/reference_mode.h"
+
+#include <chrono>
+#include <vector>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "core/parallel.h"
+#include "lib/lightfield/reference_render.h"
+#include "lib/lightfield/tone_map.h"
+#include "lib/synthetic/scene.h"
+#include "preview/image_files.h"
+
+namespace lumislab {
+namespace {
+
+// E_ij of every position slab.json lists (empty images for the others), read on `threads`
+// threads; a listed position that is missing or damaged is exit 2 naming its file.
+std::vector<ImageF> ReadSlabIrradiance(const std::string& slab_dir, const SlabInfo& info,
+                                       int threads) {
+  if (info.present.empty())
+    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
+  std::vector<ImageF> out(size_t(info.grid.count()));
+  ParallelFor(int(info.present.size()), threads, [&](int k) {
+    const auto [i, j] = info.present[k];
+    out[size_t(j) * info.grid.nu + i] = ReadSlabPosition(slab_dir, info, i, j).irradiance;
+  });
+  return out;
+}
+
+// The synthetic luminaire's emitters as the reference's point sources.
+std::vector<PointSource> PointSources(const Luminaire& luminaire) {
+  std::vector<PointSource> sources;
+  for (const Emitter& e : luminaire.emitters)
+    sources.push_back({e.position_mm, [e](const Eigen::Vector3d& w) { return e.Intensity(w); }});
+  return sources;
+}
+
+}  // namespace
+
+int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
+  const SceneSetup setup = MakeSceneSetup(config.scene, info);
+  ReferenceOptions options;
+  options.samples = config.samples;
+  options.threads = config.threads;
+  options.visibility = config.shadows;
+  // Inputs first: a bad luminaire or slab is refused before the scene is built.
+  const bool analytic = !config.analytic.empty();
+  const Luminaire luminaire = analytic ? LoadLuminaire(config.analytic) : Luminaire{};
+  const std::vector<ImageF> irradiance =
+      analytic ? std::vector<ImageF>{} : ReadSlabIrradiance(config.slab_dir, info, config.threads);
+  const ReferenceScene view(setup, config.width, config.height);
+  const auto start = std::chrono::steady_clock::now();
+  const ReferenceImage image = analytic ? RenderPointSources(view, PointSources(luminaire), options)
+                                        : RenderReference(view, info, irradiance, options);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!image.complete) throw Failure("stopped by a signal; " + config.out + " not written");
+  WriteImage(config.out, image.image,
+             ExposureFactor(image.image, config.exposure_stops, config.auto_exposure));
+  if (analytic)
+    LogInfo("analytic image of ", config.analytic, " (", luminaire.emitters.size(), " emitters), ",
+            setup.mesh.triangles(), " triangles, ", view.width(), "x", view.height(), " in ",
+            seconds, " s -> ", config.out);
+  else
+    LogInfo("exact reference, N = ", options.samples, " (", options.samples * options.samples,
+            " samples per support), ", info.present.size(), "/", info.grid.count(), " positions, ",
+            setup.mesh.triangles(), " triangles, ", view.width(), "x", view.height(), " in ",
+            seconds, " s -> ", config.out);
+  return 0;
+}
+
+}  // namespace lumislab

@@ -1,0 +1,111 @@
+// lumislab-preview --reference and --analytic (docs/design.md §4.5): on the receiver plane at
+// D = d the OpenGL render (eq. 14), the exact CPU reference and the analytic image of the built-in
+// luminaire agree; the options are checked (exit 2 naming the option, nothing written).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/exr_io.h"
+#include "lib/synthetic/scene.h"
+#include "lib/synthetic/truth.h"
+#include "preview/run_preview.h"
+
+namespace lumislab {
+namespace {
+
+namespace fs = std::filesystem;
+
+int RunPreviewWith(std::vector<std::string> args) {
+  args.insert(args.begin(), "lumislab-preview");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
+}
+
+// The built-in luminaire's exact slab at 64 texels (small and quick to write).
+std::string TestSlab() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/preview_reference_slab";
+    fs::remove_all(d);
+    WriteTruthSlab(DefaultScene().luminaire, DefaultSlabInfo(9, 7, 5, 64), d, 2);
+    return d;
+  }();
+  return dir;
+}
+
+// Relative L2 of a against b over the pixels of the 1.2 m plane (32 x 32) within `half` mm of
+// the axis.
+double RelativeL2(const ImageF& a, const ImageF& b, double half) {
+  double num = 0, den = 0;
+  for (int row = 0; row < b.height; ++row)
+    for (int col = 0; col < b.width; ++col) {
+      const double x = -600 + (col + 0.5) * 1200.0 / b.width;
+      const double y = 600 - (row + 0.5) * 1200.0 / b.height;
+      if (std::abs(x) > half || std::abs(y) > half) continue;
+      for (int c = 0; c < 3; ++c) {
+        num += std::pow(double(a.at(col, row, c)) - b.at(col, row, c), 2);
+        den += std::pow(double(b.at(col, row, c)), 2);
+      }
+    }
+  return std::sqrt(num / den);
+}
+
+TEST(PreviewReference, PlaneAgreesWithOpenGlAndTheAnalyticImage) {
+  const std::string slab = TestSlab(), out = ::testing::TempDir() + "/preview_reference_";
+  const std::vector<std::string> common = {"--slab", slab,    "--scene",   "plane",
+                                           "--size", "32x32", "--threads", "2"};
+  auto run = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = common;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunPreviewWith(args);
+  };
+  ASSERT_EQ(run({"--out", out + "gl.exr"}), 0);
+  ASSERT_EQ(run({"--reference", "--samples", "2", "--out", out + "ref.exr"}), 0);
+  ASSERT_EQ(run({"--analytic", "default", "--out", out + "analytic.exr"}), 0);
+  ASSERT_EQ(run({"--analytic", "default", "--out", out + "analytic.png"}), 0);
+  EXPECT_TRUE(fs::exists(out + "analytic.png"));
+  const ImageF gl = ReadExr(out + "gl.exr", {"R", "G", "B"});
+  const ImageF ref = ReadExr(out + "ref.exr", {"R", "G", "B"});
+  const ImageF analytic = ReadExr(out + "analytic.exr", {"R", "G", "B"});
+  // At D = d eq. 14 and the exact model both give sum_ij E_ij(x) (§4.5).
+  const double gl_vs_ref = RelativeL2(gl, ref, 600);
+  // Within 280 mm of the axis every emitter's light crosses S where the grid's duals sum to 1.
+  const double ref_vs_analytic = RelativeL2(ref, analytic, 280);
+  std::printf("plane at d: OpenGL vs reference %.3g, reference vs analytic (covered) %.3g\n",
+              gl_vs_ref, ref_vs_analytic);
+  EXPECT_LT(gl_vs_ref, 1e-3);
+  EXPECT_LT(ref_vs_analytic, 2e-3);
+}
+
+TEST(PreviewReference, BadOptionsAreRefusedNamingThem) {
+  const std::string slab = TestSlab(), out = ::testing::TempDir() + "/preview_reference_bad.exr";
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--reference", "--samples", "0"}, "--samples"},
+      {{"--reference", "--samples", "65"}, "--samples"},
+      {{"--samples", "3"}, "--samples"},
+      {{"--reference", "--watch"}, "--watch"},
+      {{"--reference", "--srgbe"}, "--srgbe"},
+      {{"--analytic", "default", "--window"}, "--window"},
+      {{"--analytic", "default", "--reference"}, "--analytic"},
+      {{"--analytic", slab + "/missing.json"}, "missing.json"},
+      {{"--analytic", slab}, "luminaire.json"},  // a folder without truth/luminaire.json
+  };
+  for (const auto& [extra, named] : cases) {
+    std::vector<std::string> args = {"--slab", slab,  "--scene", "plane",
+                                     "--size", "8x8", "--out",   out};
+    args.insert(args.end(), extra.begin(), extra.end());
+    testing::internal::CaptureStderr();
+    const int code = RunPreviewWith(args);
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(code, 2) << extra[0] << " " << err;
+    EXPECT_NE(err.find(named), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(out)) << extra[0];
+  }
+}
+
+}  // namespace
+}  // namespace lumislab

@@ -2,6 +2,7 @@
 // D = d the OpenGL render (eq. 14), the exact CPU reference and the analytic image of the built-in
 // luminaire agree; the options are checked (exit 2 naming the option, nothing written).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -26,10 +27,15 @@ int RunPreviewWith(std::vector<std::string> args) {
   return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
 }
 
+// A folder of this process: ctest runs each test of this file as its own process, in parallel.
+std::string Scratch(const std::string& name) {
+  return ::testing::TempDir() + "/preview_reference_" + std::to_string(getpid()) + "_" + name;
+}
+
 // The built-in luminaire's exact slab at 64 texels (small and quick to write).
 std::string TestSlab() {
   static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/preview_reference_slab";
+    const std::string d = Scratch("slab");
     fs::remove_all(d);
     WriteTruthSlab(DefaultScene().luminaire, DefaultSlabInfo(9, 7, 5, 64), d, 2);
     return d;
@@ -55,7 +61,7 @@ double RelativeL2(const ImageF& a, const ImageF& b, double half) {
 }
 
 TEST(PreviewReference, PlaneAgreesWithOpenGlAndTheAnalyticImage) {
-  const std::string slab = TestSlab(), out = ::testing::TempDir() + "/preview_reference_";
+  const std::string slab = TestSlab(), out = Scratch("");
   const std::vector<std::string> common = {"--slab", slab,    "--scene",   "plane",
                                            "--size", "32x32", "--threads", "2"};
   auto run = [&](std::vector<std::string> extra) {
@@ -82,7 +88,7 @@ TEST(PreviewReference, PlaneAgreesWithOpenGlAndTheAnalyticImage) {
 }
 
 TEST(PreviewReference, BadOptionsAreRefusedNamingThem) {
-  const std::string slab = TestSlab(), out = ::testing::TempDir() + "/preview_reference_bad.exr";
+  const std::string slab = TestSlab(), out = Scratch("bad.exr");
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--reference", "--samples", "0"}, "--samples"},
       {{"--reference", "--samples", "65"}, "--samples"},

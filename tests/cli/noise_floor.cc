@@ -236,8 +236,20 @@ NoiseFloor PredictNoiseFloor(const std::string& slab_dir, const std::string& cle
                                    cal.ScreenFromImage(px - Eigen::Vector2d(0, 0.5));
         const double pixel_area = std::abs(dx.x() * dy.y() - dx.y() * dy.x());
         const double side = std::sqrt(texel_area / pixel_area);
-        const int x = std::clamp(int(std::lround(px.x())), 0, w - 1);
-        const int y = std::clamp(int(std::lround(px.y())), 0, h - 1);
+        int x = std::clamp(int(std::lround(px.x())), 0, w - 1);
+        int y = std::clamp(int(std::lround(px.y())), 0, h - 1);
+        // A hot pixel reads as the mean of its nearest pixels that are not hot (lib/photo's
+        // defect correction): the noise there is theirs, taken here as that of the nearest one.
+        if (dark_map && dark.at(x, y, 2) > 0.5f) {
+          int best = -1, bx = x, by = y;
+          for (int dy = -2; dy <= 2; ++dy)
+            for (int dx = -2; dx <= 2; ++dx) {
+              const int xx = x + dx, yy = y + dy, d2 = dx * dx + dy * dy;
+              if (xx < 0 || yy < 0 || xx >= w || yy >= h || dark.at(xx, yy, 2) > 0.5f) continue;
+              if (best < 0 || d2 < best) best = d2, bx = xx, by = yy;
+            }
+          x = bx, y = by;
+        }
         const double g = gain_map ? gain.at(x, y, 0) : 1.0;
         // The flat's relative variance at this pixel: the mean of its frames.
         double flat_var = 0;

@@ -24,6 +24,7 @@
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/scene.h"
+#include "lib/synthetic/truth.h"
 
 namespace fs = std::filesystem;
 
@@ -47,7 +48,14 @@ struct Options {
   int render_px = 0;        // receiver-plane image side (0: 96, --quick 40)
   int samples = 1;          // base N of the reference
   bool keep_photos = false;
+  int values = 3;  // values per knob: the first 2 or all 3 of each list
 };
+
+template <typename T>
+std::vector<T> First(int n, std::vector<T> values) {
+  values.resize(std::min(values.size(), size_t(n)));
+  return values;
+}
 
 // One setting of the whole chain (the base, or the base with one knob moved).
 struct Setting {
@@ -195,6 +203,21 @@ void Measure(const SynthScene& scene, const Setting& s, const std::string& ds, i
     row->err[k] = CompareImages(image.irradiance, analytic.irradiance).relative_l2;
     const double flux = Sum(analytic.irradiance);
     row->flux[k] = flux > 0 ? Sum(image.irradiance) / flux : 0;
+    // Only the pixels the grid covers: what is left there is the reconstruction's own error.
+    double diff2 = 0, ref2 = 0, covered_flux = 0;
+    const ImageF& a = analytic.irradiance;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) {
+        const SurfacePoint p = view.Primary(x, y);
+        if (!p.hit || !GridCovers(scene.luminaire, info, p.x)) continue;
+        for (int c = 0; c < a.channels; ++c) {
+          const double e = image.irradiance.at(x, y, c) - a.at(x, y, c);
+          diff2 += e * e, ref2 += double(a.at(x, y, c)) * a.at(x, y, c);
+          covered_flux += a.at(x, y, c);
+        }
+      }
+    row->err_covered[k] = ref2 > 0 ? std::sqrt(diff2 / ref2) : -1;
+    row->covered[k] = flux > 0 ? covered_flux / flux : 0;
   }
 }
 
@@ -214,8 +237,10 @@ int RunStudy(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--out", o.out, "folder for study.csv, report.md, the plots and work/")
       ->required();
-  app.add_flag("--quick", o.quick,
-               "2 values per knob, photos at 0.25 of the scene's size, 48 texels, 40 px renders");
+  app.add_flag(
+      "--quick", o.quick,
+      "photos at 0.25 of the scene camera's size (x1, 1.5, 2 for the photo knob), 48 texels, 40 px "
+      "renders");
   app.add_option("--knobs", o.knobs,
                  "comma-separated subset of spacing,extent,photo,k_max,resolution,samples, or all")
       ->capture_default_str();
@@ -239,6 +264,9 @@ int RunStudy(int argc, char** argv) {
       ->check(CLI::Range(8, 2048));
   app.add_option("--samples", o.samples, "base samples per basis support N of the reference")
       ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option("--values", o.values, "values per knob: 2 (the first two of each list) or 3")
+      ->check(CLI::Range(2, 3))
       ->capture_default_str();
   app.add_flag("--keep-photos", o.keep_photos, "keep each dataset's photos (removed by default)");
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
@@ -293,38 +321,39 @@ int RunStudy(int argc, char** argv) {
   };
   for (const std::string& knob : knobs) {
     if (knob == "spacing")
-      for (double f : o.quick ? std::vector<double>{2, 1} : std::vector<double>{2, 1, 0.5}) {
+      for (double f : First(o.values, std::vector<double>{2, 1, 0.5})) {
         Setting s = base;
         s.h_mm = base.h_mm * f;
         s.nu = positions_for(base.nu, 1 / f), s.nv = positions_for(base.nv, 1 / f);
         points.push_back({knob, Num(s.h_mm) + " mm", s});
       }
     if (knob == "extent")
-      for (double f : o.quick ? std::vector<double>{0.5, 1} : std::vector<double>{0.5, 1, 1.5}) {
+      for (double f : First(o.values, std::vector<double>{0.5, 1, 1.5})) {
         Setting s = base;
         s.nu = positions_for(base.nu, f), s.nv = positions_for(base.nv, f);
         points.push_back({knob, "x" + Num(f), s});
       }
     if (knob == "photo")
-      for (double f : o.quick ? std::vector<double>{1, 1.5} : std::vector<double>{0.5, 0.75, 1}) {
+      for (double f : First(o.values, o.quick ? std::vector<double>{1, 1.5, 2}
+                                              : std::vector<double>{0.5, 0.75, 1})) {
         Setting s = base;
         s.photo_scale = base.photo_scale * f;
         points.push_back({knob, "x" + Num(s.photo_scale), s});
       }
     if (knob == "k_max")
-      for (int k : o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 3}) {
+      for (int k : First(o.values, std::vector<int>{1, 2, 3})) {
         Setting s = base;
         s.k_max = k;
         points.push_back({knob, std::to_string(k), s});
       }
     if (knob == "resolution")
-      for (double f : o.quick ? std::vector<double>{0.5, 1} : std::vector<double>{0.5, 1, 2}) {
+      for (double f : First(o.values, std::vector<double>{0.5, 1, 2})) {
         Setting s = base;
         s.resolution = std::max(8, int(std::lround(base.resolution * f)));
         points.push_back({knob, std::to_string(s.resolution), s});
       }
     if (knob == "samples")
-      for (int n : o.quick ? std::vector<int>{1, 4} : std::vector<int>{1, 2, 4}) {
+      for (int n : First(o.values, std::vector<int>{1, 2, 4})) {
         Setting s = base;
         s.samples = n;
         points.push_back({knob, std::to_string(n), s});
@@ -386,7 +415,8 @@ int RunStudy(int argc, char** argv) {
     }
     row.knob = point.knob, row.value = point.value;
     for (int k = 0; k < 3; ++k)
-      if (!std::isfinite(row.err[k]) || !std::isfinite(row.flux[k]))
+      if (!std::isfinite(row.err[k]) || !std::isfinite(row.flux[k]) ||
+          !std::isfinite(row.err_covered[k]))
         throw Failure(point.knob + " = " + point.value + ": a non-finite error");
     rows.push_back(row);
     write_outputs();  // the row is in study.csv only once the point is complete

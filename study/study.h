@@ -17,6 +17,10 @@ struct StudyRow {
   double slab_rel_l2 = 0;
   double err[3] = {0, 0, 0};   // relative L2 of the reference vs the analytic image at d, 2d, 4d
   double flux[3] = {0, 0, 0};  // its flux over the analytic image's
+  // The same error over the pixels the grid covers (GridCovers: all the light of every emitter
+  // reaches them through the slab), -1 when none is; and the analytic flux's share there.
+  double err_covered[3] = {0, 0, 0};
+  double covered[3] = {0, 0, 0};
   double lab_s = 0, acquire_s = 0, calibrate_s = 0, reconstruct_s = 0, render_s = 0, total_s = 0;
   int positions() const { return nu * nv; }
 };

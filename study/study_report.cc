@@ -25,6 +25,7 @@ std::string Fixed(double x, const char* format) {
   return buf;
 }
 std::string Percent(double x) { return Fixed(100 * x, "%.3g %%"); }
+std::string CoveredPercent(double x) { return x < 0 ? "-" : Percent(x); }
 std::string Seconds(double s) {
   if (s >= 3600) return Fixed(s / 3600, "%.2g h");
   if (s >= 60) return Fixed(s / 60, "%.3g min");
@@ -52,8 +53,9 @@ std::string Setting(const StudyRow& r) {
 
 std::string StudyCsvHeader() {
   return "knob,value,key,h_mm,nu,nv,positions,photo_w,photo_h,k_max,slab_res,samples,render_px,"
-         "slab_rel_l2,err_d,flux_d,err_2d,flux_2d,err_4d,flux_4d,lab_s,acquire_s,calibrate_s,"
-         "reconstruct_s,render_s,total_s";
+         "slab_rel_l2,err_d,flux_d,err_2d,flux_2d,err_4d,flux_4d,err_cov_d,covered_d,err_cov_2d,"
+         "covered_2d,err_cov_4d,covered_4d,lab_s,acquire_s,calibrate_s,reconstruct_s,render_s,"
+         "total_s";
 }
 
 std::string StudyCsvLine(const StudyRow& r) {
@@ -62,6 +64,7 @@ std::string StudyCsvLine(const StudyRow& r) {
     << "," << r.positions() << "," << r.photo_w << "," << r.photo_h << "," << r.k_max << ","
     << r.slab_res << "," << r.samples << "," << r.render_px << "," << Num(r.slab_rel_l2);
   for (int k = 0; k < 3; ++k) s << "," << Num(r.err[k]) << "," << Num(r.flux[k]);
+  for (int k = 0; k < 3; ++k) s << "," << Num(r.err_covered[k]) << "," << Num(r.covered[k]);
   s << "," << Num(r.lab_s) << "," << Num(r.acquire_s) << "," << Num(r.calibrate_s) << ","
     << Num(r.reconstruct_s) << "," << Num(r.render_s) << "," << Num(r.total_s);
   return s.str();
@@ -80,7 +83,7 @@ std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
     const auto bad = [&](const std::string& why) {
       return BadInput(path + ": line " + std::to_string(number) + ": " + why);
     };
-    if (f.size() != 26) throw bad("expected 26 fields, got " + std::to_string(f.size()));
+    if (f.size() != 32) throw bad("expected 32 fields, got " + std::to_string(f.size()));
     StudyRow r;
     try {
       size_t i = 0;
@@ -93,6 +96,8 @@ std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
       r.samples = std::stoi(f[i++]), r.render_px = std::stoi(f[i++]);
       r.slab_rel_l2 = std::stod(f[i++]);
       for (int k = 0; k < 3; ++k) r.err[k] = std::stod(f[i++]), r.flux[k] = std::stod(f[i++]);
+      for (int k = 0; k < 3; ++k)
+        r.err_covered[k] = std::stod(f[i++]), r.covered[k] = std::stod(f[i++]);
       r.lab_s = std::stod(f[i++]), r.acquire_s = std::stod(f[i++]);
       r.calibrate_s = std::stod(f[i++]), r.reconstruct_s = std::stod(f[i++]);
       r.render_s = std::stod(f[i++]), r.total_s = std::stod(f[i++]);
@@ -148,16 +153,18 @@ std::string StudyReport(const std::vector<StudyRow>& rows,
     if (!any) continue;
     s << "## Knob `" << knob << "`\n\n"
       << "| value | positions | setting | slab vs truth | err d | err 2d | err 4d | flux d | "
-         "flux 4d | lab | acquire (sim) | reconstruct | render | total |\n"
-      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "flux 4d | covered d | err d covered | err 4d covered | lab | acquire (sim) | "
+         "reconstruct | render | total |\n"
+      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const StudyRow& r : rows) {
       if (r.knob != knob) continue;
       s << "| " << r.value << " | " << r.positions() << " | " << Setting(r) << " | "
         << Percent(r.slab_rel_l2) << " | " << Percent(r.err[0]) << " | " << Percent(r.err[1])
         << " | " << Percent(r.err[2]) << " | " << Fixed(r.flux[0], "%.4f") << " | "
-        << Fixed(r.flux[2], "%.4f") << " | " << Seconds(r.lab_s) << " | " << Seconds(r.acquire_s)
-        << " | " << Seconds(r.reconstruct_s) << " | " << Seconds(r.render_s) << " | "
-        << Seconds(r.total_s) << " |\n";
+        << Fixed(r.flux[2], "%.4f") << " | " << Percent(r.covered[0]) << " | "
+        << CoveredPercent(r.err_covered[0]) << " | " << CoveredPercent(r.err_covered[2]) << " | "
+        << Seconds(r.lab_s) << " | " << Seconds(r.acquire_s) << " | " << Seconds(r.reconstruct_s)
+        << " | " << Seconds(r.render_s) << " | " << Seconds(r.total_s) << " |\n";
     }
     s << "\n";
   }

@@ -299,6 +299,22 @@ int RunStudy(int argc, char** argv) {
     throw BadInput("--out: cannot write into " + out + " (" + e.what() + ")");
   }
   RemoveOrphanedTemporaries(out);
+  // What the rows depend on beyond their key: the scene and the lab model. A rerun into the same
+  // --out must agree, or it would resume another study's rows and datasets.
+  const nlohmann::json identity = {{"schema_version", 1},
+                                   {"scene", base_scene},
+                                   {"move_s", o.move_s},
+                                   {"exposure_s", o.exposure_s},
+                                   {"slides", o.slides}};
+  const std::string identity_path = out + "/study.json";
+  if (fs::exists(identity_path)) {
+    if (JsonDocument::Load(identity_path).raw() != identity)
+      throw BadInput("--out: " + identity_path +
+                     ": the folder holds a study of another scene or lab model (--move-s, "
+                     "--exposure-s, --slides); use another --out");
+  } else {
+    WriteJsonAtomically(identity_path, identity);
+  }
 
   Setting base;
   base.h_mm = scene.grid.spacing_mm;
@@ -371,7 +387,8 @@ int RunStudy(int argc, char** argv) {
       Num(o.move_s) + " s move + " + std::to_string(o.slides) + " slides x brackets x " +
       Num(o.exposure_s) +
       " s). Screen calibration: `lumislab-calibrate screen` (the board "
-      "photo). Noise-free photos (the scene's effects as given). Total time = lab model + "
+      "photo). Photos through the scene's effects as given (the default scene has none: "
+      "noise-free). Total time = lab model + "
       "reconstruct + reference render (three planes); acquire (sim) is the synthetic capture's "
       "own time, not counted.\n";
   const auto write_outputs = [&] {

@@ -118,6 +118,11 @@ TEST(Study, TinySweepWritesRowsResumesAndMovesErrorsTheKnownWay) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("running"), std::string::npos) << r.output;
   EXPECT_EQ(ReadStudyCsv(out + "/study.csv").size(), 4u);
+
+  // Another lab model (or scene) into the same --out would mix two studies: refused.
+  r = RunTool("lumislab-study", SweepArgs(scene, out) + " --move-s 3");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("study.json"), std::string::npos) << r.output;
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

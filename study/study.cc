@@ -1,6 +1,7 @@
 #include "study/study.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +21,7 @@
 #include "core/json.h"
 #include "core/log.h"
 #include "core/slab_compare.h"
+#include "core/stop_signal.h"
 #include "lib/lightfield/reference_render.h"
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/tone_map.h"
@@ -106,9 +108,18 @@ double RunStage(const std::string& tool, const std::vector<std::string>& args,
     execv(path.c_str(), argv.data());
     _exit(127);
   }
+  // Polled so that a stop signal reaches the stage too: it finishes its item and leaves what it
+  // wrote valid (§7.6), and the study stops after it.
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  bool forwarded = false;
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid || (done < 0 && errno != EINTR)) break;
+    if (StopRequested() && !forwarded) kill(pid, SIGTERM), forwarded = true;
+    usleep(20000);
   }
+  if (StopRequested())
+    throw Failure("stopped by a signal during " + tool + "; run again to continue");
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
@@ -397,6 +408,9 @@ int RunStudy(int argc, char** argv) {
     WriteTextAtomically(csv, text);
   };
 
+  // SIGINT / SIGTERM: the stage in hand is told to stop, the study stops after it (exit 1);
+  // study.csv holds the points completed before, and the same command continues.
+  const StopSignalScope stop_scope;
   const int brackets = int(scene.Stops().size());
   int skipped = 0;
   for (size_t p = 0; p < points.size(); ++p) {
@@ -409,6 +423,7 @@ int RunStudy(int argc, char** argv) {
       ++skipped;
       continue;
     }
+    if (StopRequested()) throw Failure("stopped by a signal; run again to continue");
     LogInfo("point ", p + 1, "/", points.size(), ": ", point.knob, " = ", point.value);
     StudyRow row;
     const auto same =

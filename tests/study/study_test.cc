@@ -6,8 +6,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <map>
+#include <thread>
 
 #include "../cli/test_util.h"
 #include "core/atomic_file.h"
@@ -123,6 +125,38 @@ TEST(Study, TinySweepWritesRowsResumesAndMovesErrorsTheKnownWay) {
   r = RunTool("lumislab-study", SweepArgs(scene, out) + " --move-s 3");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("study.json"), std::string::npos) << r.output;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+TEST(Study, StopSignalEndsTheStageInHandAndTheSameCommandContinues) {
+  const std::string dir = FreshDir("study_stop");
+  const std::string scene = dir + "/scene.json", out = dir + "/out", log = dir + "/log.txt";
+  WriteFile(scene, testing::SceneJson(5, 5, kCamera, "[]"));
+  const std::vector<std::string> args = {"--scene", scene,           "--out", out,
+                                         "--quick", "--values",      "2",     "--knobs",
+                                         "spacing", "--photo-scale", "0.25",  "--resolution",
+                                         "32",      "--render-size", "24"};
+  {
+    testing::ToolProcess study(dir, "lumislab-study", args, log);
+    ASSERT_TRUE(study.started());
+    // Signalled once the first point is in study.csv and the second one's stages run.
+    while (study.Running() && study.Elapsed() < 60 &&
+           ReadTextFile(log).find("point 2/2") == std::string::npos)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_TRUE(study.Signal(SIGTERM));
+    ASSERT_TRUE(study.WaitFor(30));
+    EXPECT_EQ(study.exit_code(), 1);
+    EXPECT_FALSE(study.signalled());
+  }
+  EXPECT_NE(ReadTextFile(log).find("stopped by a signal"), std::string::npos) << ReadTextFile(log);
+  EXPECT_EQ(ReadStudyCsv(out + "/study.csv").size(), 1u);
+  EXPECT_TRUE(testing::TemporaryPaths(testing::SnapshotTree(out)).empty());
+  std::string line;
+  for (const auto& a : args) line += testing::ShellQuote(a) + " ";
+  const auto r = RunTool("lumislab-study", line);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 point(s) already in"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadStudyCsv(out + "/study.csv").size(), 2u);
   if (!::testing::Test::HasFailure()) fs::remove_all(dir);
 }
 

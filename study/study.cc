@@ -282,6 +282,11 @@ int RunStudy(int argc, char** argv) {
   app.add_flag("--keep-photos", o.keep_photos, "keep each dataset's photos (removed by default)");
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("study", common);
+  LogInfo("parameters: scene=", o.scene, " out=", o.out, " quick=", o.quick ? "yes" : "no",
+          " knobs=", o.knobs, " values=", o.values, " move_s=", o.move_s,
+          " exposure_s=", o.exposure_s, " slides=", o.slides, " photo_scale=", o.photo_scale,
+          " resolution=", o.resolution, " render_size=", o.render_px, " samples=", o.samples,
+          " keep_photos=", o.keep_photos ? "yes" : "no", " threads=", threads);
 
   // Inputs first: the scene (exit 2 naming the file), the knobs, then --out.
   const SynthScene scene = LoadScene(o.scene);

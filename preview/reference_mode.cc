@@ -5,7 +5,6 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "core/parallel.h"
 #include "lib/lightfield/reference_render.h"
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/scene.h"
@@ -13,20 +12,6 @@
 
 namespace lumislab {
 namespace {
-
-// E_ij of every position slab.json lists (empty images for the others), read on `threads`
-// threads; a listed position that is missing or damaged is exit 2 naming its file.
-std::vector<ImageF> ReadSlabIrradiance(const std::string& slab_dir, const SlabInfo& info,
-                                       int threads) {
-  if (info.present.empty())
-    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
-  std::vector<ImageF> out(size_t(info.grid.count()));
-  ParallelFor(int(info.present.size()), threads, [&](int k) {
-    const auto [i, j] = info.present[k];
-    out[size_t(j) * info.grid.nu + i] = ReadSlabPosition(slab_dir, info, i, j).irradiance;
-  });
-  return out;
-}
 
 // The synthetic luminaire's emitters as the reference's point sources.
 std::vector<PointSource> PointSources(const Luminaire& luminaire) {

@@ -293,4 +293,16 @@ ReferenceImage RenderPointSources(const ReferenceScene& view,
   });
 }
 
+std::vector<ImageF> ReadSlabIrradiance(const std::string& slab_dir, const SlabInfo& info,
+                                       int threads) {
+  if (info.present.empty())
+    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
+  std::vector<ImageF> out(size_t(info.grid.count()));
+  ParallelFor(int(info.present.size()), threads, [&](int k) {
+    const auto [i, j] = info.present[k];
+    out[size_t(j) * info.grid.nu + i] = ReadSlabPosition(slab_dir, info, i, j).irradiance;
+  });
+  return out;
+}
+
 }  // namespace lumislab

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -89,6 +90,12 @@ struct ReferenceImage {
 ReferenceImage RenderReference(const ReferenceScene& view, const SlabInfo& info,
                                const std::vector<ImageF>& irradiance,
                                const ReferenceOptions& options);
+
+// E_ij of every position slab.json lists, by linear index j * nu + i (empty images for the
+// others), read on `threads` threads: the input of RenderReference. A listed position that is
+// missing or damaged is exit 2 naming its file; a slab without positions is exit 2.
+std::vector<ImageF> ReadSlabIrradiance(const std::string& slab_dir, const SlabInfo& info,
+                                       int threads);
 
 // A point light behind S (luminaire frame, z < 0) with its intensity (W/sr, RGB) towards a unit
 // direction: the synthetic luminaire's emitters (lib/synthetic) handed in without this library

@@ -1,0 +1,470 @@
+#include "study/study.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/command_line.h"
+#include "core/error.h"
+#include "core/json.h"
+#include "core/log.h"
+#include "core/slab_compare.h"
+#include "core/stop_signal.h"
+#include "lib/lightfield/reference_render.h"
+#include "lib/lightfield/scene_setup.h"
+#include "lib/lightfield/tone_map.h"
+#include "lib/synthetic/scene.h"
+#include "lib/synthetic/truth.h"
+
+namespace fs = std::filesystem;
+
+namespace lumislab {
+namespace {
+
+// The knobs, in the order of the report.
+const std::vector<std::string> kKnobs = {"spacing", "extent",     "photo",
+                                         "k_max",   "resolution", "samples"};
+
+struct Options {
+  std::string scene = "default";
+  std::string out;
+  bool quick = false;
+  std::string knobs = "all";
+  double move_s = 2.0;      // lab model: stage move and settle per position
+  double exposure_s = 0.5;  // lab model: one exposure (plus readout)
+  int slides = 2;           // T+ and T-
+  double photo_scale = 0;   // base photo size over the scene camera's (0: 1, --quick 0.25)
+  int resolution = 0;       // base slab texels per side (0: 150, --quick 48)
+  int render_px = 0;        // receiver-plane image side (0: 96, --quick 40)
+  int samples = 1;          // base N of the reference
+  bool keep_photos = false;
+  int values = 3;  // values per knob: the first 2 or all 3 of each list
+};
+
+template <typename T>
+std::vector<T> First(int n, std::vector<T> values) {
+  values.resize(std::min(values.size(), size_t(n)));
+  return values;
+}
+
+// One setting of the whole chain (the base, or the base with one knob moved).
+struct Setting {
+  double h_mm = 5;
+  int nu = 9, nv = 7;
+  double photo_scale = 1;
+  int k_max = 1, resolution = 150, samples = 1, render_px = 96;
+};
+
+// Everything acquire and reconstruct see: points that agree on it share one dataset folder.
+std::string DatasetName(const Setting& s) {
+  return "h" + Num(s.h_mm) + "_" + std::to_string(s.nu) + "x" + std::to_string(s.nv) + "_p" +
+         Num(s.photo_scale) + "_K" + std::to_string(s.k_max) + "_r" + std::to_string(s.resolution);
+}
+std::string Key(const Setting& s) {
+  return DatasetName(s) + "_N" + std::to_string(s.samples) + "_px" + std::to_string(s.render_px);
+}
+
+// The executable `tool` beside this one (build/bin/ or an install's bin/).
+std::string ToolPath(const std::string& tool) {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  const fs::path path = (ec ? fs::path(".") : self.parent_path()) / tool;
+  if (!fs::exists(path))
+    throw Failure(tool + " not found beside lumislab-study (" + path.string() + ")");
+  return path.string();
+}
+
+// Runs `tool args...` with stdout and stderr appended to `log`; returns its wall time. A tool
+// that fails is a failure of the study (exit 1) naming the command and the log.
+double RunStage(const std::string& tool, const std::vector<std::string>& args,
+                const std::string& log) {
+  const std::string path = ToolPath(tool);
+  std::vector<std::string> words = {path};
+  words.insert(words.end(), args.begin(), args.end());
+  std::string line;
+  for (const auto& w : words) line += (line.empty() ? "" : " ") + w;
+  LogInfo("running ", line);
+  const auto start = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid < 0) throw Failure("cannot start " + tool);
+  if (pid == 0) {
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    if (fd >= 0) dup2(fd, 1), dup2(fd, 2), close(fd);
+    std::vector<char*> argv;
+    for (auto& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    execv(path.c_str(), argv.data());
+    _exit(127);
+  }
+  // Polled so that a stop signal reaches the stage too: it finishes its item and leaves what it
+  // wrote valid (§7.6), and the study stops after it.
+  int status = 0;
+  bool forwarded = false;
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid || (done < 0 && errno != EINTR)) break;
+    if (StopRequested() && !forwarded) kill(pid, SIGTERM), forwarded = true;
+    usleep(20000);
+  }
+  if (StopRequested())
+    throw Failure("stopped by a signal during " + tool + "; run again to continue");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw Failure(line + " failed (exit " +
+                  std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status)) +
+                  "); see " + log);
+  return seconds;
+}
+
+struct StageTimes {
+  double acquire_s = 0, calibrate_s = 0, reconstruct_s = 0;
+};
+
+// The scene file of a setting: the study's scene with its grid, camera size, K changed.
+std::string SceneText(const nlohmann::json& base, const Setting& s) {
+  nlohmann::json scene = base;
+  scene["setup"]["grid"]["nu"] = s.nu;
+  scene["setup"]["grid"]["nv"] = s.nv;
+  scene["setup"]["grid"]["spacing_mm"] = s.h_mm;
+  scene["filter"]["k_max"] = s.k_max;
+  // The same view at another pixel count: size and focal length scale together.
+  const auto size = base["camera"]["size_px"];
+  scene["camera"]["size_px"] = {int(std::lround(size[0].get<double>() * s.photo_scale)),
+                                int(std::lround(size[1].get<double>() * s.photo_scale))};
+  scene["camera"]["focal_px"] = base["camera"]["focal_px"].get<double>() * s.photo_scale;
+  return scene.dump(2) + "\n";
+}
+
+// acquire synth -> calibrate screen -> reconstruct in work/<dataset>/, once: a finished dataset
+// keeps its stage times in times.json (written last), and its photos are removed then unless
+// --keep-photos. An interrupted one is continued by the stages' own resumption (§7.4).
+StageTimes RunChain(const nlohmann::json& base_scene, const Setting& s, const std::string& work,
+                    int threads, bool keep_photos) {
+  const std::string dir = work + "/" + DatasetName(s);
+  const std::string times_path = dir + "/times.json";
+  if (fs::exists(times_path)) {
+    const JsonDocument doc = JsonDocument::Load(times_path);
+    return {doc.root()["acquire_s"].Number(), doc.root()["calibrate_s"].Number(),
+            doc.root()["reconstruct_s"].Number()};
+  }
+  MakeDirectories(dir);
+  const std::string scene = dir + "/scene.json", ds = dir + "/ds", log = dir + "/log.txt";
+  WriteTextAtomically(scene, SceneText(base_scene, s));
+  const std::string t = std::to_string(threads), res = std::to_string(s.resolution);
+  StageTimes times;
+  times.acquire_s = RunStage(
+      "lumislab-acquire",
+      {"synth", "--scene", scene, "--out", ds, "--truth-resolution", res, "--threads", t}, log);
+  times.calibrate_s =
+      RunStage("lumislab-calibrate", {"screen", "--dataset", ds, "--threads", t}, log);
+  times.reconstruct_s =
+      RunStage("lumislab-reconstruct", {"--dataset", ds, "--resolution", res, "--threads", t}, log);
+  if (!keep_photos) fs::remove_all(ds + "/photos");
+  WriteJsonAtomically(times_path, {{"acquire_s", times.acquire_s},
+                                   {"calibrate_s", times.calibrate_s},
+                                   {"reconstruct_s", times.reconstruct_s}});
+  return times;
+}
+
+double Sum(const ImageF& image) {
+  double s = 0;
+  for (float v : image.data) s += v;
+  return s;
+}
+
+// Errors of one point: slab vs truth/, and the reference against the analytic image on the
+// receiver plane at D = d, 2d, 4d (irradiance, every pixel of the plane's view).
+void Measure(const SynthScene& scene, const Setting& s, const std::string& ds, int threads,
+             StudyRow* row) {
+  row->slab_rel_l2 = CompareSlabs(ds + "/slab", ds + "/truth").overall_relative_l2;
+  const SlabInfo info = SlabInfo::Load(ds + "/slab");
+  const std::vector<ImageF> irradiance = ReadSlabIrradiance(ds + "/slab", info, threads);
+  std::vector<PointSource> sources;
+  for (const Emitter& e : scene.luminaire.emitters)
+    sources.push_back({e.position_mm, [e](const Eigen::Vector3d& w) { return e.Intensity(w); }});
+  ReferenceOptions options;
+  options.samples = s.samples;
+  options.threads = threads;
+  options.progress = false;
+  row->render_s = 0;
+  for (int k = 0; k < 3; ++k) {
+    SceneRequest request;
+    request.name = "plane";
+    request.receiver_plane_mm = info.distance_mm * (1 << k);
+    const ReferenceScene view(MakeSceneSetup(request, info), s.render_px, s.render_px);
+    const ReferenceImage analytic = RenderPointSources(view, sources, options);
+    const auto start = std::chrono::steady_clock::now();
+    const ReferenceImage image = RenderReference(view, info, irradiance, options);
+    row->render_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!image.complete || !analytic.complete) throw Failure("stopped by a signal");
+    row->err[k] = CompareImages(image.irradiance, analytic.irradiance).relative_l2;
+    const double flux = Sum(analytic.irradiance);
+    row->flux[k] = flux > 0 ? Sum(image.irradiance) / flux : 0;
+    // Only the pixels the grid covers: what is left there is the reconstruction's own error.
+    double diff2 = 0, ref2 = 0, covered_flux = 0;
+    const ImageF& a = analytic.irradiance;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) {
+        const SurfacePoint p = view.Primary(x, y);
+        if (!p.hit || !GridCovers(scene.luminaire, info, p.x)) continue;
+        for (int c = 0; c < a.channels; ++c) {
+          const double e = image.irradiance.at(x, y, c) - a.at(x, y, c);
+          diff2 += e * e, ref2 += double(a.at(x, y, c)) * a.at(x, y, c);
+          covered_flux += a.at(x, y, c);
+        }
+      }
+    row->err_covered[k] = ref2 > 0 ? std::sqrt(diff2 / ref2) : -1;
+    row->covered[k] = flux > 0 ? covered_flux / flux : 0;
+  }
+}
+
+}  // namespace
+
+int RunStudy(int argc, char** argv) {
+  CLI::App app{
+      "lumislab-study: what accuracy costs in time. Sweeps one knob at a time around a base "
+      "setting on a synthetic scene, each point end to end (acquire synth -> calibrate screen -> "
+      "reconstruct -> exact reference against the analytic image at D = d, 2d, 4d), and writes "
+      "study.csv, report.md and error-against-time plots (SVG) into --out. Resumes: points "
+      "already in study.csv are skipped."};
+  Options o;
+  CommonOptions common;
+  AddCommonOptions(&app, &common);
+  app.add_option("--scene", o.scene, "scene file (JSON) or \"default\" (acquire synth's)")
+      ->capture_default_str();
+  app.add_option("--out", o.out, "folder for study.csv, report.md, the plots and work/")
+      ->required();
+  app.add_flag(
+      "--quick", o.quick,
+      "photos at 0.25 of the scene camera's size (x1, 1.5, 2 for the photo knob), 48 texels, 40 px "
+      "renders");
+  app.add_option("--knobs", o.knobs,
+                 "comma-separated subset of spacing,extent,photo,k_max,resolution,samples, or all")
+      ->capture_default_str();
+  app.add_option("--move-s", o.move_s, "lab model: stage move and settle per position, s")
+      ->check(FiniteIn(0, 1e6))
+      ->capture_default_str();
+  app.add_option("--exposure-s", o.exposure_s, "lab model: one exposure with readout, s")
+      ->check(FiniteIn(0, 1e6))
+      ->capture_default_str();
+  app.add_option("--slides", o.slides, "lab model: slides per position")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  app.add_option("--photo-scale", o.photo_scale,
+                 "base photo size over the scene camera's (default 1, --quick 0.25)")
+      ->check(FiniteIn(0.05, 4));
+  app.add_option("--resolution", o.resolution,
+                 "base slab texels per side (default 150, --quick 48)")
+      ->check(CLI::Range(8, 1000));
+  app.add_option("--render-size", o.render_px,
+                 "receiver-plane image side in px (default 96, --quick 40)")
+      ->check(CLI::Range(8, 2048));
+  app.add_option("--samples", o.samples, "base samples per basis support N of the reference")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option("--values", o.values, "values per knob: 2 (the first two of each list) or 3")
+      ->check(CLI::Range(2, 3))
+      ->capture_default_str();
+  app.add_flag("--keep-photos", o.keep_photos, "keep each dataset's photos (removed by default)");
+  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
+  const int threads = StartTool("study", common);
+  LogInfo("parameters: scene=", o.scene, " out=", o.out, " quick=", o.quick ? "yes" : "no",
+          " knobs=", o.knobs, " values=", o.values, " move_s=", o.move_s,
+          " exposure_s=", o.exposure_s, " slides=", o.slides, " photo_scale=", o.photo_scale,
+          " resolution=", o.resolution, " render_size=", o.render_px, " samples=", o.samples,
+          " keep_photos=", o.keep_photos ? "yes" : "no", " threads=", threads);
+
+  // Inputs first: the scene (exit 2 naming the file), the knobs, then --out.
+  const SynthScene scene = LoadScene(o.scene);
+  const nlohmann::json base_scene =
+      nlohmann::json::parse(o.scene == "default" ? DefaultSceneJson() : ReadTextFile(o.scene));
+  std::vector<std::string> knobs;
+  if (o.knobs == "all") {
+    knobs = kKnobs;
+  } else {
+    std::istringstream in(o.knobs);
+    for (std::string k; std::getline(in, k, ',');) {
+      if (std::find(kKnobs.begin(), kKnobs.end(), k) == kKnobs.end())
+        throw BadInput(
+            "--knobs: expected a comma-separated subset of spacing, extent, photo, "
+            "k_max, resolution, samples, got \"" +
+            k + "\"");
+      knobs.push_back(k);
+    }
+  }
+  const std::string out = TrimTrailingSlashes(o.out);
+  try {
+    fs::create_directories(out);
+    WriteTextAtomically(out + "/.write_probe", "");
+    fs::remove(out + "/.write_probe");
+  } catch (const std::exception& e) {
+    throw BadInput("--out: cannot write into " + out + " (" + e.what() + ")");
+  }
+  RemoveOrphanedTemporaries(out);
+  // What the rows depend on beyond their key: the scene and the lab model. A rerun into the same
+  // --out must agree, or it would resume another study's rows and datasets.
+  const nlohmann::json identity = {{"schema_version", 1},
+                                   {"scene", base_scene},
+                                   {"move_s", o.move_s},
+                                   {"exposure_s", o.exposure_s},
+                                   {"slides", o.slides}};
+  const std::string identity_path = out + "/study.json";
+  if (fs::exists(identity_path)) {
+    if (JsonDocument::Load(identity_path).raw() != identity)
+      throw BadInput("--out: " + identity_path +
+                     ": the folder holds a study of another scene or lab model (--move-s, "
+                     "--exposure-s, --slides); use another --out");
+  } else {
+    WriteJsonAtomically(identity_path, identity);
+  }
+
+  Setting base;
+  base.h_mm = scene.grid.spacing_mm;
+  base.nu = scene.grid.nu, base.nv = scene.grid.nv;
+  base.photo_scale = o.photo_scale > 0 ? o.photo_scale : (o.quick ? 0.25 : 1.0);
+  base.k_max = scene.k_max;
+  base.resolution = o.resolution > 0 ? o.resolution : (o.quick ? 48 : 150);
+  base.samples = o.samples;
+  base.render_px = o.render_px > 0 ? o.render_px : (o.quick ? 40 : 96);
+
+  // The points: (knob, value label, setting). Spacing keeps the grid's extent (the positions
+  // cover the same part of S); extent keeps h and scales the grid's span.
+  struct Point {
+    std::string knob, value;
+    Setting setting;
+  };
+  std::vector<Point> points;
+  const auto positions_for = [](int n0, double span_factor) {
+    return std::max(1, int(std::lround((n0 - 1) * span_factor)) + 1);
+  };
+  for (const std::string& knob : knobs) {
+    if (knob == "spacing")
+      for (double f : First(o.values, std::vector<double>{2, 1, 0.5})) {
+        Setting s = base;
+        s.h_mm = base.h_mm * f;
+        s.nu = positions_for(base.nu, 1 / f), s.nv = positions_for(base.nv, 1 / f);
+        points.push_back({knob, Num(s.h_mm) + " mm", s});
+      }
+    if (knob == "extent")
+      for (double f : First(o.values, std::vector<double>{0.5, 1, 1.5})) {
+        Setting s = base;
+        s.nu = positions_for(base.nu, f), s.nv = positions_for(base.nv, f);
+        points.push_back({knob, "x" + Num(f), s});
+      }
+    if (knob == "photo")
+      for (double f : First(o.values, o.quick ? std::vector<double>{1, 1.5, 2}
+                                              : std::vector<double>{0.5, 0.75, 1})) {
+        Setting s = base;
+        s.photo_scale = base.photo_scale * f;
+        points.push_back({knob, "x" + Num(s.photo_scale), s});
+      }
+    if (knob == "k_max")
+      for (int k : First(o.values, std::vector<int>{1, 2, 3})) {
+        Setting s = base;
+        s.k_max = k;
+        points.push_back({knob, std::to_string(k), s});
+      }
+    if (knob == "resolution")
+      for (double f : First(o.values, std::vector<double>{0.5, 1, 2})) {
+        Setting s = base;
+        s.resolution = std::max(8, int(std::lround(base.resolution * f)));
+        points.push_back({knob, std::to_string(s.resolution), s});
+      }
+    if (knob == "samples")
+      for (int n : First(o.values, std::vector<int>{1, 2, 4})) {
+        Setting s = base;
+        s.samples = n;
+        points.push_back({knob, std::to_string(n), s});
+      }
+  }
+
+  const std::string csv = out + "/study.csv";
+  std::vector<StudyRow> rows = fs::exists(csv) ? ReadStudyCsv(csv) : std::vector<StudyRow>{};
+  const std::string header_note =
+      "# lumislab-study: " + scene.source + "\n\nBase: h " + Num(base.h_mm) + " mm, " +
+      std::to_string(base.nu) + "x" + std::to_string(base.nv) + " positions, photos " +
+      Num(base.photo_scale) + " x the scene camera's, K " + std::to_string(base.k_max) + ", " +
+      std::to_string(base.resolution) + " texels, N " + std::to_string(base.samples) +
+      ", receiver plane " + std::to_string(base.render_px) + " px. Lab model: positions x (" +
+      Num(o.move_s) + " s move + " + std::to_string(o.slides) + " slides x brackets x " +
+      Num(o.exposure_s) +
+      " s). Screen calibration: `lumislab-calibrate screen` (the board "
+      "photo). Photos through the scene's effects as given (the default scene has none: "
+      "noise-free). Total time = lab model + "
+      "reconstruct + reference render (three planes); acquire (sim) is the synthetic capture's "
+      "own time, not counted.\n";
+  const auto write_outputs = [&] {
+    std::string text = StudyCsvHeader() + "\n";
+    for (const StudyRow& r : rows) text += StudyCsvLine(r) + "\n";
+    WriteTextAtomically(csv, text);
+  };
+
+  // SIGINT / SIGTERM: the stage in hand is told to stop, the study stops after it (exit 1);
+  // study.csv holds the points completed before, and the same command continues.
+  const StopSignalScope stop_scope;
+  const int brackets = int(scene.Stops().size());
+  int skipped = 0;
+  for (size_t p = 0; p < points.size(); ++p) {
+    const Point& point = points[p];
+    const std::string key = Key(point.setting);
+    const auto done = std::find_if(rows.begin(), rows.end(), [&](const StudyRow& r) {
+      return r.knob == point.knob && r.key == key;
+    });
+    if (done != rows.end()) {
+      ++skipped;
+      continue;
+    }
+    if (StopRequested()) throw Failure("stopped by a signal; run again to continue");
+    LogInfo("point ", p + 1, "/", points.size(), ": ", point.knob, " = ", point.value);
+    StudyRow row;
+    const auto same =
+        std::find_if(rows.begin(), rows.end(), [&](const StudyRow& r) { return r.key == key; });
+    if (same != rows.end()) {
+      row = *same;  // the same setting under another knob (the base): measured once
+    } else {
+      const Setting& s = point.setting;
+      const StageTimes times = RunChain(base_scene, s, out + "/work", threads, o.keep_photos);
+      row.key = key;
+      row.h_mm = s.h_mm, row.nu = s.nu, row.nv = s.nv;
+      row.photo_w = int(std::lround(scene.camera.width * s.photo_scale));
+      row.photo_h = int(std::lround(scene.camera.height * s.photo_scale));
+      row.k_max = s.k_max, row.slab_res = s.resolution, row.samples = s.samples;
+      row.render_px = s.render_px;
+      row.acquire_s = times.acquire_s, row.calibrate_s = times.calibrate_s;
+      row.reconstruct_s = times.reconstruct_s;
+      Measure(scene, s, out + "/work/" + DatasetName(s) + "/ds", threads, &row);
+      row.lab_s = row.positions() * (o.move_s + o.slides * brackets * o.exposure_s);
+      row.total_s = row.lab_s + row.reconstruct_s + row.render_s;
+    }
+    row.knob = point.knob, row.value = point.value;
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(row.err[k]) || !std::isfinite(row.flux[k]) ||
+          !std::isfinite(row.err_covered[k]))
+        throw Failure(point.knob + " = " + point.value + ": a non-finite error");
+    rows.push_back(row);
+    write_outputs();  // the row is in study.csv only once the point is complete
+  }
+  if (skipped > 0) LogInfo(skipped, " point(s) already in ", csv, ", skipped");
+
+  WriteTextAtomically(out + "/report.md", StudyReport(rows, kKnobs, header_note));
+  WriteTextAtomically(out + "/study_d.svg", StudySvg(rows, kKnobs, 0));
+  WriteTextAtomically(out + "/study_4d.svg", StudySvg(rows, kKnobs, 2));
+  std::cout << ParetoTables(rows) << out << "/report.md\n";
+  return 0;
+}
+
+}  // namespace lumislab

@@ -1,0 +1,49 @@
+// lumislab-study (docs/design.md §4.7): what accuracy costs in time. A sweep over a synthetic
+// scene, one knob at a time around a base setting; each point runs the whole chain (acquire synth
+// -> calibrate screen -> reconstruct) and measures the slab against truth/ and the receiver-plane
+// irradiance of the exact reference against the analytic image at D = d, 2d, 4d, with the times.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace lumislab {
+
+// One point of the sweep: its knob and value, every setting, every error and time (a CSV row).
+struct StudyRow {
+  std::string knob, value, key;  // key: every setting, so equal points share results
+  double h_mm = 0;
+  int nu = 0, nv = 0, photo_w = 0, photo_h = 0, k_max = 0, slab_res = 0, samples = 0, render_px = 0;
+  double slab_rel_l2 = 0;
+  double err[3] = {0, 0, 0};   // relative L2 of the reference vs the analytic image at d, 2d, 4d
+  double flux[3] = {0, 0, 0};  // its flux over the analytic image's
+  // The same error over the pixels the grid covers (GridCovers: all the light of every emitter
+  // reaches them through the slab), -1 when none is; and the analytic flux's share there.
+  double err_covered[3] = {0, 0, 0};
+  double covered[3] = {0, 0, 0};
+  double lab_s = 0, acquire_s = 0, calibrate_s = 0, reconstruct_s = 0, render_s = 0, total_s = 0;
+  int positions() const { return nu * nv; }
+};
+
+// The CSV (header line + one line per row) and back; a file with another header or a damaged
+// line is bad input naming the file and line.
+std::string StudyCsvHeader();
+std::string StudyCsvLine(const StudyRow& row);
+std::vector<StudyRow> ReadStudyCsv(const std::string& path);
+
+// Indices of the rows on the Pareto front of (total_s, err[d_index]): no other row is at least
+// as fast and at least as accurate and better in one; one row per key; sorted by time.
+std::vector<size_t> ParetoFront(const std::vector<StudyRow>& rows, int d_index);
+
+// report.md text (tables per knob in `knob_order`, the Pareto fronts at d and 4d) and the
+// front tables alone (what is printed on stdout).
+std::string StudyReport(const std::vector<StudyRow>& rows,
+                        const std::vector<std::string>& knob_order, const std::string& header);
+std::string ParetoTables(const std::vector<StudyRow>& rows);
+// Error at D = d_index against total time, log axes, one curve per knob, the front marked.
+std::string StudySvg(const std::vector<StudyRow>& rows, const std::vector<std::string>& knob_order,
+                     int d_index);
+
+int RunStudy(int argc, char** argv);
+
+}  // namespace lumislab

@@ -1,0 +1,185 @@
+// lumislab-study end to end on a tiny sweep (3x3 / 5x5 grids, 400x300 photos, 32 texels): the
+// CSV's rows, resumption, the report and its Pareto table, and errors that move the known way.
+#include "study/study.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include "../cli/test_util.h"
+#include "core/atomic_file.h"
+
+namespace lumislab {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::FreshDir;
+using testing::RunTool;
+using testing::WriteFile;
+
+const char* kCamera =
+    R"({"size_px": [1600, 1200], "focal_px": 1300, "position_mm": [0, -400, 2400],
+        "look_at_mm": [0, 0, 750]})";
+
+std::string SweepArgs(const std::string& scene, const std::string& out) {
+  return "--scene " + scene + " --out " + out +
+         " --quick --values 2 --knobs spacing,samples --photo-scale 0.25 --resolution 32 "
+         "--render-size 24";
+}
+
+const StudyRow& Find(const std::vector<StudyRow>& rows, const std::string& knob,
+                     const std::string& value) {
+  for (const StudyRow& r : rows)
+    if (r.knob == knob && r.value == value) return r;
+  ADD_FAILURE() << "no row " << knob << " = " << value;
+  return rows.front();
+}
+
+TEST(Study, TinySweepWritesRowsResumesAndMovesErrorsTheKnownWay) {
+  const std::string dir = FreshDir("study_sweep");
+  const std::string scene = dir + "/scene.json", out = dir + "/out";
+  WriteFile(scene, testing::SceneJson(5, 5, kCamera, "[]"));
+  auto r = RunTool("lumislab-study", SweepArgs(scene, out));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  // spacing: h 10 mm on 3x3 (the same span as 5 mm on 5x5) and the base; samples: N 1 and 2.
+  const std::vector<StudyRow> rows = ReadStudyCsv(out + "/study.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  const StudyRow& coarse = Find(rows, "spacing", "10 mm");
+  const StudyRow& fine = Find(rows, "spacing", "5 mm");
+  const StudyRow& n1 = Find(rows, "samples", "1");
+  const StudyRow& n2 = Find(rows, "samples", "2");
+  EXPECT_EQ(coarse.nu * coarse.nv, 9);
+  EXPECT_EQ(fine.nu * fine.nv, 25);
+  EXPECT_EQ(fine.photo_w, 400);
+  EXPECT_EQ(fine.key, n1.key);  // the base, measured once
+  for (const StudyRow& row : rows) {
+    EXPECT_TRUE(std::isfinite(row.slab_rel_l2) && row.slab_rel_l2 < 0.05) << row.key;
+    for (int k = 0; k < 3; ++k) {
+      // Grids this small cover little of the plane's view (the duals sum to 1 only within
+      // ((n - 1)/2 - K) h of the centre): measured 9.5 % (5x5) and 13 % (3x3, flux 1.12).
+      EXPECT_TRUE(std::isfinite(row.err[k]) && row.err[k] > 0 && row.err[k] < 0.25) << row.key;
+      EXPECT_NEAR(row.flux[k], 1.0, 0.2) << row.key;
+    }
+    // Lab model defaults: positions x (2 s + 2 slides x 1 exposure x 0.5 s).
+    EXPECT_DOUBLE_EQ(row.lab_s, row.positions() * 3.0);
+    EXPECT_NEAR(row.total_s, row.lab_s + row.reconstruct_s + row.render_s, 1e-3 * row.total_s);
+  }
+  // At D = d the exact model gives sum_ij E_ij(x) whatever N (docs/design.md §4.5): N only
+  // moves the error away from d.
+  EXPECT_NEAR(n2.err[0], n1.err[0], 1e-5);
+  // Noise-free photos: a finer grid over the same span is not worse at d (measured 1.0 % vs
+  // 2.2 % on the default scene's 9x7 against 5x4); 0.2 % is room for the screen calibration.
+  EXPECT_LE(fine.err[0], coarse.err[0] + 0.002);
+  // Coverage: the duals sum to 1 only within ((n - 1)/2 - K) h of the centre, which is 0 for
+  // the 3x3 grid (no covered pixel: -1) and 5 mm for the 5x5 one; where the grid covers, the
+  // error at d is the reconstruction's own, far below the whole view's.
+  EXPECT_EQ(coarse.covered[0], 0);
+  EXPECT_EQ(coarse.err_covered[0], -1);
+  EXPECT_GT(fine.covered[0], 0.05);
+  EXPECT_LT(fine.err_covered[0], 0.01);
+  EXPECT_LT(fine.err_covered[0], 0.5 * fine.err[0]);
+
+  // The report: a table per knob and the fronts, which hold the fastest point (the coarse grid).
+  const std::string report = ReadTextFile(out + "/report.md");
+  EXPECT_NE(report.find("## Knob `spacing`"), std::string::npos);
+  EXPECT_NE(report.find("## Knob `samples`"), std::string::npos);
+  EXPECT_NE(report.find("Pareto front, relative L2 error at D = 4d"), std::string::npos);
+  EXPECT_NE(r.output.find("Pareto front, relative L2 error at D = d"), std::string::npos);
+  EXPECT_NE(r.output.find("| spacing = 10 mm |"), std::string::npos) << r.output;
+  const std::vector<size_t> front = ParetoFront(rows, 0);
+  ASSERT_FALSE(front.empty());
+  EXPECT_EQ(rows[front.front()].key, coarse.key);
+  for (const char* svg : {"/study_d.svg", "/study_4d.svg"}) {
+    const std::string text = ReadTextFile(out + svg);
+    EXPECT_NE(text.find("Pareto front"), std::string::npos);
+    EXPECT_NE(text.find("</svg>"), std::string::npos);
+  }
+
+  // Resumption: a second run adds nothing and runs no stage.
+  const std::string csv = ReadTextFile(out + "/study.csv");
+  const auto start = std::chrono::steady_clock::now();
+  r = RunTool("lumislab-study", SweepArgs(scene, out));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(ReadTextFile(out + "/study.csv"), csv);
+  EXPECT_NE(r.output.find("4 point(s) already in"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("running"), std::string::npos) << r.output;
+  EXPECT_LT(seconds, 3.0);
+
+  // A point whose row is lost is measured again from its finished dataset (no stage runs).
+  std::string shorter = csv.substr(0, csv.rfind('\n', csv.size() - 2) + 1);
+  WriteFile(out + "/study.csv", shorter);
+  r = RunTool("lumislab-study", SweepArgs(scene, out));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("running"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadStudyCsv(out + "/study.csv").size(), 4u);
+
+  // Another lab model (or scene) into the same --out would mix two studies: refused.
+  r = RunTool("lumislab-study", SweepArgs(scene, out) + " --move-s 3");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("study.json"), std::string::npos) << r.output;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+TEST(Study, StopSignalEndsTheStageInHandAndTheSameCommandContinues) {
+  const std::string dir = FreshDir("study_stop");
+  const std::string scene = dir + "/scene.json", out = dir + "/out", log = dir + "/log.txt";
+  WriteFile(scene, testing::SceneJson(5, 5, kCamera, "[]"));
+  const std::vector<std::string> args = {"--scene", scene,           "--out", out,
+                                         "--quick", "--values",      "2",     "--knobs",
+                                         "spacing", "--photo-scale", "0.25",  "--resolution",
+                                         "32",      "--render-size", "24"};
+  {
+    testing::ToolProcess study(dir, "lumislab-study", args, log);
+    ASSERT_TRUE(study.started());
+    // Signalled once the first point is in study.csv and the second one's stages run.
+    while (study.Running() && study.Elapsed() < 60 &&
+           ReadTextFile(log).find("point 2/2") == std::string::npos)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_TRUE(study.Signal(SIGTERM));
+    ASSERT_TRUE(study.WaitFor(30));
+    EXPECT_EQ(study.exit_code(), 1);
+    EXPECT_FALSE(study.signalled());
+  }
+  EXPECT_NE(ReadTextFile(log).find("stopped by a signal"), std::string::npos) << ReadTextFile(log);
+  EXPECT_EQ(ReadStudyCsv(out + "/study.csv").size(), 1u);
+  EXPECT_TRUE(testing::TemporaryPaths(testing::SnapshotTree(out)).empty());
+  std::string line;
+  for (const auto& a : args) line += testing::ShellQuote(a) + " ";
+  const auto r = RunTool("lumislab-study", line);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 point(s) already in"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadStudyCsv(out + "/study.csv").size(), 2u);
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+}
+
+TEST(Study, BadInputIsExit2NamingTheOptionOrFile) {
+  const std::string dir = FreshDir("study_bad");
+  const auto expect_bad = [](const std::string& args, const std::string& name) {
+    const auto r = RunTool("lumislab-study", args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(name), std::string::npos) << args << "\n" << r.output;
+  };
+  expect_bad("--scene " + dir + "/missing.json --out " + dir + "/o", "missing.json");
+  expect_bad("--out " + dir + "/o --knobs spacing,colour", "--knobs");
+  expect_bad("--out " + dir + "/o --move-s -1", "--move-s");
+  expect_bad("--out " + dir + "/o --exposure-s nan", "--exposure-s");
+  WriteFile(dir + "/file", "x");
+  expect_bad("--out " + dir + "/file/o", "--out");
+  expect_bad("--scene default", "--out");
+  fs::create_directories(dir + "/damaged");
+  WriteFile(dir + "/damaged/study.csv", "knob,value\n");
+  expect_bad("--out " + dir + "/damaged --knobs samples", "study.csv");
+  EXPECT_FALSE(fs::exists(dir + "/o/study.csv"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lumislab

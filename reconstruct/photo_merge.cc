@@ -131,7 +131,7 @@ bool FusedDifference(const Photo& plus, double gain_p, const Photo& minus, doubl
 }  // namespace
 
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain, int downsample,
-                             const MergeOptions& options) {
+                             const MergeOptions& options, const cv::Rect& region) {
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
   // Fast path: one linear photo per slide without black level, white balance or per-pixel
   // calibration (dark, flat), same 16-bit or float 3-channel type, nothing saturated. Averaging is
@@ -156,7 +156,7 @@ MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gai
       }
     }
   }
-  return MergeFullResolution(photos, gain, downsample, options);
+  return MergeFullResolution(photos, gain, downsample, options, region);
 }
 
 namespace {
@@ -685,10 +685,10 @@ struct MergeRows {
     faintest.assign(kChunk, std::numeric_limits<float>::infinity());
   }
 
-  // Row y: value, state, difference and saturated for the whole row; stats counted.
-  void Merge(int y, float gain, MergeStats* stats) {
-    for (int x0 = 0; x0 < width; x0 += kChunk / 3) {
-      const int pixels = std::min(kChunk / 3, width - x0), m = 3 * pixels;
+  // Row y, pixels [xa, xb): value, state, difference and saturated; stats counted.
+  void Merge(int y, int xa, int xb, float gain, MergeStats* stats) {
+    for (int x0 = xa; x0 < xb; x0 += kChunk / 3) {
+      const int pixels = std::min(kChunk / 3, xb - x0), m = 3 * pixels;
       for (size_t k = 0; k < exposures.size(); ++k) {
         const Exposure& e = exposures[k];
         float* uk = u.data() + size_t(slot_of[k]) * kChunk;
@@ -731,10 +731,14 @@ std::vector<BracketRatio> EstimateBracketRatios(const std::vector<DecodedPhoto>&
 }
 
 MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain,
-                                   int downsample, const MergeOptions& options) {
+                                   int downsample, const MergeOptions& options,
+                                   const cv::Rect& region) {
   LUMISLAB_CHECK(!photos.empty(), "MergePosition: no photos");
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
   const int w = photos[0].photo.pixels.cols, h = photos[0].photo.pixels.rows;
+  LUMISLAB_CHECK(
+      region.empty() || (region & cv::Rect(0, 0, w / downsample, h / downsample)) == region,
+      "MergePosition: region inside the averaged image");
   std::vector<Exposure> exposures = MakeExposures(photos, options);
   MergedPosition out;
   for (int slide : {0, 1})
@@ -746,9 +750,15 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
   const size_t n = exposures.size();
   const float inv_full_well = float(1.0 / options.noise.full_well_e);
   // F x F blocks of the top-left multiple of F make the output pixels; the rows and columns
-  // beyond are merged for the counts only.
+  // beyond are merged for the counts only. With a region, only its output pixels' blocks are
+  // merged (and counted), the rest of the signal is 0.
   const int f = downsample, ow = w / f, oh = h / f;
   out.signal.create(oh, ow, CV_32FC4);
+  const bool whole = region.empty();
+  if (!whole) out.signal.setTo(0);
+  const int band0 = whole ? 0 : region.y, band1 = whole ? (h + f - 1) / f : region.br().y;
+  const int ox0 = whole ? 0 : region.x, ox1 = whole ? ow : region.br().x;
+  const int xa = ox0 * f, xb = whole ? w : ox1 * f;
   const float g = float(gain), inv_area = 1.f / float(f * f);
   // Each slide's photos, longest effective exposure first.
   std::vector<int> members[2];
@@ -758,20 +768,19 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
                      [&](int a, int b) { return exposures[a].effective > exposures[b].effective; });
   MergeStats total;
   std::mutex total_mutex;
-  const int bands = (h + f - 1) / f;
-  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(band0, band1), [&](const cv::Range& range) {
     MergeStats stats;
     MergeRows rows(exposures, members, w, inv_full_well);
     std::vector<float> acc(size_t(ow) * 4);
     for (int band = range.start; band < range.end; ++band) {
       std::fill(acc.begin(), acc.end(), 0.f);
       for (int y = band * f; y < std::min(h, (band + 1) * f); ++y) {
-        rows.Merge(y, g, &stats);
+        rows.Merge(y, xa, xb, g, &stats);
         if (band >= oh) continue;  // merged for the counts only
         // The F x F box sums, in the order of the pixels (x, then y).
         const float* d = rows.difference.data();
         const float* sat = rows.saturated.data();
-        for (int ox = 0; ox < ow; ++ox) {
+        for (int ox = ox0; ox < ox1; ++ox) {
           float* o = &acc[size_t(ox) * 4];
           for (int x = ox * f; x < (ox + 1) * f; ++x) {
             for (int ch = 0; ch < 3; ++ch) o[ch] += d[x * 3 + ch];
@@ -781,7 +790,7 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
       }
       if (band >= oh) continue;
       float* o = out.signal.ptr<float>(band);
-      for (size_t k = 0; k < acc.size(); ++k) o[k] = acc[k] * inv_area;
+      for (size_t k = size_t(ox0) * 4; k < size_t(ox1) * 4; ++k) o[k] = acc[k] * inv_area;
     }
     rows.Finish(&stats);
     std::lock_guard<std::mutex> lock(total_mutex);

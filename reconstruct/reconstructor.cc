@@ -83,8 +83,18 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   const std::optional<double> scale =
       options.radiometry ? options.radiometry->scale : dataset.radiometric_scale;
   const double gain = dataset.filter.peak * scale.value_or(1.0);
-  const MergedPosition merged = MergePosition(photos, gain, map.downsample, options.merge);
+  // Only the photo pixels that reach the slab (the map's read region) are merged and counted.
+  const MergedPosition merged =
+      MergePosition(photos, gain, map.downsample, options.merge, map.read_region);
   r.saturated_pixels = merged.saturated_pixels;
+  const auto& corrections = options.radiometry ? options.radiometry->corrections : nullptr;
+  if (corrections && corrections->dark && !map.read_region.empty()) {
+    const int f = map.downsample, w = calibration.image_width;
+    const cv::Rect& g = map.read_region;
+    const std::vector<uint8_t>& hot = corrections->dark->hot;
+    for (int y = g.y * f; y < g.br().y * f; ++y)
+      for (int x = g.x * f; x < g.br().x * f; ++x) r.hot_pixels += hot[size_t(y) * w + x];
+  }
   r.exposures = merged.exposures;
   r.near_black_pixels = merged.near_black_pixels;
   r.brightest = merged.brightest, r.faintest = merged.faintest;

@@ -107,8 +107,7 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
   r.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // Hot pixels of calib/dark.json count as clipped in every photo (said once at the start):
   // warn only about the pixels the light saturated.
-  const auto& corrections = config.options.radiometry->corrections;
-  const int hot = corrections && corrections->dark ? corrections->dark->hot_count : 0;
+  const int hot = r.hot_pixels;
   if (r.saturated_pixels > hot)
     LogWarning("position ", Name(position), ": ", r.saturated_pixels - hot,
                " saturated photo pixels", hot ? " (and " + std::to_string(hot) + " hot ones)" : "",

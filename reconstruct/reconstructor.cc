@@ -90,10 +90,10 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   const auto& corrections = options.radiometry ? options.radiometry->corrections : nullptr;
   if (corrections && corrections->dark && !map.read_region.empty()) {
     const int f = map.downsample, w = calibration.image_width;
-    const cv::Rect& g = map.read_region;
+    const cv::Rect& region = map.read_region;  // averaged pixels: F x F photo pixels each
     const std::vector<uint8_t>& hot = corrections->dark->hot;
-    for (int y = g.y * f; y < g.br().y * f; ++y)
-      for (int x = g.x * f; x < g.br().x * f; ++x) r.hot_pixels += hot[size_t(y) * w + x];
+    for (int y = region.y * f; y < region.br().y * f; ++y)
+      for (int x = region.x * f; x < region.br().x * f; ++x) r.hot_pixels += hot[size_t(y) * w + x];
   }
   r.exposures = merged.exposures;
   r.near_black_pixels = merged.near_black_pixels;

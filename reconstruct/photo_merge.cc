@@ -131,7 +131,7 @@ bool FusedDifference(const Photo& plus, double gain_p, const Photo& minus, doubl
 }  // namespace
 
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain, int downsample,
-                             const MergeOptions& options) {
+                             const MergeOptions& options, const cv::Rect& region) {
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
   // Fast path: one linear photo per slide without black level, white balance or per-pixel
   // calibration (dark, flat), same 16-bit or float 3-channel type, nothing saturated. Averaging is
@@ -156,7 +156,7 @@ MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gai
       }
     }
   }
-  return MergeFullResolution(photos, gain, downsample, options);
+  return MergeFullResolution(photos, gain, downsample, options, region);
 }
 
 namespace {
@@ -193,10 +193,11 @@ struct Exposure {
   const Photo* source = nullptr;
   bool linear_codes = false;
   float u_gain = 0, u_offset = 0, saturation_code = 0;
-  // 8-bit photos: u per code and channel (R, G, B), NaN where clipped, read through the reader
-  // from a 256-pixel photo holding every code, so the table is the decoder's own
-  // linearisation. Valid because LinearReader maps a code the same way at every pixel.
-  std::vector<float> code_u[3];
+  // 8-bit photos: u per code and channel, [c * 256 + code] for c = R, G, B, NaN where clipped,
+  // read through the reader from a 256-pixel photo holding every code, so the table is the
+  // decoder's own linearisation. Valid because LinearReader maps a code the same way at every
+  // pixel. Empty for other photos.
+  std::vector<float> code_u;
   int slide = 0;        // 0: p, 1: n
   float recorded = 1;   // exposure in dataset.json
   float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
@@ -227,7 +228,7 @@ struct Exposure {
         for (int c = 0; c < codes.pixels.channels(); ++c)
           codes.pixels.ptr<uint8_t>(0)[v * codes.pixels.channels() + c] = uint8_t(v);
       const LinearReader code_reader(codes);
-      for (auto& table : code_u) table.resize(256);
+      code_u.resize(3 * 256);
       for (int v = 0; v < 256; ++v) {
         float rgb[3];
         bool clipped[3];
@@ -235,7 +236,7 @@ struct Exposure {
         for (int c = 0; c < 3; ++c) {
           const float value = rgb[c] * recorded;
           const bool ok = !clipped[c] && std::isfinite(value);
-          code_u[c][v] = ok ? value : kClipped;
+          code_u[c * 256 + v] = ok ? value : kClipped;
         }
       }
     }
@@ -314,21 +315,19 @@ void ReadLinear(const Exposure& e, int y, int x0, int pixels, float* __restrict 
 // 8-bit codes (1 or 3 channels) through the exposure's per-code tables:
 void ReadCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
   const cv::Mat& m = e.source->pixels;
-  const float* __restrict r = e.code_u[0].data();
-  const float* __restrict g = e.code_u[1].data();
-  const float* __restrict b = e.code_u[2].data();
+  const float* __restrict table = e.code_u.data();
   if (m.channels() == 1) {
     const uint8_t* __restrict row = m.ptr<uint8_t>(y) + x0;
     for (int x = 0; x < pixels; ++x)
-      uk[3 * x] = r[row[x]], uk[3 * x + 1] = g[row[x]], uk[3 * x + 2] = b[row[x]];
+      for (int c = 0; c < 3; ++c) uk[3 * x + c] = table[c * 256 + row[x]];
     return;
   }
   const uint8_t* __restrict row = m.ptr<uint8_t>(y) + 3 * x0;
   const int ri = e.source->rgb_order ? 0 : 2;  // storage position of red (blue: 2 - ri)
   for (int x = 0; x < pixels; ++x, row += 3, uk += 3) {
-    uk[0] = r[row[ri]];
-    uk[1] = g[row[1]];
-    uk[2] = b[row[2 - ri]];
+    uk[0] = table[row[ri]];
+    uk[1] = table[256 + row[1]];
+    uk[2] = table[512 + row[2 - ri]];
   }
 }
 
@@ -364,7 +363,7 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
         for (size_t k = 0; k < order.size(); ++k) {
           const Exposure& e = exposures[order[k]];
           float* uk = &u[k * 3];
-          if (!e.code_u[0].empty()) {  // the reader's values (all finite) through its table
+          if (!e.code_u.empty()) {  // the reader's values (all finite) through its table
             ReadCodes(e, y, x, 1, uk);
             continue;
           }
@@ -430,12 +429,14 @@ struct MergeStats {
 // Bits, so that the states of a pixel's channels combine with OR.
 enum : uint8_t { kMeasured = 0, kNearBlackEverywhere = 1, kClippedEverywhere = 2 };
 
-// GCC on x86-64: the row kernels below are compiled for the SSE2 baseline and for AVX2, and the
-// loader picks the one the processor runs (glibc ifunc). Both do the same IEEE operations in the
-// same order (AVX2 without FMA, so nothing is contracted): the same numbers on every machine.
+// GCC on x86-64: the row kernels below are compiled for the SSE2 baseline, AVX2 and AVX-512F, and
+// the loader picks the best one the processor runs (glibc ifunc). All do the same IEEE operations
+// in the same order (neither target enables FMA, so nothing is contracted): the same numbers on
+// every machine. (AVX-512F: 16 values per operation and mask registers for the selects, ~10 %
+// faster than AVX2 on the AMD Zen 5 development machine.)
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
     !defined(LUMISLAB_NO_TARGET_CLONES)
-#define LUMISLAB_ROW_KERNEL __attribute__((target_clones("avx2", "default")))
+#define LUMISLAB_ROW_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define LUMISLAB_ROW_KERNEL
 #endif
@@ -684,10 +685,10 @@ struct MergeRows {
     faintest.assign(kChunk, std::numeric_limits<float>::infinity());
   }
 
-  // Row y: value, state, difference and saturated for the whole row; stats counted.
-  void Merge(int y, float gain, MergeStats* stats) {
-    for (int x0 = 0; x0 < width; x0 += kChunk / 3) {
-      const int pixels = std::min(kChunk / 3, width - x0), m = 3 * pixels;
+  // Row y, pixels [xa, xb): value, state, difference and saturated; stats counted.
+  void Merge(int y, int xa, int xb, float gain, MergeStats* stats) {
+    for (int x0 = xa; x0 < xb; x0 += kChunk / 3) {
+      const int pixels = std::min(kChunk / 3, xb - x0), m = 3 * pixels;
       for (size_t k = 0; k < exposures.size(); ++k) {
         const Exposure& e = exposures[k];
         float* uk = u.data() + size_t(slot_of[k]) * kChunk;
@@ -695,7 +696,7 @@ struct MergeRows {
           ReadLinear<uint16_t>(e, y, x0, pixels, uk);
         else if (e.linear_codes)
           ReadLinear<float>(e, y, x0, pixels, uk);
-        else if (!e.code_u[0].empty())
+        else if (!e.code_u.empty())
           ReadCodes(e, y, x0, pixels, uk);
         else
           ReadPixels(e, y, x0, pixels, uk);
@@ -730,10 +731,14 @@ std::vector<BracketRatio> EstimateBracketRatios(const std::vector<DecodedPhoto>&
 }
 
 MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain,
-                                   int downsample, const MergeOptions& options) {
+                                   int downsample, const MergeOptions& options,
+                                   const cv::Rect& region) {
   LUMISLAB_CHECK(!photos.empty(), "MergePosition: no photos");
   LUMISLAB_CHECK(downsample >= 1, "MergePosition: downsample >= 1");
   const int w = photos[0].photo.pixels.cols, h = photos[0].photo.pixels.rows;
+  LUMISLAB_CHECK(
+      region.empty() || (region & cv::Rect(0, 0, w / downsample, h / downsample)) == region,
+      "MergePosition: region inside the averaged image");
   std::vector<Exposure> exposures = MakeExposures(photos, options);
   MergedPosition out;
   for (int slide : {0, 1})
@@ -745,9 +750,15 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
   const size_t n = exposures.size();
   const float inv_full_well = float(1.0 / options.noise.full_well_e);
   // F x F blocks of the top-left multiple of F make the output pixels; the rows and columns
-  // beyond are merged for the counts only.
+  // beyond are merged for the counts only. With a region, only its output pixels' blocks are
+  // merged (and counted), the rest of the signal is 0.
   const int f = downsample, ow = w / f, oh = h / f;
   out.signal.create(oh, ow, CV_32FC4);
+  const bool whole = region.empty();
+  if (!whole) out.signal.setTo(0);
+  const int band0 = whole ? 0 : region.y, band1 = whole ? (h + f - 1) / f : region.br().y;
+  const int ox0 = whole ? 0 : region.x, ox1 = whole ? ow : region.br().x;
+  const int xa = ox0 * f, xb = whole ? w : ox1 * f;
   const float g = float(gain), inv_area = 1.f / float(f * f);
   // Each slide's photos, longest effective exposure first.
   std::vector<int> members[2];
@@ -757,20 +768,19 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
                      [&](int a, int b) { return exposures[a].effective > exposures[b].effective; });
   MergeStats total;
   std::mutex total_mutex;
-  const int bands = (h + f - 1) / f;
-  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(band0, band1), [&](const cv::Range& range) {
     MergeStats stats;
     MergeRows rows(exposures, members, w, inv_full_well);
     std::vector<float> acc(size_t(ow) * 4);
     for (int band = range.start; band < range.end; ++band) {
       std::fill(acc.begin(), acc.end(), 0.f);
       for (int y = band * f; y < std::min(h, (band + 1) * f); ++y) {
-        rows.Merge(y, g, &stats);
+        rows.Merge(y, xa, xb, g, &stats);
         if (band >= oh) continue;  // merged for the counts only
         // The F x F box sums, in the order of the pixels (x, then y).
         const float* d = rows.difference.data();
         const float* sat = rows.saturated.data();
-        for (int ox = 0; ox < ow; ++ox) {
+        for (int ox = ox0; ox < ox1; ++ox) {
           float* o = &acc[size_t(ox) * 4];
           for (int x = ox * f; x < (ox + 1) * f; ++x) {
             for (int ch = 0; ch < 3; ++ch) o[ch] += d[x * 3 + ch];
@@ -780,7 +790,7 @@ MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, doub
       }
       if (band >= oh) continue;
       float* o = out.signal.ptr<float>(band);
-      for (size_t k = 0; k < acc.size(); ++k) o[k] = acc[k] * inv_area;
+      for (size_t k = size_t(ox0) * 4; k < size_t(ox1) * 4; ++k) o[k] = acc[k] * inv_area;
     }
     rows.Finish(&stats);
     std::lock_guard<std::mutex> lock(total_mutex);

@@ -76,6 +76,7 @@ struct MergedPosition {
   // (exact INTER_AREA on the top-left multiple of the factor). CV_32FC3 when no pixel is
   // saturated; otherwise CV_32FC4 with A > 0 wherever a saturated pixel contributed.
   cv::Mat signal;
+  // Of the pixels merged (all, or the region's; the fast path counts none):
   int saturated_pixels = 0;   // pixels with a channel clipped in every exposure of a slide
   int near_black_pixels = 0;  // pixels with a channel near-black in every exposure of a slide
   int exposures = 1;          // most photos of one slide
@@ -88,13 +89,19 @@ struct MergedPosition {
 };
 
 // gain = filter peak * radiometric scale. Needs at least one photo of each slide.
+// region: the output (box-averaged) pixels that are needed (RectifyMap::read_region), inside
+// the averaged image; empty: all. The general path merges only the photo pixels of the
+// region's blocks (the rest of the signal is 0), and its counts and dynamic range are over
+// those pixels; the fast path computes the whole image (as cheap) and counts nothing.
 MergedPosition MergePosition(const std::vector<DecodedPhoto>& photos, double gain,
-                             int downsample = 1, const MergeOptions& options = {});
+                             int downsample = 1, const MergeOptions& options = {},
+                             const cv::Rect& region = {});
 // The general path (brackets, saturation, 8-bit sRGB, black level), per pixel at full
 // resolution, box-averaged `downsample` x `downsample` in the same pass; the signal is
 // CV_32FC4 with A = the fraction of saturated pixels.
 MergedPosition MergeFullResolution(const std::vector<DecodedPhoto>& photos, double gain,
-                                   int downsample = 1, const MergeOptions& options = {});
+                                   int downsample = 1, const MergeOptions& options = {},
+                                   const cv::Rect& region = {});
 
 // The exposure ratios of each slide's consecutive exposures, estimated from the pixels
 // (median of the ratio of values well exposed in both, on a grid of at most ~2^18 pixels).

@@ -83,7 +83,9 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   const std::optional<double> scale =
       options.radiometry ? options.radiometry->scale : dataset.radiometric_scale;
   const double gain = dataset.filter.peak * scale.value_or(1.0);
-  const MergedPosition merged = MergePosition(photos, gain, map.downsample, options.merge);
+  // Only the photo pixels that reach the slab (the map's read region) are merged and counted.
+  const MergedPosition merged =
+      MergePosition(photos, gain, map.downsample, options.merge, map.read_region);
   r.saturated_pixels = merged.saturated_pixels;
   r.exposures = merged.exposures;
   r.near_black_pixels = merged.near_black_pixels;

@@ -27,7 +27,10 @@ struct ReconstructOptions {
 
 struct PositionReport {
   int i = 0, j = 0;
-  int saturated_pixels = 0;  // photo pixels clipped in every exposure of a slide
+  // Photo pixels clipped in every exposure of a slide, of those the merge reads (the pixels
+  // that reach the slab, RectifyMap::read_region). calib/dark.json's hot pixels are not among
+  // them: the decoder reads them as their neighbours' mean.
+  int saturated_pixels = 0;
   int saturated_texels = 0;  // texels dropped because a sample touched a saturated pixel
   // Brackets (MergedPosition): exposures per slide, pixels near-black in every exposure of a
   // slide, the merged image's dynamic range, the exposure ratios found in the pixels.

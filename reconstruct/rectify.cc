@@ -127,6 +127,23 @@ void WriteRemapTables(const TexelCorners& c, RectifyMap* m) {
   });
 }
 
+// The bounding box of the pixels the seen texels' samples read (unseen texels' samples read the
+// border at -10 and are left out), clipped to the w x h averaged image.
+cv::Rect ReadRegion(const RectifyMap& m, int w, int h) {
+  int x0 = w, y0 = h, x1 = -1, y1 = -1;
+  for (int r = 0; r < m.map_xy.rows; ++r) {
+    const int16_t* xy = m.map_xy.ptr<int16_t>(r);
+    for (int c = 0; c < m.map_xy.cols; ++c, xy += 2) {
+      if (xy[0] < 0 || xy[1] < 0) continue;
+      x0 = std::min(x0, int(xy[0])), x1 = std::max(x1, int(xy[0]));
+      y0 = std::min(y0, int(xy[1])), y1 = std::max(y1, int(xy[1]));
+    }
+  }
+  if (x1 < 0) return {};
+  // + 1: the bilinear neighbours; + 1: exclusive end.
+  return cv::Rect(cv::Point(x0, y0), cv::Point(x1 + 2, y1 + 2)) & cv::Rect(0, 0, w, h);
+}
+
 }  // namespace
 
 RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayout& layout,
@@ -152,6 +169,7 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
   }
   MarkInside(corners, photo, screen_w_mm, screen_h_mm, &m);
   WriteRemapTables(corners, &m);
+  m.read_region = ReadRegion(m, calibration.image_width / f, calibration.image_height / f);
   return m;
 }
 

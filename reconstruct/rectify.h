@@ -29,6 +29,10 @@ struct RectifyMap {
   // Per texel: all its corners (hence all samples) inside the photo, and the texel on the
   // physical screen.
   std::vector<unsigned char> inside;
+  // The averaged-photo pixels that the samples of the seen texels read (each sample's pixel and
+  // its right and lower neighbours, bilinear), clipped to the averaged image; empty when no texel
+  // is seen. The rest of the photo does not reach the slab: the merge skips it.
+  cv::Rect read_region;
   double max_texel_px = 0;  // largest texel extent in photo pixels (what K follows)
   double min_texel_px = 0;  // smallest (what F follows)
 };

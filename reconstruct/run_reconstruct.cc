@@ -69,7 +69,7 @@ void ReportBrackets(const Position& position, const PositionReport& r, const Run
   LogInfo("position ", Name(position), ": ", r.exposures, " exposures per slide merged, dynamic ",
           "range ", r.dynamic_range_stops, " stops (", r.brightest, " / ", r.faintest, "), ",
           r.saturated_pixels, " pixels clipped in every exposure (masked), ", r.near_black_pixels,
-          " near-black in every exposure");
+          " near-black in every exposure (of the photo pixels the slab reads)");
   const bool used = config.options.merge.bracket_ratios == BracketRatios::kEstimated;
   for (const BracketRatio& b : r.bracket_ratios) {
     std::ostringstream text;

@@ -73,6 +73,45 @@ TEST(BracketMerge, NoiseModelWeights) {
   EXPECT_EQ(m.saturated_pixels, 0);
 }
 
+// A region (what Rectify reads) merges only its blocks: the same numbers bit for bit there, 0
+// elsewhere, and the counts over its pixels only. 8-bit sRGB brackets with clipped pixels, rows
+// longer than a chunk of the row kernels and a region starting inside one.
+TEST(BracketMerge, RegionMergesOnlyItsBlocks) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> radiance(0.0, 4.4);  // > 4: clipped at 0.25
+  const int w = 620, h = 20, f = 3;
+  std::vector<double> scene(size_t(w) * h * 3);
+  for (double& v : scene) v = radiance(rng);
+  std::vector<DecodedPhoto> photos;
+  for (bool positive : {true, false})
+    for (double e : {0.25, 1.0, 4.0})
+      photos.push_back(
+          MakePhoto(w, h, positive, e, CV_8U, Transfer::kSrgb, [&](int x, int y, int c) {
+            const double v = scene[(size_t(y) * w + x) * 3 + c] * (positive ? 1.0 : 0.3);
+            return Srgb(std::min(1.0, e * v));
+          }));
+  const MergedPosition whole = MergeFullResolution(photos, 2.0, f);
+  const MergedPosition pixels = MergeFullResolution(photos, 2.0, 1);  // A: saturated per pixel
+  const cv::Rect region(90, 2, 101, 3);  // averaged pixels; photo x 270 .. 572, y 6 .. 14
+  const MergedPosition m = MergePosition(photos, 2.0, f, {}, region);
+  ASSERT_EQ(m.signal.size(), whole.signal.size());
+  ASSERT_GT(whole.saturated_pixels, 0);
+  for (int y = 0; y < m.signal.rows; ++y)
+    for (int x = 0; x < m.signal.cols; ++x) {
+      const cv::Vec4f expected = region.contains({x, y}) ? At(whole, x, y) : cv::Vec4f();
+      for (int c = 0; c < 4; ++c) ASSERT_EQ(At(m, x, y)[c], expected[c]) << x << "," << y;
+    }
+  int saturated = 0;
+  for (int y = region.y * f; y < region.br().y * f; ++y)
+    for (int x = region.x * f; x < region.br().x * f; ++x) saturated += At(pixels, x, y)[3] > 0;
+  EXPECT_GT(saturated, 0);
+  EXPECT_LT(saturated, whole.saturated_pixels);
+  EXPECT_EQ(m.saturated_pixels, saturated);
+  EXPECT_GT(m.dynamic_range_stops, 0);
+  EXPECT_LE(m.dynamic_range_stops, whole.dynamic_range_stops);
+  EXPECT_EQ(m.ratios.size(), whole.ratios.size());  // the ratios: from the whole photo
+}
+
 // A pixel clipped in every exposure of a slide is masked (A = 1, RGB 0) and counted; one clipped
 // (or NaN) only in the long exposure takes the short one's value exactly.
 TEST(BracketMerge, ClippedInEveryExposureIsMaskedAndCounted) {

@@ -572,7 +572,7 @@ LUMISLAB_INLINE void WeightPass(const SlideParams& p, const float* __restrict u,
     // As std::max / std::min, lane by lane (a NaN value is never taken).
     const float b = measured ? v : 0.f;
     brightest[i] = brightest[i] < b ? b : brightest[i];
-    const float f = measured & (v > 0.f) ? v : faintest[i];
+    const float f = (measured & (v > 0.f)) ? v : faintest[i];
     faintest[i] = f < faintest[i] ? f : faintest[i];
   }
 }

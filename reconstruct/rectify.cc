@@ -76,20 +76,56 @@ double MeasureTexels(const TexelCorners& c, const PhotoBounds& photo, RectifyMap
 }
 
 // Seen geometrically: all four corners inside the photo (the samples interpolate them, so they
-// are inside too) and the texel's lab rectangle on the physical screen.
-void MarkInside(const TexelCorners& c, const PhotoBounds& photo, double screen_w_mm,
-                double screen_h_mm, RectifyMap* m) {
+// are inside too), the texel's lab rectangle on the physical screen, and every photo pixel its
+// samples read on the screen and in the photo. The last matters at the screen's edge: a sample
+// half a sample step inside the texel reads the F x F-averaged image bilinearly, i.e. photo
+// pixels up to 2F - 1 beyond it, which there show the frame around the screen (black in a
+// synthetic capture), not the light: the edge texels came out 4 % dark with light running off
+// the screen (tests/cli/hard_cases_test.cc). `f` is the pre-average, `k` the samples per texel;
+// the corners are in the averaged image's pixels.
+void MarkInside(const TexelCorners& c, const PhotoBounds& photo, const ScreenCalibration& calib,
+                int f, int k, double screen_w_mm, double screen_h_mm, RectifyMap* m) {
   m->inside.assign(size_t(m->res_x) * m->res_y, 0);
   const double half_w = 0.5 * screen_w_mm + 1e-9, half_h = 0.5 * screen_h_mm + 1e-9;
-  for (int row = 0; row < m->res_y; ++row)
-    for (int col = 0; col < m->res_x; ++col) {
-      const Eigen::Vector2d lo = c.lab_of(col, row + 1), hi = c.lab_of(col + 1, row);
-      const bool on_screen =
-          lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h;
-      const bool in = photo.Contains(c.at(col, row)) && photo.Contains(c.at(col + 1, row)) &&
-                      photo.Contains(c.at(col, row + 1)) && photo.Contains(c.at(col + 1, row + 1));
-      m->inside[size_t(row) * m->res_x + col] = (on_screen && in) ? 1 : 0;
-    }
+  auto on_screen = [&](const Eigen::Vector2d& lab) {
+    return std::abs(lab.x()) <= half_w && std::abs(lab.y()) <= half_h;
+  };
+  const float lo_frac = 0.5f / k, hi_frac = 1 - lo_frac;
+  cv::parallel_for_(cv::Range(0, m->res_y), [&](const cv::Range& rows) {
+    for (int row = rows.start; row < rows.end; ++row)
+      for (int col = 0; col < m->res_x; ++col) {
+        const Eigen::Vector2d lo = c.lab_of(col, row + 1), hi = c.lab_of(col + 1, row);
+        const Eigen::Vector2f &p00 = c.at(col, row), &p10 = c.at(col + 1, row);
+        const Eigen::Vector2f &p01 = c.at(col, row + 1), &p11 = c.at(col + 1, row + 1);
+        const bool in = photo.Contains(p00) && photo.Contains(p10) && photo.Contains(p01) &&
+                        photo.Contains(p11);
+        if (!in ||
+            !(lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h))
+          continue;
+        // The outermost samples (the sample grid's corners, WriteRemapTables), their bounding
+        // box in the averaged image, the averaged pixels bilinear reads touch, the photo pixels
+        // those average, and half a pixel more for the pixels' own area.
+        Eigen::Vector2f bmin(HUGE_VALF, HUGE_VALF), bmax(-HUGE_VALF, -HUGE_VALF);
+        for (const float fy : {lo_frac, hi_frac})
+          for (const float fx : {lo_frac, hi_frac}) {
+            const Eigen::Vector2f left = p00 + fy * (p01 - p00), right = p10 + fy * (p11 - p10);
+            const Eigen::Vector2f p = left + fx * (right - left);
+            bmin = bmin.cwiseMin(p), bmax = bmax.cwiseMax(p);
+          }
+        const double x0 = f * std::floor(bmin.x()) - 0.5, y0 = f * std::floor(bmin.y()) - 0.5;
+        const double x1 = f * (std::floor(bmax.x()) + 1) + f - 0.5;
+        const double y1 = f * (std::floor(bmax.y()) + 1) + f - 0.5;
+        // (The averaged image covers the top-left multiple of F; beyond it remap reads 0.)
+        bool read_on_screen = x0 >= -0.5 && y0 >= -0.5 && x1 <= f * (calib.image_width / f) - 0.5 &&
+                              y1 <= f * (calib.image_height / f) - 0.5;
+        // The screen is convex in undistorted pixels: the box's corners decide (the box spans a
+        // few pixels, where the lens's distortion bends no edge measurably).
+        for (const double y : {y0, y1})
+          for (const double x : {x0, x1})
+            read_on_screen = read_on_screen && on_screen(calib.ScreenFromImage({x, y}));
+        m->inside[size_t(row) * m->res_x + col] = read_on_screen ? 1 : 0;
+      }
+  });
 }
 
 // Sample (a, b) of texel (col, row) interpolates the texel's corners bilinearly at
@@ -150,7 +186,7 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
     for (auto& p : corners.pixel) p = (p.array() - shift) * scale;
     photo = {float(calibration.image_width / f - 1), float(calibration.image_height / f - 1)};
   }
-  MarkInside(corners, photo, screen_w_mm, screen_h_mm, &m);
+  MarkInside(corners, photo, calibration, f, m.samples_per_texel, screen_w_mm, screen_h_mm, &m);
   WriteRemapTables(corners, &m);
   return m;
 }

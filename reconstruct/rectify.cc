@@ -118,11 +118,27 @@ void MarkInside(const TexelCorners& c, const PhotoBounds& photo, const ScreenCal
         // (The averaged image covers the top-left multiple of F; beyond it remap reads 0.)
         bool read_on_screen = x0 >= -0.5 && y0 >= -0.5 && x1 <= f * (calib.image_width / f) - 0.5 &&
                               y1 <= f * (calib.image_height / f) - 0.5;
+        // Far from the screen's edge the box is on the screen anyway: its reach beyond the
+        // texel's corners, in photo pixels, times the texel's mm per pixel (√2 for a rotated
+        // view, 2 for the perspective's change over a few texels) is a safe margin. Only near
+        // the edge are the box's corners mapped to the screen.
+        const double side_px = f * std::min((p10 - p00).norm(), (p01 - p00).norm());
+        const Eigen::Vector2f tmin = p00.cwiseMin(p10).cwiseMin(p01).cwiseMin(p11) * float(f);
+        const Eigen::Vector2f tmax = p00.cwiseMax(p10).cwiseMax(p01).cwiseMax(p11) * float(f);
+        const double reach_px =
+            std::max({tmin.x() - x0, x1 - tmax.x(), tmin.y() - y0, y1 - tmax.y(), double(f)});
+        const double margin = 2 * std::sqrt(2.0) * reach_px *
+                              std::max(c.lab_of(1, 0).x() - c.lab_of(0, 0).x(),
+                                       c.lab_of(0, 0).y() - c.lab_of(0, 1).y()) /
+                              std::max(side_px, 1e-9);
+        const bool far_from_edge = lo.x() - margin >= -half_w && hi.x() + margin <= half_w &&
+                                   lo.y() - margin >= -half_h && hi.y() + margin <= half_h;
         // The screen is convex in undistorted pixels: the box's corners decide (the box spans a
         // few pixels, where the lens's distortion bends no edge measurably).
-        for (const double y : {y0, y1})
-          for (const double x : {x0, x1})
-            read_on_screen = read_on_screen && on_screen(calib.ScreenFromImage({x, y}));
+        if (!far_from_edge)
+          for (const double y : {y0, y1})
+            for (const double x : {x0, x1})
+              read_on_screen = read_on_screen && on_screen(calib.ScreenFromImage({x, y}));
         m->inside[size_t(row) * m->res_x + col] = read_on_screen ? 1 : 0;
       }
   });

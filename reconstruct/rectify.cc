@@ -36,13 +36,22 @@ TexelCorners CornerPixels(const ScreenCalibration& calibration, const SlabLayout
            centre_mm;
   };
   const Eigen::Matrix3d image_from_screen = calibration.screen_from_image.inverse();
+  // A screen point behind the camera maps through the homography to a mirrored pixel, which can
+  // lie inside the photo: its texel would read the light of another point (a camera near a
+  // large screen at a grazing angle, tests/cli/hard_cases_test.cc). Points in front share the
+  // sign of the homogeneous coordinate with the photo's centre, which the camera sees; the
+  // homography's overall sign is arbitrary, so it is taken from there.
+  const Eigen::Vector2d centre_px(0.5 * (calibration.image_width - 1),
+                                  0.5 * (calibration.image_height - 1));
+  const double in_front =
+      (calibration.screen_from_image * calibration.Undistort(centre_px).homogeneous()).z();
   c.pixel.resize(size_t(c.nx) * c.ny);
   cv::parallel_for_(cv::Range(0, c.ny), [&](const cv::Range& rows) {
     for (int cy = rows.start; cy < rows.end; ++cy)
       for (int cx = 0; cx < c.nx; ++cx) {
         const Eigen::Vector3d hp = image_from_screen * c.lab_of(cx, cy).homogeneous();
         Eigen::Vector2d px(NAN, NAN);
-        if (hp.z() > 0 || hp.z() < 0) px = calibration.Distort(hp.hnormalized());
+        if (hp.z() * in_front > 0) px = calibration.Distort(hp.hnormalized());
         c.pixel[size_t(cy) * c.nx + cx] = px.cast<float>();
       }
   });

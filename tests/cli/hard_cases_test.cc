@@ -618,6 +618,46 @@ TEST(HardCases, GrazingCamera75Degrees) {
   CleanUp(r);
 }
 
+// A camera 700 mm from the centre of a large screen (8 x 8 m), 60 degrees off its normal: its
+// focal plane crosses the screen at x = 700 / sin 60 = 808 mm, and the screen beyond lies
+// behind it. Such points map through the homography to mirrored pixels inside the photo; their
+// texels read the light of other points (errors > 10 %, written as seen) until rectify.cc
+// rejected points behind the camera. The camera sees only part of the screen, so any on-screen
+// texel may be unseen; none behind the camera may be seen, and the seen ones keep the bound.
+TEST(HardCases, ScreenReachingBehindTheCamera) {
+  const double dist = 700, a = 60 * M_PI / 180;
+  char camera[256];
+  std::snprintf(camera, sizeof camera,
+                R"({"size_px": [400, 300], "focal_px": 220, "position_mm": [%.6f, 0, %.6f],)"
+                R"( "look_at_mm": [0, 0, 750]})",
+                dist * std::sin(a), 750 + dist * std::cos(a));
+  Geometry g;
+  g.nu = g.nv = 1;
+  g.screen_w = g.screen_h = 8000;
+  std::string scene = Scene(g, Emitter(1, -1.5, -0.05, 1, 0), camera);
+  // A board of 7 x 6 squares of 70 mm, which the camera sees whole.
+  scene.insert(scene.rfind('}'), R"(, "calibration": {"squares": [7, 6], "square_mm": 70})");
+  const CaseRun r = RunCase("behind_camera", scene, 32);
+  ASSERT_EQ(r.reconstruct.exit_code, 0)
+      << r.acquire.output << r.calibrate.output << r.reconstruct.output;
+  CheckOptions o;
+  o.may_drop = [](int, int, int, int) { return true; };
+  ExpectStable("screen behind the camera", CheckSlab(r.ds, o));
+  const SlabInfo info = SlabInfo::Load(r.ds + "/slab");
+  const SlabPosition p = ReadSlabPosition(r.ds + "/slab", info, 0, 0);
+  const double behind_x = dist / std::sin(a);  // lab x of the focal plane on the screen
+  int seen_behind = 0, seen = 0;
+  for (int row = 0; row < info.layout.res_y; ++row)
+    for (int col = 0; col < info.layout.res_x; ++col) {
+      if (p.mask.at(col, row, 0) != 1.f) continue;
+      ++seen;
+      seen_behind += info.layout.TexelCentre(col, row).x() > behind_x;
+    }
+  EXPECT_GT(seen, 50);
+  EXPECT_EQ(seen_behind, 0);
+  CleanUp(r);
+}
+
 // A tiny full well (50 e-, read noise 3 e-): noise dominates every texel. The slab's error
 // against the truth must stay within the noise floor predicted for this sensor
 // (tests/cli/noise_floor.h, the same capture without noise as the expected values) plus the

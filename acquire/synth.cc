@@ -106,6 +106,25 @@ ImageF SynthPhoto(const SynthScene& scene, const ScreenView& view, double scale,
 
 namespace {
 
+// The automatic scale (ChooseRadiometricScale) sees every 7th pixel: light narrower than that
+// (a beam of lobe exponent in the thousands) can peak above full scale and clip, which the
+// scale was meant to avoid. Said once, with the scale that would keep it at 0.85.
+void WarnIfPrePassMissedThePeak(const SynthScene& scene, const ImageF& plus, const ImageF& minus,
+                                double scale, int i, int j) {
+  if (scene.camera.radiometric_scale_w_m2 > 0) return;
+  float peak = 0;
+  for (const ImageF* image : {&plus, &minus})
+    for (const float v : image->data) peak = std::max(peak, v);
+  const double at_unit_exposure = peak / scene.camera.exposure;
+  if (!(at_unit_exposure > 1)) return;
+  static std::atomic<bool> said{false};
+  if (said.exchange(true)) return;
+  LogWarning(scene.source, ": light narrower than the scale's pre-pass (every ", kPrePassStride,
+             "th pixel) peaks at ", at_unit_exposure, " x full scale at exposure 1 (position ", i,
+             ",", j, "): its photos clip; set camera.radiometric_scale_w_m2 >= ",
+             scale * at_unit_exposure / kTargetPeakValue);
+}
+
 // Renders, applies the effects to and writes the photos of every position: in order with a
 // pause for a live acquisition, else on `threads` threads. A stop signal ends it after the
 // positions in hand (each written whole). Returns the number of photos written.
@@ -123,6 +142,7 @@ int CapturePositions(const SynthScene& scene, const Dataset& dataset, const std:
     if (StopRequested()) return;
     ImageF plus, minus;
     RenderPosition(scene, view, i, j, scale, &plus, &minus);
+    WarnIfPrePassMissedThePeak(scene, plus, minus, scale, i, j);
     for (bool positive : {true, false})
       for (int stop = 0; stop < stops; ++stop) {
         // Without brackets the render itself is the photo (no copy); with them each stop

@@ -1,5 +1,6 @@
 #include "reconstruct/reconstructor.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -12,6 +13,21 @@ namespace lumislab {
 namespace {
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The brightest stored code of the photos above their black level, in code steps, when every
+// photo is an integer one read through a linear transfer (so that a code step is the near-black
+// floor's unit, docs/design.md §3.5.1); -1 otherwise.
+double BrightestCodes(const std::vector<DecodedPhoto>& photos) {
+  double brightest = -1;
+  for (const auto& p : photos) {
+    const int depth = p.photo.pixels.depth();
+    if ((depth != CV_8U && depth != CV_16U) || p.photo.transfer != Transfer::kLinear) return -1;
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(p.photo.pixels.reshape(1), &lo, &hi);
+    brightest = std::max(brightest, hi - p.photo.spec.black_level * p.photo.CodeMax());
+  }
+  return brightest;
 }
 }  // namespace
 
@@ -138,6 +154,15 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
   }
   r.fit_iterations = fit_report.iterations;
   r.fit_residual = fit_report.relative_residual;
+  double moved = 0, total = 0;
+  for (size_t k = 0; k < n; ++k)
+    if (seen[k])
+      for (int ch = 0; ch < 3; ++ch)
+        moved += std::abs(c[k * 3 + ch] - data[k * 3 + ch]), total += std::abs(data[k * 3 + ch]);
+  r.bell_correction = total > 0 ? moved / total : 0;
+  r.brightest_codes = BrightestCodes(photos);
+  r.no_light =
+      total == 0 || (r.brightest_codes >= 0 && r.brightest_codes < options.merge.near_black_codes);
   SlabPosition out;
   out.i = i, out.j = j;
   out.irradiance = ImageF(layout.res_x, layout.res_y, 3);

@@ -25,6 +25,13 @@ struct ReconstructOptions {
   void Check() const;  // throws BadInput naming the option
 };
 
+// Above this PositionReport::bell_correction the light varies within a texel. For a Gaussian
+// spot of sigma texels, c - b ~ -(1/12) lap c and the integral of |lap G| is 4 / (e sigma^2)
+// times G's, so the ratio is 0.123 / sigma^2: 5 % at sigma = 1.57 texels, where the bell
+// model's own error at the spot's centre, (1/24) |lap E| / E = 1 / (12 sigma^2), reaches 3 %.
+//
+constexpr double kUnresolvedLight = 0.05;
+
 struct PositionReport {
   int i = 0, j = 0;
   // Photo pixels clipped in every exposure of a slide, of those the merge reads (the pixels
@@ -43,6 +50,15 @@ struct PositionReport {
   int downsample = 1;  // photo box-averaged F x F before the remap
   int fit_iterations = 0;
   double fit_residual = 0;
+  // How much the fit moved the texel box averages b to the bell coefficients c,
+  // sum |c - b| / sum |b| over the seen texels and channels: about (1/12) |lap E| a^2 / |E|
+  // for light smooth over several texels (docs/design.md §3.6), of order 1 for light that
+  // varies within a texel, which the slab cannot hold (its flux stays right, not its shape).
+  double bell_correction = 0;
+  // Nothing measured: every seen texel is 0, or the brightest stored code of the position's
+  // (linear, integer) photos lies below the near-black floor (MergeOptions::near_black_codes).
+  bool no_light = false;
+  double brightest_codes = -1;  // that code above black; -1 for float or curved photos
   // Seconds per stage.
   double decode_s = 0, rectify_s = 0, fit_s = 0, write_s = 0;
   // rectify_s split: building the map, merging the photos, remap + area average.

@@ -36,13 +36,22 @@ TexelCorners CornerPixels(const ScreenCalibration& calibration, const SlabLayout
            centre_mm;
   };
   const Eigen::Matrix3d image_from_screen = calibration.screen_from_image.inverse();
+  // A screen point behind the camera maps through the homography to a mirrored pixel, which can
+  // lie inside the photo: its texel would read the light of another point (a camera near a
+  // large screen at a grazing angle, tests/cli/hard_cases_test.cc). Points in front share the
+  // sign of the homogeneous coordinate with the photo's centre, which the camera sees; the
+  // homography's overall sign is arbitrary, so it is taken from there.
+  const Eigen::Vector2d centre_px(0.5 * (calibration.image_width - 1),
+                                  0.5 * (calibration.image_height - 1));
+  const double in_front =
+      (calibration.screen_from_image * calibration.Undistort(centre_px).homogeneous()).z();
   c.pixel.resize(size_t(c.nx) * c.ny);
   cv::parallel_for_(cv::Range(0, c.ny), [&](const cv::Range& rows) {
     for (int cy = rows.start; cy < rows.end; ++cy)
       for (int cx = 0; cx < c.nx; ++cx) {
         const Eigen::Vector3d hp = image_from_screen * c.lab_of(cx, cy).homogeneous();
         Eigen::Vector2d px(NAN, NAN);
-        if (hp.z() > 0 || hp.z() < 0) px = calibration.Distort(hp.hnormalized());
+        if (hp.z() * in_front > 0) px = calibration.Distort(hp.hnormalized());
         c.pixel[size_t(cy) * c.nx + cx] = px.cast<float>();
       }
   });
@@ -76,20 +85,72 @@ double MeasureTexels(const TexelCorners& c, const PhotoBounds& photo, RectifyMap
 }
 
 // Seen geometrically: all four corners inside the photo (the samples interpolate them, so they
-// are inside too) and the texel's lab rectangle on the physical screen.
-void MarkInside(const TexelCorners& c, const PhotoBounds& photo, double screen_w_mm,
-                double screen_h_mm, RectifyMap* m) {
+// are inside too), the texel's lab rectangle on the physical screen, and every photo pixel its
+// samples read on the screen and in the photo. The last matters at the screen's edge: a sample
+// half a sample step inside the texel reads the F x F-averaged image bilinearly, i.e. photo
+// pixels up to 2F - 1 beyond it, which there show the frame around the screen (black in a
+// synthetic capture), not the light: the edge texels came out 4 % dark with light running off
+// the screen (tests/cli/hard_cases_test.cc). `f` is the pre-average, `k` the samples per texel;
+// the corners are in the averaged image's pixels.
+void MarkInside(const TexelCorners& c, const PhotoBounds& photo, const ScreenCalibration& calib,
+                int f, int k, double screen_w_mm, double screen_h_mm, RectifyMap* m) {
   m->inside.assign(size_t(m->res_x) * m->res_y, 0);
   const double half_w = 0.5 * screen_w_mm + 1e-9, half_h = 0.5 * screen_h_mm + 1e-9;
-  for (int row = 0; row < m->res_y; ++row)
-    for (int col = 0; col < m->res_x; ++col) {
-      const Eigen::Vector2d lo = c.lab_of(col, row + 1), hi = c.lab_of(col + 1, row);
-      const bool on_screen =
-          lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h;
-      const bool in = photo.Contains(c.at(col, row)) && photo.Contains(c.at(col + 1, row)) &&
-                      photo.Contains(c.at(col, row + 1)) && photo.Contains(c.at(col + 1, row + 1));
-      m->inside[size_t(row) * m->res_x + col] = (on_screen && in) ? 1 : 0;
-    }
+  auto on_screen = [&](const Eigen::Vector2d& lab) {
+    return std::abs(lab.x()) <= half_w && std::abs(lab.y()) <= half_h;
+  };
+  const float lo_frac = 0.5f / k, hi_frac = 1 - lo_frac;
+  cv::parallel_for_(cv::Range(0, m->res_y), [&](const cv::Range& rows) {
+    for (int row = rows.start; row < rows.end; ++row)
+      for (int col = 0; col < m->res_x; ++col) {
+        const Eigen::Vector2d lo = c.lab_of(col, row + 1), hi = c.lab_of(col + 1, row);
+        const Eigen::Vector2f &p00 = c.at(col, row), &p10 = c.at(col + 1, row);
+        const Eigen::Vector2f &p01 = c.at(col, row + 1), &p11 = c.at(col + 1, row + 1);
+        const bool in = photo.Contains(p00) && photo.Contains(p10) && photo.Contains(p01) &&
+                        photo.Contains(p11);
+        if (!in ||
+            !(lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h))
+          continue;
+        // The outermost samples (the sample grid's corners, WriteRemapTables), their bounding
+        // box in the averaged image, the averaged pixels bilinear reads touch, the photo pixels
+        // those average, and half a pixel more for the pixels' own area.
+        Eigen::Vector2f bmin(HUGE_VALF, HUGE_VALF), bmax(-HUGE_VALF, -HUGE_VALF);
+        for (const float fy : {lo_frac, hi_frac})
+          for (const float fx : {lo_frac, hi_frac}) {
+            const Eigen::Vector2f left = p00 + fy * (p01 - p00), right = p10 + fy * (p11 - p10);
+            const Eigen::Vector2f p = left + fx * (right - left);
+            bmin = bmin.cwiseMin(p), bmax = bmax.cwiseMax(p);
+          }
+        const double x0 = f * std::floor(bmin.x()) - 0.5, y0 = f * std::floor(bmin.y()) - 0.5;
+        const double x1 = f * (std::floor(bmax.x()) + 1) + f - 0.5;
+        const double y1 = f * (std::floor(bmax.y()) + 1) + f - 0.5;
+        // (The averaged image covers the top-left multiple of F; beyond it remap reads 0.)
+        bool read_on_screen = x0 >= -0.5 && y0 >= -0.5 && x1 <= f * (calib.image_width / f) - 0.5 &&
+                              y1 <= f * (calib.image_height / f) - 0.5;
+        // Far from the screen's edge the box is on the screen anyway: its reach beyond the
+        // texel's corners, in photo pixels, times the texel's mm per pixel (√2 for a rotated
+        // view, 2 for the perspective's change over a few texels) is a safe margin. Only near
+        // the edge are the box's corners mapped to the screen.
+        const double side_px = f * std::min((p10 - p00).norm(), (p01 - p00).norm());
+        const Eigen::Vector2f tmin = p00.cwiseMin(p10).cwiseMin(p01).cwiseMin(p11) * float(f);
+        const Eigen::Vector2f tmax = p00.cwiseMax(p10).cwiseMax(p01).cwiseMax(p11) * float(f);
+        const double reach_px =
+            std::max({tmin.x() - x0, x1 - tmax.x(), tmin.y() - y0, y1 - tmax.y(), double(f)});
+        const double margin = 2 * std::sqrt(2.0) * reach_px *
+                              std::max(c.lab_of(1, 0).x() - c.lab_of(0, 0).x(),
+                                       c.lab_of(0, 0).y() - c.lab_of(0, 1).y()) /
+                              std::max(side_px, 1e-9);
+        const bool far_from_edge = lo.x() - margin >= -half_w && hi.x() + margin <= half_w &&
+                                   lo.y() - margin >= -half_h && hi.y() + margin <= half_h;
+        // The screen is convex in undistorted pixels: the box's corners decide (the box spans a
+        // few pixels, where the lens's distortion bends no edge measurably).
+        if (!far_from_edge)
+          for (const double y : {y0, y1})
+            for (const double x : {x0, x1})
+              read_on_screen = read_on_screen && on_screen(calib.ScreenFromImage({x, y}));
+        m->inside[size_t(row) * m->res_x + col] = read_on_screen ? 1 : 0;
+      }
+  });
 }
 
 // Sample (a, b) of texel (col, row) interpolates the texel's corners bilinearly at
@@ -167,7 +228,7 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
     for (auto& p : corners.pixel) p = (p.array() - shift) * scale;
     photo = {float(calibration.image_width / f - 1), float(calibration.image_height / f - 1)};
   }
-  MarkInside(corners, photo, screen_w_mm, screen_h_mm, &m);
+  MarkInside(corners, photo, calibration, f, m.samples_per_texel, screen_w_mm, screen_h_mm, &m);
   WriteRemapTables(corners, &m);
   m.read_region = ReadRegion(m, calibration.image_width / f, calibration.image_height / f);
   return m;

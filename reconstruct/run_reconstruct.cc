@@ -111,6 +111,20 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
     LogWarning("position ", Name(position), ": ", r.saturated_pixels, " saturated photo pixels; ",
                r.saturated_texels, " texels left out of the fit (mask 0)");
   if (r.exposures > 1) ReportBrackets(position, r, config);
+  // Outside what the slab can say: no light at all (a slab of zeros is not a measurement of
+  // this luminaire), or light that varies within a texel (the bell basis needs light smooth
+  // over a few texels, kUnresolvedLight).
+  if (r.no_light)
+    LogWarning("position ", Name(position), ": no light measured (",
+               r.brightest_codes >= 0
+                   ? "the brightest photo pixel is " + std::to_string(r.brightest_codes) +
+                         " codes above black, below the near-black floor"
+                   : std::string("every seen texel is 0"),
+               "): its slab image holds no signal; raise the exposure");
+  else if (r.bell_correction > kUnresolvedLight)
+    LogWarning("position ", Name(position), ": the light varies within a texel (the fit moves ",
+               "the texel averages by ", 100 * r.bell_correction,
+               " %): the slab keeps its flux, not its shape; use a higher --resolution");
   LogDebug("position ", Name(position), ": seen ", r.seen_texels,
            " texels, K=", r.samples_per_texel, ", fit ", r.fit_iterations, " it (residual ",
            r.fit_residual, "), decode ", r.decode_s, " s, rectify ", r.rectify_s, " s, fit ",

@@ -151,10 +151,13 @@ TEST(Reconstruct, OffScreenTexelsAreMaskedAndZero) {
   const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("mask"), SyntheticOptions());
   // Position (0, 0) has c = (-2.5, 0) mm: the texel column at s = +60 sees lab x = 62.5 beyond
   // the screen edge; the column at s = -60 is on the screen.
+  // The top and bottom rows lie on the screen's edge (c_y = 0): their samples' bilinear reads
+  // may reach photo pixels beyond it, which are then not seen either (rectify.cc MarkInside).
   const SlabPosition p = Reconstruct(s, 0, 0, nullptr);
   for (int row = 0; row < kRes; ++row) {
     EXPECT_EQ(p.mask.at(kRes - 1, row, 0), 0.f) << row;
     for (int c = 0; c < 3; ++c) EXPECT_EQ(p.irradiance.at(kRes - 1, row, c), 0.f);
+    if (row == 0 || row == kRes - 1) continue;
     EXPECT_EQ(p.mask.at(0, row, 0), 1.f) << row;
     EXPECT_EQ(p.mask.at(kRes / 2, row, 0), 1.f) << row;
   }

@@ -354,39 +354,38 @@ void ExpectNoWarning(const CaseRun& r) {
   EXPECT_FALSE(Says(r.reconstruct, "warning")) << r.reconstruct.output;
 }
 
-// The reference point: the default luminaire on a 3 x 3 grid at 64 texels (18.75 mm).
-TEST(HardCases, Baseline) {
-  const CaseRun r = RunCase("baseline", Scene(Geometry{}, DefaultEmitters(), kSmallCamera), 64);
+// A case the method handles: the chain succeeds, no tool warns, and the slab is stable
+// (ExpectStable over CheckSlab with `options`); the datasets are removed unless it failed.
+void ExpectCleanStableCase(const std::string& name, const std::string& label,
+                           const std::string& scene_json, int resolution,
+                           const CheckOptions& options = {}) {
+  const CaseRun r = RunCase(name, scene_json, resolution);
   ASSERT_EQ(r.reconstruct.exit_code, 0)
       << r.acquire.output << r.calibrate.output << r.reconstruct.output;
   ExpectNoWarning(r);
-  ExpectStable("baseline", CheckSlab(r.ds));
+  ExpectStable(label, CheckSlab(r.ds, options));
   CleanUp(r);
+}
+
+// The reference point: the default luminaire on a 3 x 3 grid at 64 texels (18.75 mm).
+TEST(HardCases, Baseline) {
+  ExpectCleanStableCase("baseline", "baseline", Scene(Geometry{}, DefaultEmitters(), kSmallCamera),
+                        64);
 }
 
 // An emitter almost on S (z = -0.05 mm): every ray to the screen crosses S within 0.1 mm of the
 // emitter, so each position is the filter's value there times the isotropic emitter's
 // cos/r^2: light wider than the screen, running off every edge (the mask-edge terms).
 TEST(HardCases, EmitterOnTheFilterPlaneWiderThanTheScreen) {
-  const CaseRun r =
-      RunCase("on_plane", Scene(Geometry{}, Emitter(1, -1.5, -0.05, 1, 0), kSmallCamera), 64);
-  ASSERT_EQ(r.reconstruct.exit_code, 0)
-      << r.acquire.output << r.calibrate.output << r.reconstruct.output;
-  ExpectNoWarning(r);
-  ExpectStable("on the filter plane", CheckSlab(r.ds));
-  CleanUp(r);
+  ExpectCleanStableCase("on_plane", "on the filter plane",
+                        Scene(Geometry{}, Emitter(1, -1.5, -0.05, 1, 0), kSmallCamera), 64);
 }
 
 // A pattern running off the screen's edge: the emitter 10 mm off axis puts the filter's image
 // (+-385 mm) around s = -375 mm, over the left edge at -600 mm.
 TEST(HardCases, PatternRunningOffTheScreenEdge) {
-  const CaseRun r =
-      RunCase("off_edge", Scene(Geometry{}, Emitter(10, 2, -20, 1, 0), kSmallCamera), 64);
-  ASSERT_EQ(r.reconstruct.exit_code, 0)
-      << r.acquire.output << r.calibrate.output << r.reconstruct.output;
-  ExpectNoWarning(r);
-  ExpectStable("off the screen edge", CheckSlab(r.ds));
-  CleanUp(r);
+  ExpectCleanStableCase("off_edge", "off the screen edge",
+                        Scene(Geometry{}, Emitter(10, 2, -20, 1, 0), kSmallCamera), 64);
 }
 
 // The close-up setup A (§1.5): d = 55 mm, an 18 x 27 mm screen, h = 2.5 mm, here a 1 x 5 grid,
@@ -401,23 +400,13 @@ Geometry CloseUp(int nu, int nv, double h) {
   return s;
 }
 TEST(HardCases, CloseUpSetupGrid1x5) {
-  const CaseRun r =
-      RunCase("closeup", Scene(CloseUp(1, 5, 2.5), DefaultEmitters(), kCloseUpCamera), 64);
-  ASSERT_EQ(r.reconstruct.exit_code, 0)
-      << r.acquire.output << r.calibrate.output << r.reconstruct.output;
-  ExpectNoWarning(r);
-  ExpectStable("close-up 1x5", CheckSlab(r.ds));
-  CleanUp(r);
+  ExpectCleanStableCase("closeup", "close-up 1x5",
+                        Scene(CloseUp(1, 5, 2.5), DefaultEmitters(), kCloseUpCamera), 64);
 }
 TEST(HardCases, EmitterFarBehindTheFilterPlane) {
-  const CaseRun r =
-      RunCase("far_behind",
-              Scene(CloseUp(1, 1, 2.5), Emitter(0.5, -0.3, -1e5, 1e7, 0), kCloseUpCamera), 64);
-  ASSERT_EQ(r.reconstruct.exit_code, 0)
-      << r.acquire.output << r.calibrate.output << r.reconstruct.output;
-  ExpectNoWarning(r);
-  ExpectStable("far behind, 1x1", CheckSlab(r.ds));
-  CleanUp(r);
+  ExpectCleanStableCase("far_behind", "far behind, 1x1",
+                        Scene(CloseUp(1, 1, 2.5), Emitter(0.5, -0.3, -1e5, 1e7, 0), kCloseUpCamera),
+                        64);
 }
 
 // h large against d: h = 12 mm at d = 55 mm on a 2 x 1 grid shifts each window by 6 mm of the
@@ -425,13 +414,8 @@ TEST(HardCases, EmitterFarBehindTheFilterPlane) {
 // positions' windows (c = +-40 mm) miss the 27 mm screen entirely: exit 2 naming the position,
 // not an empty slab.
 TEST(HardCases, SpacingLargeAgainstDistance) {
-  const CaseRun r =
-      RunCase("large_h", Scene(CloseUp(2, 1, 12), DefaultEmitters(), kCloseUpCamera), 64);
-  ASSERT_EQ(r.reconstruct.exit_code, 0)
-      << r.acquire.output << r.calibrate.output << r.reconstruct.output;
-  ExpectNoWarning(r);
-  ExpectStable("h = 12 mm, d = 55 mm, 2x1", CheckSlab(r.ds));
-  CleanUp(r);
+  ExpectCleanStableCase("large_h", "h = 12 mm, d = 55 mm, 2x1",
+                        Scene(CloseUp(2, 1, 12), DefaultEmitters(), kCloseUpCamera), 64);
   const CaseRun off =
       RunCase("large_h_off", Scene(CloseUp(1, 5, 20), DefaultEmitters(), kCloseUpCamera), 32);
   EXPECT_EQ(off.reconstruct.exit_code, 2) << off.reconstruct.output;

@@ -297,6 +297,11 @@ TEST(PlanCli, TableJsonWarningsAndBadInput) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("does not cover"), std::string::npos) << r.output;
 
+  // h beyond the calibrated range: a warning, with the measured counter-example.
+  r = RunTool("lumislab-plan", "--scene default --h 20");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("outside the model's calibrated range"), std::string::npos) << r.output;
+
   // Bad input: exit 2 naming the option, no JSON written.
   const std::string bad = dir + "/bad.json";
   struct Case {

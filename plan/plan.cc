@@ -89,6 +89,21 @@ Coverage RequiredCoverage(const PlanInput& in) {
   return c;
 }
 
+Coverage ScreenHoldsRoi(const PlanInput& in, const PlanSetting& s) {
+  const double d = in.distance_mm, D = in.D();
+  const double spread = std::abs(1 - d / D) * (s.k_max + 2) * s.h_mm;
+  // A ray from e (depth z) to x on z = D meets M at e (D - d)/(D + z) + x (d + z)/(D + z).
+  auto limit = [&](bool x_axis, double half_window) {
+    double X = 1e300;
+    for (const LightPoint& p : in.light) {
+      const double e = x_axis ? p.ax : p.ay;
+      X = std::min(X, ((half_window - spread) * (D + p.z) - e * std::abs(D - d)) / (d + p.z));
+    }
+    return std::max(0.0, 2 * X);
+  };
+  return {limit(true, in.screen_w_mm / 2), limit(false, in.screen_h_mm / 2)};
+}
+
 int RequiredPositions(double half_extent_mm, double h_mm, int k_max) {
   // ((n - 1)/2 - K) h >= u  <=>  n >= 2 (u / h + K) + 1; at least 2K + 1 (one covered point).
   const double n = 2 * (half_extent_mm / h_mm + k_max) + 1;
@@ -147,7 +162,16 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
   p.at_d = PredictError(in, s, in.distance_mm);
   p.at_D = PredictError(in, s, in.D());
   p.lab_s = LabSeconds(in, s);
+  p.roi_max = ScreenHoldsRoi(in, s);
   p.reachable = p.at_D.total <= in.target;
+  if ((in.roi_w_mm > 0 && in.roi_w_mm > p.roi_max.u_mm + 1e-9) ||
+      (in.roi_h_mm > 0 && in.roi_h_mm > p.roi_max.v_mm + 1e-9)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%.0f x %.0f mm", p.roi_max.u_mm, p.roi_max.v_mm);
+    p.warnings.push_back(std::string("--roi-mm reaches beyond what the screen holds at D (") + buf +
+                         "): rays from its edges meet the screen outside the window, light no "
+                         "grid can capture; use a larger screen or a smaller region");
+  }
   if (s.h_mm > kCalibratedHMax + 1e-12) {
     p.warnings.push_back(
         "h above " + std::to_string(int(kCalibratedHMax)) +
@@ -215,8 +239,7 @@ Plan MakePlan(const PlanInput& in) {
     PlanInput closest = in;
     closest.target = 1.05 * least;
     Plan p = MakePlan(closest);
-    p.reachable = false;
-    p.warnings.clear();
+    p.reachable = false;  // closest's plan met closest's target: no "above the target" warning
     const ErrorTerms& e = p.at_D;
     std::string why = "the target " + Percent(in.target) +
                       " at D = " + std::to_string(int(std::lround(in.D()))) +
@@ -252,6 +275,9 @@ std::string PlanTable(const PlanInput& in, const Plan& p) {
   std::snprintf(cov, sizeof cov, "|u| <= %.1f mm, |v| <= %.1f mm (%s)", p.coverage.u_mm,
                 p.coverage.v_mm, p.covers ? "covered" : "NOT covered");
   row("coverage needed on S", cov);
+  char roi[96];
+  std::snprintf(roi, sizeof roi, "%.0f x %.0f mm", p.roi_max.u_mm, p.roi_max.v_mm);
+  row("largest region the screen holds at D", roi);
   row("lab time", Minutes(p.lab_s));
   o << "\n| predicted error | at d = " << std::lround(in.distance_mm)
     << " mm | at D = " << std::lround(in.D()) << " mm |\n|---|---|---|\n";
@@ -294,6 +320,7 @@ std::string PlanJson(const PlanInput& in, const Plan& p) {
                         {"samples", s.samples}}},
                       {"coverage_mm", {p.coverage.u_mm, p.coverage.v_mm}},
                       {"covers", p.covers},
+                      {"roi_max_mm", {p.roi_max.u_mm, p.roi_max.v_mm}},
                       {"error_at_d", terms(p.at_d)},
                       {"error_at_D", terms(p.at_D)},
                       {"lab_s", p.lab_s},

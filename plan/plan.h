@@ -63,6 +63,11 @@ struct Coverage {
   double u_mm = 0, v_mm = 0;
 };
 Coverage RequiredCoverage(const PlanInput& in);
+// The largest region of interest (full width, height; mm) on the plane z = D whose rays from the
+// light all meet M inside the window less the spread |1 - d/D| (K + 2) h of the supports the
+// reconstruction draws from (GridCovers' window condition): light beyond it is lost whatever
+// the grid. At D = d it is the window itself.
+Coverage ScreenHoldsRoi(const PlanInput& in, const PlanSetting& s);
 // Fewest positions per axis with ((n - 1)/2 - K) h >= half_extent (GridCovers' condition).
 int RequiredPositions(double half_extent_mm, double h_mm, int k_max);
 // True when the setting's grid covers `RequiredCoverage`.
@@ -75,6 +80,7 @@ struct Plan {
   PlanSetting setting;
   Coverage coverage;
   bool covers = true;
+  Coverage roi_max;  // ScreenHoldsRoi
   ErrorTerms at_d, at_D;
   double lab_s = 0;
   bool reachable = true;              // the prediction at D meets the target

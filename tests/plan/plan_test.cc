@@ -171,6 +171,27 @@ TEST(Plan, RecommendedGridCoversPerGridCovers) {
       const Plan p = MakePlan(in);
       EXPECT_TRUE(p.covers);
       CheckCovers(scene, in, p.setting);
+      // The region the screen holds at D: every point inside is covered by the recommended
+      // grid; a little beyond its edges some are not, whatever the grid.
+      SynthScene sc = LoadScene(scene);
+      sc.grid = {p.setting.nu, p.setting.nv, p.setting.h_mm};
+      const SlabInfo info = TruthSlabInfo(sc, 32);
+      SlabInfo huge = info;
+      huge.grid = {999, 999, p.setting.h_mm};
+      const double hw = p.roi_max.u_mm / 2, hh = p.roi_max.v_mm / 2, D = in.D();
+      EXPECT_GT(hw, 0.9 * in.screen_w_mm);  // at 2d most of the screen x 2
+      for (int a = 0; a <= 40; ++a) {
+        for (int b = 0; b <= 40; ++b) {
+          const Eigen::Vector3d x(-hw + 2 * hw * a / 40, -hh + 2 * hh * b / 40, D);
+          EXPECT_TRUE(GridCovers(sc.luminaire, info, x)) << x.transpose();
+        }
+      }
+      // (The region is symmetric, the light need not be: one side or the other loses.)
+      auto held = [&](double px, double py) {
+        return GridCovers(sc.luminaire, huge, Eigen::Vector3d(px, py, D));
+      };
+      EXPECT_FALSE(held(hw + 3, 0) && held(-hw - 3, 0));
+      EXPECT_FALSE(held(0, hh + 3) && held(0, -hh - 3));
     }
   }
 }
@@ -296,6 +317,14 @@ TEST(PlanCli, TableJsonWarningsAndBadInput) {
   r = RunTool("lumislab-plan", "--scene default --h 5 --nu 9 --nv 7 --resolution 48");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("does not cover"), std::string::npos) << r.output;
+
+  // A region of interest the screen cannot hold: a warning.
+  r = RunTool("lumislab-plan", "--scene default --receiver-mm 1500 --roi-mm 2500,2000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("beyond what the screen holds"), std::string::npos) << r.output;
+  r = RunTool("lumislab-plan", "--scene default --receiver-mm 1500 --roi-mm 1000,1000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
 
   // h beyond the calibrated range: a warning, with the measured counter-example.
   r = RunTool("lumislab-plan", "--scene default --h 20");

@@ -33,7 +33,7 @@ constexpr double kSlab = 0.055;
 constexpr double kQuadrature = 5.4;
 // What the knobs above do not reach: photos, the screen calibration from the board photo,
 // bilinear lookups (covered error at d 0.03 - 0.12 % whatever the photo size).
-constexpr double kFloor = 5e-4;
+constexpr double kFloor = 7e-4;
 
 // The largest h the model was checked at (the study's 10 mm points, the planner's own measured
 // recommendation). Beyond it the error at d grows with h by a mechanism the model lacks

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <opencv2/imgproc.hpp>
@@ -85,13 +86,17 @@ double MeasureTexels(const TexelCorners& c, const PhotoBounds& photo, RectifyMap
 }
 
 // Seen geometrically: all four corners inside the photo (the samples interpolate them, so they
-// are inside too), the texel's lab rectangle on the physical screen, and every photo pixel its
-// samples read on the screen and in the photo. The last matters at the screen's edge: a sample
-// half a sample step inside the texel reads the F x F-averaged image bilinearly, i.e. photo
-// pixels up to 2F - 1 beyond it, which there show the frame around the screen (black in a
-// synthetic capture), not the light: the edge texels came out 4 % dark with light running off
-// the screen (tests/cli/hard_cases_test.cc). `f` is the pre-average, `k` the samples per texel;
-// the corners are in the averaged image's pixels.
+// are inside too) and the texel's lab rectangle on the physical screen. Near the screen's edge a
+// sample also reads photo pixels beyond the texel: bilinear reads of the F x F-averaged image
+// reach photo pixels up to 2F - 1 away, which there show the frame around the screen, not the
+// light (the edge texels came out 4 % dark with light running off the screen,
+// tests/cli/hard_cases_test.cc). Such a sample gets weight 0 (`sample_weight`), and the texel
+// is the mean of its other samples: the light over the part of the texel that reads only the
+// screen. A texel with less than kMinCleanSamples of its samples left is unseen. Texels far from
+// the edge have no such sample, and when no texel has one `sample_weight` stays empty. `f` is
+// the pre-average, `k` the samples per texel; the corners are in the averaged image's pixels.
+constexpr double kMinCleanSamples = 0.25;
+
 void MarkInside(const TexelCorners& c, const PhotoBounds& photo, const ScreenCalibration& calib,
                 int f, int k, double screen_w_mm, double screen_h_mm, RectifyMap* m) {
   m->inside.assign(size_t(m->res_x) * m->res_y, 0);
@@ -99,7 +104,27 @@ void MarkInside(const TexelCorners& c, const PhotoBounds& photo, const ScreenCal
   auto on_screen = [&](const Eigen::Vector2d& lab) {
     return std::abs(lab.x()) <= half_w && std::abs(lab.y()) <= half_h;
   };
-  const float lo_frac = 0.5f / k, hi_frac = 1 - lo_frac;
+  // The photo pixels the averaged image covers (its top-left multiple of F; beyond, remap
+  // reads 0).
+  const double photo_x1 = f * (calib.image_width / f) - 0.5;
+  const double photo_y1 = f * (calib.image_height / f) - 0.5;
+  // Whether the sample at averaged pixel p reads only the screen: the averaged pixels bilinear
+  // reads touch (floor(p) and the next), the photo pixels those average, half a pixel more for
+  // the pixels' own area; their box's corners on the screen (the box spans a few pixels, where
+  // the lens's distortion bends no edge measurably; the screen is convex).
+  auto clean = [&](const Eigen::Vector2f& p) {
+    const double x0 = f * std::floor(p.x()) - 0.5, y0 = f * std::floor(p.y()) - 0.5;
+    const double x1 = f * (std::floor(p.x()) + 2) - 0.5, y1 = f * (std::floor(p.y()) + 2) - 0.5;
+    if (x0 < -0.5 || y0 < -0.5 || x1 > photo_x1 || y1 > photo_y1) return false;
+    for (const double y : {y0, y1})
+      for (const double x : {x0, x1})
+        if (!on_screen(calib.ScreenFromImage({x, y}))) return false;
+    return true;
+  };
+  std::vector<float> fr(k);
+  for (int a = 0; a < k; ++a) fr[a] = (a + 0.5f) / k;
+  cv::Mat weight(m->res_y * k, m->res_x * k, CV_32FC1, cv::Scalar(1));
+  std::atomic<bool> partial{false};
   cv::parallel_for_(cv::Range(0, m->res_y), [&](const cv::Range& rows) {
     for (int row = rows.start; row < rows.end; ++row)
       for (int col = 0; col < m->res_x; ++col) {
@@ -111,46 +136,34 @@ void MarkInside(const TexelCorners& c, const PhotoBounds& photo, const ScreenCal
         if (!in ||
             !(lo.x() >= -half_w && hi.x() <= half_w && lo.y() >= -half_h && hi.y() <= half_h))
           continue;
-        // The outermost samples (the sample grid's corners, WriteRemapTables), their bounding
-        // box in the averaged image, the averaged pixels bilinear reads touch, the photo pixels
-        // those average, and half a pixel more for the pixels' own area.
-        Eigen::Vector2f bmin(HUGE_VALF, HUGE_VALF), bmax(-HUGE_VALF, -HUGE_VALF);
-        for (const float fy : {lo_frac, hi_frac})
-          for (const float fx : {lo_frac, hi_frac}) {
-            const Eigen::Vector2f left = p00 + fy * (p01 - p00), right = p10 + fy * (p11 - p10);
-            const Eigen::Vector2f p = left + fx * (right - left);
-            bmin = bmin.cwiseMin(p), bmax = bmax.cwiseMax(p);
-          }
-        const double x0 = f * std::floor(bmin.x()) - 0.5, y0 = f * std::floor(bmin.y()) - 0.5;
-        const double x1 = f * (std::floor(bmax.x()) + 1) + f - 0.5;
-        const double y1 = f * (std::floor(bmax.y()) + 1) + f - 0.5;
-        // (The averaged image covers the top-left multiple of F; beyond it remap reads 0.)
-        bool read_on_screen = x0 >= -0.5 && y0 >= -0.5 && x1 <= f * (calib.image_width / f) - 0.5 &&
-                              y1 <= f * (calib.image_height / f) - 0.5;
-        // Far from the screen's edge the box is on the screen anyway: its reach beyond the
-        // texel's corners, in photo pixels, times the texel's mm per pixel (√2 for a rotated
-        // view, 2 for the perspective's change over a few texels) is a safe margin. Only near
-        // the edge are the box's corners mapped to the screen.
+        // Far from the screen's edge every sample reads the screen: the reads reach at most
+        // 2F photo pixels (two averaged pixels) beyond the texel, times the texel's mm per
+        // pixel, doubled (√2 for a rotated view, and the perspective's change over a few
+        // texels), is a safe margin. Only near the edge are the samples mapped to the screen.
         const double side_px = f * std::min((p10 - p00).norm(), (p01 - p00).norm());
-        const Eigen::Vector2f tmin = p00.cwiseMin(p10).cwiseMin(p01).cwiseMin(p11) * float(f);
-        const Eigen::Vector2f tmax = p00.cwiseMax(p10).cwiseMax(p01).cwiseMax(p11) * float(f);
-        const double reach_px =
-            std::max({tmin.x() - x0, x1 - tmax.x(), tmin.y() - y0, y1 - tmax.y(), double(f)});
-        const double margin = 2 * std::sqrt(2.0) * reach_px *
-                              std::max(c.lab_of(1, 0).x() - c.lab_of(0, 0).x(),
-                                       c.lab_of(0, 0).y() - c.lab_of(0, 1).y()) /
-                              std::max(side_px, 1e-9);
+        const double margin = 2 * std::sqrt(2.0) * 2 * f *
+                              std::max(hi.x() - lo.x(), hi.y() - lo.y()) / std::max(side_px, 1e-9);
         const bool far_from_edge = lo.x() - margin >= -half_w && hi.x() + margin <= half_w &&
                                    lo.y() - margin >= -half_h && hi.y() + margin <= half_h;
-        // The screen is convex in undistorted pixels: the box's corners decide (the box spans a
-        // few pixels, where the lens's distortion bends no edge measurably).
-        if (!far_from_edge)
-          for (const double y : {y0, y1})
-            for (const double x : {x0, x1})
-              read_on_screen = read_on_screen && on_screen(calib.ScreenFromImage({x, y}));
-        m->inside[size_t(row) * m->res_x + col] = read_on_screen ? 1 : 0;
+        int kept = k * k;
+        if (!far_from_edge) {
+          kept = 0;
+          for (int b = 0; b < k; ++b) {
+            const Eigen::Vector2f left = p00 + fr[b] * (p01 - p00);
+            const Eigen::Vector2f right = p10 + fr[b] * (p11 - p10);
+            float* w = weight.ptr<float>(row * k + b) + col * k;
+            for (int a = 0; a < k; ++a) {
+              const bool ok = clean(left + fr[a] * (right - left));
+              w[a] = ok ? 1.f : 0.f;
+              kept += ok;
+            }
+          }
+          if (kept < k * k) partial = true;
+        }
+        m->inside[size_t(row) * m->res_x + col] = kept >= kMinCleanSamples * k * k ? 1 : 0;
       }
   });
+  if (partial) m->sample_weight = weight;
 }
 
 // Sample (a, b) of texel (col, row) interpolates the texel's corners bilinearly at
@@ -240,8 +253,28 @@ cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
   cv::Mat samples, texels;
   cv::remap(signal, samples, map.map_xy, map.map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));
-  if (map.samples_per_texel == 1) return samples;
-  cv::resize(samples, texels, cv::Size(map.res_x, map.res_y), 0, 0, cv::INTER_AREA);
+  if (map.samples_per_texel == 1 && map.sample_weight.empty()) return samples;
+  const cv::Size size(map.res_x, map.res_y);
+  if (map.sample_weight.empty()) {
+    cv::resize(samples, texels, size, 0, 0, cv::INTER_AREA);
+    return texels;
+  }
+  // Near the screen's edge: the mean of the samples that read only the screen (BuildRectifyMap).
+  std::vector<cv::Mat> planes;
+  cv::split(samples, planes);
+  for (cv::Mat& plane : planes) plane = plane.mul(map.sample_weight);
+  cv::Mat weighted, kept;
+  cv::merge(planes, weighted);
+  cv::resize(weighted, texels, size, 0, 0, cv::INTER_AREA);
+  cv::resize(map.sample_weight, kept, size, 0, 0, cv::INTER_AREA);
+  for (int row = 0; row < texels.rows; ++row) {
+    float* t = texels.ptr<float>(row);
+    const float* w = kept.ptr<float>(row);
+    for (int col = 0; col < texels.cols; ++col)
+      for (int ch = 0; ch < texels.channels(); ++ch)
+        t[col * texels.channels() + ch] =
+            w[col] > 0 ? t[col * texels.channels() + ch] / w[col] : 0.f;
+  }
   return texels;
 }
 

@@ -26,9 +26,14 @@ struct RectifyMap {
   // Averaged-photo pixel of each sample, (res_y K) x (res_x K), in OpenCV's fixed-point remap
   // format: CV_16SC2 integer pixel + CV_16UC1 1/32-pixel fraction index.
   cv::Mat map_xy, map_frac;
-  // Per texel: all its corners (hence all samples) inside the photo, and the texel on the
-  // physical screen.
+  // Per texel: all its corners (hence all samples) inside the photo, the texel on the physical
+  // screen, and at least a quarter of its samples reading only the screen.
   std::vector<unsigned char> inside;
+  // Near the screen's edge a sample's bilinear read of the averaged image can reach photo pixels
+  // beyond the screen: such samples have weight 0 here, the others 1 (CV_32FC1, the size of
+  // map_xy), and Rectify takes the mean of the weighted samples. Empty when no seen texel has
+  // such a sample (every sample counts).
+  cv::Mat sample_weight;
   // The averaged-photo pixels that the samples of the seen texels read (each sample's pixel and
   // its right and lower neighbours, bilinear), clipped to the averaged image; empty when no texel
   // is seen. The rest of the photo does not reach the slab: the merge skips it.

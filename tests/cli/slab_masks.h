@@ -1,6 +1,7 @@
 // The slab mask's rule at the screen's edge (docs/design.md §3.5 step 3), for tests that check
-// masks: a texel is seen when every photo pixel its samples read lies on the screen, so a band
-// of about one texel along the screen's edge may be unseen.
+// masks: a texel along the screen's edge whose samples' reads reach past it keeps only its other
+// samples, and is unseen when fewer than a quarter are left, so texels within about one texel
+// of the screen's edge may be unseen.
 #pragma once
 
 #include <Eigen/Core>

@@ -7,6 +7,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/log.h"
 #include "study/study.h"
 
 namespace lumislab {
@@ -14,11 +15,8 @@ namespace {
 
 const char* kDLabel[3] = {"d", "2d", "4d"};
 
-std::string Num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
+// CSV numbers: 6 significant digits (core/log.h's Num).
+std::string Num6(double x) { return Num(x, 6); }
 std::string Fixed(double x, const char* format) {
   char buf[32];
   std::snprintf(buf, sizeof buf, format, x);
@@ -44,7 +42,7 @@ std::vector<std::string> Split(const std::string& line) {
 // What sets a row apart from the base, in words (the table's "setting" column).
 std::string Setting(const StudyRow& r) {
   std::ostringstream s;
-  s << "h " << Num(r.h_mm) << " mm, " << r.nu << "x" << r.nv << ", " << r.photo_w << "x"
+  s << "h " << Num6(r.h_mm) << " mm, " << r.nu << "x" << r.nv << ", " << r.photo_w << "x"
     << r.photo_h << " px, K " << r.k_max << ", " << r.slab_res << " texels, N " << r.samples;
   return s.str();
 }
@@ -60,13 +58,13 @@ std::string StudyCsvHeader() {
 
 std::string StudyCsvLine(const StudyRow& r) {
   std::ostringstream s;
-  s << r.knob << "," << r.value << "," << r.key << "," << Num(r.h_mm) << "," << r.nu << "," << r.nv
+  s << r.knob << "," << r.value << "," << r.key << "," << Num6(r.h_mm) << "," << r.nu << "," << r.nv
     << "," << r.positions() << "," << r.photo_w << "," << r.photo_h << "," << r.k_max << ","
-    << r.slab_res << "," << r.samples << "," << r.render_px << "," << Num(r.slab_rel_l2);
-  for (int k = 0; k < 3; ++k) s << "," << Num(r.err[k]) << "," << Num(r.flux[k]);
-  for (int k = 0; k < 3; ++k) s << "," << Num(r.err_covered[k]) << "," << Num(r.covered[k]);
-  s << "," << Num(r.lab_s) << "," << Num(r.acquire_s) << "," << Num(r.calibrate_s) << ","
-    << Num(r.reconstruct_s) << "," << Num(r.render_s) << "," << Num(r.total_s);
+    << r.slab_res << "," << r.samples << "," << r.render_px << "," << Num6(r.slab_rel_l2);
+  for (int k = 0; k < 3; ++k) s << "," << Num6(r.err[k]) << "," << Num6(r.flux[k]);
+  for (int k = 0; k < 3; ++k) s << "," << Num6(r.err_covered[k]) << "," << Num6(r.covered[k]);
+  s << "," << Num6(r.lab_s) << "," << Num6(r.acquire_s) << "," << Num6(r.calibrate_s) << ","
+    << Num6(r.reconstruct_s) << "," << Num6(r.render_s) << "," << Num6(r.total_s);
   return s.str();
 }
 

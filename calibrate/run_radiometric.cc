@@ -193,6 +193,10 @@ int RunScale(const RadiometricCommand& c, const Dataset& dataset) {
       CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report);
   MakeCalib(dataset);
   SaveRadiometricScale(out, scale, report);
+  if (report.value("photos_through_srgb_curve", false))
+    LogInfo(
+        "scale: the photos' codes were linearised through the sRGB curve (no "
+        "calib/response.json for them)");
   LogInfo("scale: ", scale.scale, " ", scale.units, " per unit (readings ", reference.reading_p,
           " - ", reference.reading_n, " over values ", report["value_p"].get<double>(), " - ",
           report["value_n"].get<double>(), ")",

@@ -4,7 +4,6 @@
 #include <Eigen/Core>
 #include <cmath>
 
-#include "calibrate/calibration_frames.h"
 #include "core/error.h"
 #include "core/json.h"
 #include "lib/photo/photo_io.h"
@@ -112,13 +111,12 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
                          std::to_string(pixel.x()) + ", " + std::to_string(pixel.y()) + ")",
                      "a point outside the photo");
   SlideValue slides[2];
-  bool noted = false;  // the sRGB-curve note, once
+  bool srgb = false;  // codes linearised through the sRGB curve (report, and a note in the log)
   for (const PhotoEntry& e : dataset.PhotosOf(reference.i, reference.j)) {
     PhotoSpec spec = PhotoSpecOf(dataset, e);
     spec.corrections = corrections;
     const Photo photo = DecodePhoto(dataset.PhotoPath(e.file), spec);
-    if (!noted) NoteSrgbCurve("scale", photo);
-    noted = true;
+    srgb = srgb || (photo.transfer == Transfer::kSrgb && photo.pixels.depth() != CV_32F);
     if (photo.pixels.cols != screen.image_width || photo.pixels.rows != screen.image_height)
       throw InputError(photo.path, "image size",
                        std::to_string(screen.image_width) + "x" +
@@ -150,6 +148,7 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
     throw InputError(reference.source, "reading_p", "readings giving a scale in [1e-12, 1e12]",
                      std::to_string(scale.scale));
   nlohmann::json& j = *report;
+  j["photos_through_srgb_curve"] = srgb;
   j["reference"] = reference.source;
   j["position"] = {reference.i, reference.j};
   j["point_mm"] = {reference.point_mm.x(), reference.point_mm.y()};

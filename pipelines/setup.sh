@@ -15,6 +15,10 @@ packages=(
   libembree-dev
   # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), DNG and TIFF writing (libtiff)
   libraw-dev libexif-dev libtiff-dev
+  # preview: the window's on-screen controls (Dear ImGui 1.86 with its GLFW and OpenGL 3 backends)
+  libimgui-dev
+  # pipelines/Snakefile: batch conversion as a workflow that also runs on a cluster
+  snakemake
   xvfb xauth x11-apps
   # pipelines/test.sh's sanitizer and fuzz builds: clang 14, its sanitizer and libFuzzer
   # run-times, llvm-symbolizer for the stack traces (fuzz/README.md)

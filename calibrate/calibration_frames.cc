@@ -66,11 +66,11 @@ std::vector<CalibrationFrame> DecodeCalibrationFrames(const Dataset& dataset,
       throw InputError(options.files[k], "image size",
                        std::to_string(width) + "x" + std::to_string(height) + " as " + size_source,
                        std::to_string(px.cols) + "x" + std::to_string(px.rows));
-    if (!frames.empty() && px.depth() != frames[0].photo.pixels.depth())
+    if (!frames.empty() && f.photo.CodeBits() != frames[0].photo.CodeBits())
       throw InputError(
           options.files[k], "bit depth",
-          std::to_string(frames[0].photo.pixels.elemSize1() * 8) + " bits like " + options.files[0],
-          std::to_string(px.elemSize1() * 8) + " bits");
+          std::to_string(frames[0].photo.CodeBits()) + " bits like " + options.files[0],
+          std::to_string(f.photo.CodeBits()) + " bits");
     frames.push_back(std::move(f));
   }
   return frames;
@@ -79,8 +79,8 @@ std::vector<CalibrationFrame> DecodeCalibrationFrames(const Dataset& dataset,
 // Says when the decoder linearised `photo`'s codes through the sRGB curve (8- or 16-bit codes,
 // no calibrated response for them); RAW and float frames are linear and say nothing.
 void NoteSrgbCurve(const char* step, const Photo& photo) {
-  if (photo.transfer == Transfer::kSrgb && photo.pixels.depth() != CV_32F)
-    LogInfo(step, ": ", photo.pixels.elemSize1() * 8, "-bit ", PhotoFormatName(photo.format),
+  if (photo.transfer == Transfer::kSrgb && photo.CodeBits() < 32)
+    LogInfo(step, ": ", photo.CodeBits(), "-bit ", PhotoFormatName(photo.format),
             " photos linearised through the sRGB curve (no calib/response.json for them)");
 }
 

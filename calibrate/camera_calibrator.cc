@@ -30,10 +30,11 @@ std::string SizeText(const cv::Size& s) {
 // The 8-bit image the detectors work on: an 8-bit photo's own codes (as a camera's JPEG shows
 // the board), anything else as linear luminance stretched to 8 bits.
 cv::Mat Gray8(const Photo& photo) {
-  if (photo.pixels.depth() == CV_8U) {
-    if (photo.pixels.channels() == 1) return photo.pixels;
+  if (photo.EightBitCodes()) {
+    const cv::Mat codes = Codes8(photo);
+    if (codes.channels() == 1) return codes;
     cv::Mat gray;
-    cv::cvtColor(photo.pixels, gray, photo.rgb_order ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY);
+    cv::cvtColor(codes, gray, photo.rgb_order ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY);
     return gray;
   }
   return StretchToGray8(LinearGray(photo));

@@ -23,7 +23,7 @@ namespace {
 std::vector<cv::Mat> BgrCodes(const std::vector<CalibrationFrame>& frames) {
   std::vector<cv::Mat> out;
   for (const auto& f : frames) {
-    cv::Mat bgr = f.photo.pixels;
+    cv::Mat bgr = Codes8(f.photo);
     if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
     if (f.photo.rgb_order) cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
     out.push_back(bgr);

@@ -111,7 +111,7 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
     throw BadInput("--frames: expected at least 2 bracketed frames, got " +
                    std::to_string(frames.size()));
   std::string out;
-  if (frames[0].photo.pixels.depth() != CV_8U) {
+  if (!frames[0].photo.EightBitCodes()) {
     // Linear data: nothing to recover, only to verify.
     if (!Prepare(dataset, "linearity.json", c.force, &out)) return 0;
     nlohmann::json report = CheckLinearity(frames);
@@ -119,7 +119,7 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
     report["kind"] = "linearity";
     MakeCalib(dataset);
     WriteJsonAtomically(out, report);
-    LogInfo("response: ", frames[0].photo.pixels.elemSize1() * 8,
+    LogInfo("response: ", frames[0].photo.CodeBits(),
             "-bit frames are linear data: no curve recovered; value / exposure deviates from the "
             "middle exposure's by at most ",
             100 * report["max_deviation"].get<double>(), " % -> ", out);

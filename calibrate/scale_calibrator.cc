@@ -116,7 +116,7 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
     PhotoSpec spec = PhotoSpecOf(dataset, e);
     spec.corrections = corrections;
     const Photo photo = DecodePhoto(dataset.PhotoPath(e.file), spec);
-    srgb = srgb || (photo.transfer == Transfer::kSrgb && photo.pixels.depth() != CV_32F);
+    srgb = srgb || (photo.transfer == Transfer::kSrgb && photo.CodeBits() < 32);
     if (photo.pixels.cols != screen.image_width || photo.pixels.rows != screen.image_height)
       throw InputError(photo.path, "image size",
                        std::to_string(screen.image_width) + "x" +

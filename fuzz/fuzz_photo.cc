@@ -23,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   spec.exposure = 0.25;
   Photo srgb = photo;
   srgb.spec = spec;
-  if (photo.pixels.depth() != CV_32F) srgb.transfer = Transfer::kSrgb;
+  if (photo.CodeBits() < 32) srgb.transfer = Transfer::kSrgb;
   const LinearReader reader(srgb);
   float rgb[3];
   bool clipped[3];

@@ -47,12 +47,14 @@ namespace {
 
 // The stored codes of `photo` map to linear values as code * Gain() - Offset(), with nothing
 // else applied per pixel (the condition under which Photo's Gain/Offset/SaturationCode may stand
-// in for LinearReader): linear transfer, unity white balance, 16-bit or float RGB.
+// in for LinearReader): linear transfer, unity white balance, 16-bit or float RGB. (A JPEG's
+// fractional codes go through the code tables, which share the reader's clipping rule.)
 bool CodesAreLinear(const Photo& photo) {
   const int type = photo.pixels.type();
   // A dark map, hot pixels or a flat field (calib/) differ per pixel: only LinearReader has them.
   return photo.transfer == Transfer::kLinear && photo.UnityWhiteBalance() &&
-         !photo.PixelCorrections() && (type == CV_16UC3 || type == CV_32FC3);
+         !photo.PixelCorrections() && !photo.fractional_codes &&
+         (type == CV_16UC3 || type == CV_32FC3);
 }
 
 // One pass over both photos of a position: F x F box sums of T+ and T-, their weighted
@@ -196,7 +198,8 @@ struct Exposure {
   // 8-bit photos: u per code and channel, [c * 256 + code] for c = R, G, B, NaN where clipped,
   // read through the reader from a 256-pixel photo holding every code, so the table is the
   // decoder's own linearisation. Valid because LinearReader maps a code the same way at every
-  // pixel. Empty for other photos.
+  // pixel. A JPEG's fractional codes read it between codes (ReadFractionalCodes). Empty for
+  // other photos.
   std::vector<float> code_u;
   int slide = 0;        // 0: p, 1: n
   float recorded = 1;   // exposure in dataset.json
@@ -221,12 +224,17 @@ struct Exposure {
     linear_codes = CodesAreLinear(photo);
     // The tables assume a code means the same at every pixel: not so with calib/'s dark map,
     // hot pixels or flat field (such photos are read through the reader, pixel by pixel).
-    if (photo.pixels.depth() == CV_8U && !photo.PixelCorrections()) {
+    if (photo.EightBitCodes() && !photo.PixelCorrections()) {
       Photo codes = photo;
       codes.pixels.create(1, 256, photo.pixels.type());
       for (int v = 0; v < 256; ++v)
-        for (int c = 0; c < codes.pixels.channels(); ++c)
-          codes.pixels.ptr<uint8_t>(0)[v * codes.pixels.channels() + c] = uint8_t(v);
+        for (int c = 0; c < codes.pixels.channels(); ++c) {
+          const int i = v * codes.pixels.channels() + c;
+          if (photo.fractional_codes)
+            codes.pixels.ptr<float>(0)[i] = float(v);
+          else
+            codes.pixels.ptr<uint8_t>(0)[i] = uint8_t(v);
+        }
       const LinearReader code_reader(codes);
       code_u.resize(3 * 256);
       for (int v = 0; v < 256; ++v) {
@@ -246,7 +254,7 @@ struct Exposure {
     transfer = photo.transfer;
     black = float(photo.spec.black_level);
     range = float(photo.spec.white_level - photo.spec.black_level);
-    code_step = photo.pixels.depth() == CV_32F ? 0.f : float(1.0 / (photo.CodeMax() * range));
+    code_step = photo.CodeBits() == 32 ? 0.f : float(1.0 / (photo.CodeMax() * range));
     read_var = float(std::pow(noise.read_noise_e / noise.full_well_e, 2));
     // n codes above black (the curve's slope at black: exact for sRGB up to code 10), or three
     // read-noise sigmas, whichever is larger.
@@ -331,6 +339,20 @@ void ReadCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict u
   }
 }
 
+// A JPEG's fractional codes (RGB order) through the same tables, read linearly between codes;
+// NaN (clipped) when the next whole code up is, as LinearReader has it:
+void ReadFractionalCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
+  const float* __restrict row = e.source->pixels.ptr<float>(y) + 3 * x0;
+  for (int x = 0; x < pixels; ++x, row += 3, uk += 3)
+    for (int c = 0; c < 3; ++c) {
+      const float code = row[c];
+      const int k = int(code);
+      const float f = code - float(k);
+      const float* t = e.code_u.data() + c * 256 + k;
+      uk[c] = f > 0 ? t[0] + f * (t[1] - t[0]) : t[0];  // k < 255 whenever f > 0
+    }
+}
+
 // Any other photo (calib/'s dark map, hot pixels or flat field), pixel by pixel:
 void ReadPixels(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
   for (int x = 0; x < pixels; ++x) {
@@ -364,7 +386,10 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
           const Exposure& e = exposures[order[k]];
           float* uk = &u[k * 3];
           if (!e.code_u.empty()) {  // the reader's values (all finite) through its table
-            ReadCodes(e, y, x, 1, uk);
+            if (e.source->fractional_codes)
+              ReadFractionalCodes(e, y, x, 1, uk);
+            else
+              ReadCodes(e, y, x, 1, uk);
             continue;
           }
           float v[3];
@@ -696,6 +721,8 @@ struct MergeRows {
           ReadLinear<uint16_t>(e, y, x0, pixels, uk);
         else if (e.linear_codes)
           ReadLinear<float>(e, y, x0, pixels, uk);
+        else if (!e.code_u.empty() && e.source->fractional_codes)
+          ReadFractionalCodes(e, y, x0, pixels, uk);
         else if (!e.code_u.empty())
           ReadCodes(e, y, x0, pixels, uk);
         else

@@ -61,11 +61,11 @@ std::vector<DecodedPhoto> DecodePosition(
   // One camera writes one kind of photo: an 8-bit photo among 16-bit ones (or the other way)
   // would be linearised differently and merged as if it were the same measurement.
   for (const auto& p : photos)
-    if (p.photo.pixels.depth() != photos[0].photo.pixels.depth())
-      throw InputError(p.photo.path, "bit depth",
-                       std::to_string(photos[0].photo.pixels.elemSize1() * 8) + " bits like " +
-                           photos[0].photo.path,
-                       std::to_string(p.photo.pixels.elemSize1() * 8) + " bits");
+    if (p.photo.CodeBits() != photos[0].photo.CodeBits())
+      throw InputError(
+          p.photo.path, "bit depth",
+          std::to_string(photos[0].photo.CodeBits()) + " bits like " + photos[0].photo.path,
+          std::to_string(p.photo.CodeBits()) + " bits");
   if (photos[0].photo.transfer == Transfer::kSrgb && dataset.photo_transfer == "auto") {
     static std::once_flag said;
     std::call_once(said, [&] {

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/input_file.h"
+#include "lib/photo/jpeg_decode.h"
 #include "lib/photo/raw_decode.h"
 
 namespace lumislab {
@@ -192,6 +193,7 @@ PhotoFormat DetectPhotoFormat(const std::string& path) {
 }
 
 double Photo::CodeMax() const {
+  if (fractional_codes) return 255.0;
   switch (pixels.depth()) {
     case CV_8U:
       return 255.0;
@@ -219,6 +221,7 @@ bool Photo::PixelCorrections() const {
 }
 
 double Photo::SaturationCode() const {
+  if (fractional_codes) return spec.saturation_level * CodeMax();
   if (pixels.depth() == CV_32F) return spec.saturation_level;
   return std::ceil(spec.saturation_level * CodeMax() - 1e-9);
 }
@@ -245,15 +248,20 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
       photo.white_balance = raw.as_shot_white_balance;
   } else {
     if (photo.format == PhotoFormat::kPng) CheckPng(path);
-    photo.pixels = DecodeWithOpenCv(path);
+    if (photo.format == PhotoFormat::kJpeg) photo.pixels = DecodeJpegFractional(path);
+    if (!photo.pixels.empty()) {
+      photo.fractional_codes = photo.rgb_order = true;
+    } else {  // not a colour JPEG: its codes as stored
+      photo.pixels = DecodeWithOpenCv(path);
+    }
   }
   photo.transfer = spec.transfer != Transfer::kAuto ? spec.transfer
-                   : photo.pixels.depth() == CV_8U  ? Transfer::kSrgb
+                   : photo.EightBitCodes()          ? Transfer::kSrgb
                                                     : Transfer::kLinear;
   if (photo.format == PhotoFormat::kRaw) photo.transfer = Transfer::kLinear;  // sensor values
   if (const PhotoCorrections* c = spec.corrections.get()) {
     // The calibrated camera curve is what an 8-bit code means, whatever the dataset says.
-    if (c->response && photo.pixels.depth() == CV_8U) photo.transfer = Transfer::kResponse;
+    if (c->response && photo.EightBitCodes()) photo.transfer = Transfer::kResponse;
     auto check_size = [&](const ImageF& map, const std::string& file) {
       if (map.width != photo.pixels.cols || map.height != photo.pixels.rows)
         throw InputError(
@@ -273,12 +281,14 @@ LinearReader::LinearReader(const Photo& photo) : photo_(photo) {
   b_ = channels_ == 1 ? 0 : 2 - r_;
   const PhotoCorrections* corrections = photo.spec.corrections.get();
   const bool srgb = photo.transfer == Transfer::kSrgb;
-  for (int c = 0; c < 3; ++c)
+  for (int c = 0; c < 3; ++c) {
     for (int v = 0; v < 256; ++v)
       curve8_[c][v] = photo.transfer == Transfer::kResponse
                           ? corrections->response->linear_of_code[c][v]
                       : srgb ? SrgbToLinear(v / 255.f)
                              : v / 255.f;
+    curve8_[c][256] = curve8_[c][255];
+  }
   inv_max_ = float(1.0 / photo.CodeMax());
   black_ = float(photo.spec.black_level);
   inv_range_ = float(1.0 / (photo.spec.white_level - photo.spec.black_level));
@@ -303,7 +313,15 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
   if (dark_ && dark_->hot[pixel]) return ReadHot(y, x, rgb, clipped);
   for (int c = 0; c < 3; ++c) {
     float v;
-    if (m.depth() == CV_32F) {
+    if (photo_.fractional_codes) {
+      // Between two codes the curve is read linearly; the code counts as clipped when the next
+      // whole code up does (the merge's code tables have the same rule).
+      const float code = m.ptr<float>(y)[size_t(x) * channels_ + offsets[c]];
+      const int k = int(code);
+      const float f = code - float(k);
+      v = curve8_[c][k] + f * (curve8_[c][k + 1] - curve8_[c][k]);
+      clipped[c] = !(curve8_[c][k + (f > 0)] < saturation_);
+    } else if (m.depth() == CV_32F) {
       v = m.ptr<float>(y)[size_t(x) * channels_ + offsets[c]];
     } else if (m.depth() == CV_16U) {
       v = m.ptr<uint16_t>(y)[size_t(x) * channels_ + offsets[c]] * inv_max_;
@@ -311,7 +329,7 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
     } else {
       v = curve8_[c][m.ptr<uint8_t>(y)[size_t(x) * channels_ + offsets[c]]];
     }
-    clipped[c] = !(v < saturation_);  // NaN counts as clipped
+    if (!photo_.fractional_codes) clipped[c] = !(v < saturation_);  // NaN counts as clipped
     // Linear value before the exposure division, less the sensor's dark signal at this exposure;
     // then per unit exposure, less the pixel's gain.
     float linear;
@@ -355,6 +373,14 @@ void LinearReader::ReadHot(int y, int x, float rgb[3], bool clipped[3]) const {
     rgb[c] = n ? float(sum[c] / n) : 0.f;
     if (n == 0) clipped[c] = true;
   }
+}
+
+cv::Mat Codes8(const Photo& photo) {
+  LUMISLAB_CHECK(photo.EightBitCodes(), "Codes8: a photo of 8-bit codes");
+  if (!photo.fractional_codes) return photo.pixels;
+  cv::Mat codes;
+  photo.pixels.convertTo(codes, CV_8U);  // rounds to the nearest code
+  return codes;
 }
 
 cv::Mat LinearGray(const Photo& photo) {

@@ -63,8 +63,12 @@ struct Photo {
   std::string path;
   PhotoFormat format = PhotoFormat::kPng;
   // As stored: CV_8U or CV_16U with 1 or 3 channels (BGR order, as OpenCV decodes), or CV_32FC3
-  // in RGB order (EXR channels R, G, B; camera RAW with white level 1).
+  // in RGB order (EXR channels R, G, B; camera RAW with white level 1; a colour JPEG's codes with
+  // their fractions, fractional_codes).
   cv::Mat pixels;
+  // A colour JPEG (lib/photo/jpeg_decode.h): pixels are 8-bit codes in [0, 255] kept with the
+  // fractions of the decoder's colour conversion, read through the transfer curve between codes.
+  bool fractional_codes = false;
   bool rgb_order = false;
   Transfer transfer = Transfer::kLinear;  // resolved: never kAuto
   PhotoSpec spec;
@@ -72,7 +76,12 @@ struct Photo {
   // channel is clipped where the sensor was, whatever the white balance (RAW kAsShot).
   std::array<float, 3> white_balance = {1, 1, 1};
 
-  double CodeMax() const;  // 255, 65535 or 1 (float)
+  double CodeMax() const;  // 255 (8-bit codes, fractional or not), 65535 or 1 (float)
+  // 8-bit camera codes (CV_8U, or a JPEG's fractional codes): linearised through the sRGB curve
+  // or a calibrated response.
+  bool EightBitCodes() const { return pixels.depth() == CV_8U || fractional_codes; }
+  // Bits per stored code (8, 16; 32 for float values), for messages and consistency checks.
+  int CodeBits() const { return fractional_codes ? 8 : int(pixels.elemSize1() * 8); }
   // For a linear transfer: linear value = code * Gain() - Offset(). (Fast paths that work on
   // the stored codes use these, and only when UnityWhiteBalance(); everything else uses
   // LinearReader.)
@@ -110,12 +119,16 @@ class LinearReader {
   const Photo& photo_;
   int channels_;
   int r_, b_;             // offsets of red and blue in a pixel
-  float curve8_[3][256];  // R, G, B: 8-bit code -> curve value
+  float curve8_[3][257];  // R, G, B: 8-bit code -> curve value (257: code 255 + 1 for lerps)
   float inv_max_, black_, inv_range_, inv_exposure_, exposure_, inv_range_exposure_, saturation_;
   float white_balance_[3];         // R, G, B
   const DarkMap* dark_ = nullptr;  // per-pixel corrections (PhotoSpec::corrections)
   const FlatMap* flat_ = nullptr;
 };
+
+// An 8-bit-code photo's codes as CV_8U in storage order (fractional codes rounded): what the
+// detectors and the response fit look at.
+cv::Mat Codes8(const Photo& photo);
 
 // The whole photo as linear, exposure-normalised Rec. 709 luminance (CV_32FC1); BadInput when a
 // value is not finite.

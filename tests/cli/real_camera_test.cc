@@ -222,8 +222,8 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   const auto rows = Evidence("JPEG camera, noise-free", {"response", "dark", "flat", "scale"});
   ASSERT_EQ(rows.size(), 5u);
   ASSERT_EQ(rows[0].positions.size(), 9u);
-  // 0.95 % overall, 1.06 % worst position: without noise the 8-bit rounding of the curve's
-  // output and of JPEG's decoder is not dithered, and 4 x 4-pixel means keep it
+  // 0.86 % overall, 0.92 % worst position: without noise the 8-bit rounding of the curve's
+  // output and JPEG's coding are not dithered, and 4 x 4-pixel means keep them
   // (docs/design.md §5.16). Held at 1.2 % so that a regression shows.
   for (const auto& p : rows[0].positions)
     EXPECT_LE(p.relative_l2, 0.012) << "position " << p.i << "," << p.j;
@@ -253,20 +253,17 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   while (response.Inverse(first_clipped / 255.0) < 0.95) ++first_clipped;
   sensor.saturation = response.Inverse((first_clipped - 0.5) / 255);
   const testing::NoiseFloor floor = CompareWithNoiseFloor("ds_noisy", noisy, sensor);
-  // Issue 8 asks for 1 % per position and 1.5x the noise floor. Measured: 0.87 % overall,
-  // 1.02 % worst position (2,2), 1.8x the floor of 0.48 % (docs/design.md §5.16). The curve
-  // that calibrate response recovers is within 0.4 % RMS of the true one, and the true curve
-  // gives the same (0.86 % / 1.02 %): what is left is the 8-bit coding. JPEG's chroma
-  // subsampling costs little (4:4:4: 0.84 % / 0.99 %), its compression more (quality 100,
-  // 4:4:4: 0.72 % / 0.88 %), and so does the decoder's rounding of its YCbCr -> RGB conversion
-  // to 8-bit codes (converted in floating point and linearised at the fractional code:
-  // 0.77 % / 0.89 %; not done yet: the photo pipeline carries 8-bit photos as integer codes).
-  // Held at 1.1 % per position, 0.95 % overall and 2x the floor so that a regression shows;
-  // the DNG camera below holds both of the issue's bounds.
+  // Issue 8 asks for 1 % per position and 1.5x the noise floor. Measured: 0.77 % overall,
+  // 0.90 % worst position (2,2), 1.62x the floor of 0.47 % (docs/design.md §5.16). The curve
+  // that calibrate response recovers is within 0.4 % RMS of the true one and gives what the true
+  // curve gives; the decoder keeps the fractions of JPEG's YCbCr -> RGB conversion (0.87 % /
+  // 1.02 % when it rounded them). What is left above the floor is JPEG's coding, which the floor
+  // leaves out (quality 100, 4:4:4: 0.72 % / 0.88 % even with the rounded conversion).
+  // The issue's 1 % per position; 0.85 % overall and 1.8x the floor so that a regression shows.
   for (const auto& p : noisy.positions)
-    EXPECT_LE(p.relative_l2, 0.011) << "position " << p.i << "," << p.j;
-  EXPECT_LE(noisy.overall_relative_l2, 0.0095);
-  EXPECT_LE(noisy.overall_relative_l2, 2 * floor.overall);
+    EXPECT_LE(p.relative_l2, 0.01) << "position " << p.i << "," << p.j;
+  EXPECT_LE(noisy.overall_relative_l2, 0.0085);
+  EXPECT_LE(noisy.overall_relative_l2, 1.8 * floor.overall);
   // The noise is there: not below its floor.
   EXPECT_GE(noisy.overall_relative_l2, floor.overall);
 }

@@ -1,0 +1,153 @@
+#include "lib/photo/jpeg_decode.h"
+
+#include <jpeglib.h>
+
+#include <csetjmp>
+#include <cstdio>
+// jerror.h after jpeglib.h, which it needs
+#include <jerror.h>
+#include <libexif/exif-data.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/error.h"
+#include "lib/photo/photo_io.h"
+
+namespace lumislab {
+namespace {
+
+// libjpeg reports a fatal error through error_exit, which must not return: it jumps back to
+// DecodeJpegFractional with the message, which becomes BadInput there (no C++ object with a
+// destructor lives between the setjmp and the libjpeg calls that may jump).
+struct ErrorManager {
+  jpeg_error_mgr base;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+void ErrorExit(j_common_ptr info) {
+  auto* error = reinterpret_cast<ErrorManager*>(info->err);
+  info->err->format_message(info, error->message);
+  std::longjmp(error->jump, 1);
+}
+
+// The warnings that say the data ended early (libjpeg then pads the image with grey) are errors
+// for a measurement: a truncated photo is not a photo. Other warnings (extraneous bytes before a
+// marker, which some cameras write) are not.
+void EmitMessage(j_common_ptr info, int level) {
+  if (level < 0 && (info->err->msg_code == JWRN_JPEG_EOF || info->err->msg_code == JWRN_HIT_MARKER))
+    ErrorExit(info);
+}
+
+// EXIF Orientation (1-8) from the APP1 markers libjpeg kept; 1 when there is none.
+int Orientation(j_decompress_ptr info) {
+  for (jpeg_saved_marker_ptr m = info->marker_list; m; m = m->next) {
+    if (m->marker != JPEG_APP0 + 1 || m->data_length < 6) continue;
+    ExifData* exif = exif_data_new_from_data(m->data, m->data_length);
+    if (!exif) continue;
+    int orientation = 1;
+    if (ExifEntry* e = exif_data_get_entry(exif, EXIF_TAG_ORIENTATION))
+      if (e->format == EXIF_FORMAT_SHORT && e->components == 1)
+        orientation = exif_get_short(e->data, exif_data_get_byte_order(exif));
+    exif_data_unref(exif);
+    return orientation >= 1 && orientation <= 8 ? orientation : 1;
+  }
+  return 1;
+}
+
+// The orientation as OpenCV's imread applies it (modules/imgcodecs ExifTransform).
+void Orient(int orientation, cv::Mat& image) {
+  switch (orientation) {
+    case 2:
+      cv::flip(image, image, 1);
+      break;
+    case 3:
+      cv::flip(image, image, -1);
+      break;
+    case 4:
+      cv::flip(image, image, 0);
+      break;
+    case 5:
+      cv::transpose(image, image);
+      break;
+    case 6:
+      cv::transpose(image, image);
+      cv::flip(image, image, 1);
+      break;
+    case 7:
+      cv::transpose(image, image);
+      cv::flip(image, image, -1);
+      break;
+    case 8:
+      cv::transpose(image, image);
+      cv::flip(image, image, 0);
+      break;
+    default:
+      break;
+  }
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+}  // namespace
+
+cv::Mat DecodeJpegFractional(const std::string& path) {
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) throw BadInput(path + ": cannot open the photo");
+  jpeg_decompress_struct info;
+  ErrorManager error;
+  info.err = jpeg_std_error(&error.base);
+  error.base.error_exit = ErrorExit;
+  error.base.emit_message = EmitMessage;
+  cv::Mat out;  // allocated before the setjmp: a jump back leaves it to its destructor
+  std::vector<JSAMPLE> row;
+  if (setjmp(error.jump)) {
+    jpeg_destroy_decompress(&info);
+    throw BadInput(path + ": cannot decode the JPEG (" + error.message + ")");
+  }
+  jpeg_create_decompress(&info);
+  jpeg_stdio_src(&info, file.get());
+  jpeg_save_markers(&info, JPEG_APP0 + 1, 0xffff);
+  jpeg_read_header(&info, TRUE);
+  if (info.num_components != 3 || info.jpeg_color_space != JCS_YCbCr) {
+    jpeg_destroy_decompress(&info);
+    return cv::Mat();
+  }
+  if (uint64_t(info.image_width) * info.image_height > uint64_t(kMaxPhotoPixels)) {
+    const std::string size =
+        std::to_string(info.image_width) + "x" + std::to_string(info.image_height);
+    jpeg_destroy_decompress(&info);
+    throw InputError(path, "image size",
+                     "an image of 1 .. " + std::to_string(kMaxPhotoPixels) + " pixels", size);
+  }
+  const int orientation = Orientation(&info);
+  info.out_color_space = JCS_YCbCr;  // libjpeg's inverse DCT and upsampling, no conversion
+  jpeg_start_decompress(&info);
+  const int w = int(info.output_width), h = int(info.output_height);
+  out.create(h, w, CV_32FC3);
+  row.resize(size_t(w) * 3);
+  while (info.output_scanline < info.output_height) {
+    JSAMPLE* rows[1] = {row.data()};
+    const int y = int(info.output_scanline);
+    jpeg_read_scanlines(&info, rows, 1);
+    float* rgb = out.ptr<float>(y);
+    // JFIF's conversion (ITU-R BT.601 full range), which libjpeg's integer tables round.
+    for (int x = 0; x < w; ++x) {
+      const float luma = row[3 * x], cb = row[3 * x + 1] - 128.f, cr = row[3 * x + 2] - 128.f;
+      const float r = luma + 1.402f * cr, g = luma - 0.34413629f * cb - 0.71413629f * cr,
+                  b = luma + 1.772f * cb;
+      rgb[3 * x] = std::min(255.f, std::max(0.f, r));
+      rgb[3 * x + 1] = std::min(255.f, std::max(0.f, g));
+      rgb[3 * x + 2] = std::min(255.f, std::max(0.f, b));
+    }
+  }
+  jpeg_finish_decompress(&info);
+  jpeg_destroy_decompress(&info);
+  Orient(orientation, out);
+  return out;
+}
+
+}  // namespace lumislab

@@ -1,0 +1,23 @@
+// Colour JPEG photos decoded without the 8-bit rounding of the colour conversion (docs/design.md
+// §5.4), for DecodePhoto. A JPEG stores Y, Cb and Cr as 8-bit samples; a decoder's conversion to
+// R, G and B (R = Y + 1.402 (Cr - 128), ...) lands between codes and every decoder then rounds it
+// to an 8-bit code again, an error of up to half a code on top of the camera's own rounding that
+// the response curve then magnifies (one code is 1-5 % of a dark value). Here libjpeg decodes to
+// Y, Cb, Cr (its inverse DCT and chroma upsampling, as every decoder) and the conversion is done
+// in floating point: the codes keep their fractions, and the curve is read between its codes.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace lumislab {
+
+// Decodes a baseline or progressive JPEG whose components are YCbCr (JFIF, or EXIF without an
+// Adobe transform) into CV_32FC3 in RGB order holding codes in [0, 255] with their fractions, in
+// the orientation its EXIF Orientation tag gives (as OpenCV's imread shows it). Returns an empty
+// Mat for a JPEG of any other colour space (grayscale, CMYK, RGB): those store codes directly and
+// go through OpenCV. A corrupt or truncated file, or one larger than kMaxPhotoPixels, is BadInput
+// naming the file.
+cv::Mat DecodeJpegFractional(const std::string& path);
+
+}  // namespace lumislab

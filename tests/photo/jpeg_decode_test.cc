@@ -1,0 +1,102 @@
+// The colour JPEG decoder (lib/photo/jpeg_decode.h): the same picture as OpenCV's decoder, less
+// the rounding of the colour conversion; truncated files refused; other JPEGs left to OpenCV.
+#include "lib/photo/jpeg_decode.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "lib/photo/photo_io.h"
+#include "photo_test_util.h"
+
+namespace lumislab {
+namespace {
+
+using testing::ScratchDir;
+using testing::ThrowsBadInputNaming;
+
+// The sRGB curve (IEC 61966-2-1), as the decoder's tables hold it.
+float SrgbToLinear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+// A smooth colour picture with noise, as a camera's JPEG holds (BGR).
+cv::Mat Picture() {
+  cv::Mat bgr(48, 64, CV_8UC3);
+  cv::RNG rng(7);
+  for (int y = 0; y < bgr.rows; ++y)
+    for (int x = 0; x < bgr.cols; ++x)
+      for (int c = 0; c < 3; ++c)
+        bgr.at<cv::Vec3b>(y, x)[c] =
+            cv::saturate_cast<uint8_t>(40 + 2.5 * x + (c + 1) * y + rng.gaussian(2.0));
+  return bgr;
+}
+
+TEST(JpegDecode, OpenCvsPictureWithTheConversionsFractions) {
+  const std::string path = ScratchDir() + "/p.jpg";
+  ASSERT_TRUE(cv::imwrite(path, Picture(), {cv::IMWRITE_JPEG_QUALITY, 95}));
+  const cv::Mat ours = DecodeJpegFractional(path);
+  ASSERT_EQ(ours.type(), CV_32FC3);
+  cv::Mat opencv = cv::imread(path), opencv_rgb, opencv_f;
+  cv::cvtColor(opencv, opencv_rgb, cv::COLOR_BGR2RGB);
+  opencv_rgb.convertTo(opencv_f, CV_32F);
+  // OpenCV (libjpeg's integer tables) rounds the same conversion: within about half a code.
+  cv::Mat diff = cv::abs(ours - opencv_f);
+  double max_diff = 0;
+  cv::minMaxLoc(diff.reshape(1), nullptr, &max_diff);
+  EXPECT_LE(max_diff, 0.51 + 1e-3);
+  // And the fractions are there: a code is rarely whole.
+  int whole = 0;
+  const cv::Mat values = ours.reshape(1);
+  for (int y = 0; y < values.rows; ++y)
+    for (int x = 0; x < values.cols; ++x)
+      whole += values.at<float>(y, x) == std::floor(values.at<float>(y, x));
+  EXPECT_LT(whole, int(ours.total()));  // of 3 x total values
+  std::printf("whole codes: %d of %d values\n", whole, int(3 * ours.total()));
+  // DecodePhoto takes them as 8-bit codes, read through the sRGB curve between codes.
+  const Photo photo = DecodePhoto(path);
+  EXPECT_TRUE(photo.fractional_codes);
+  EXPECT_TRUE(photo.EightBitCodes());
+  EXPECT_EQ(photo.CodeBits(), 8);
+  EXPECT_EQ(photo.CodeMax(), 255);
+  EXPECT_EQ(photo.transfer, Transfer::kSrgb);
+  const LinearReader reader(photo);
+  float rgb[3];
+  bool clipped[3];
+  reader.Read(10, 20, rgb, clipped);
+  const cv::Vec3f code = ours.at<cv::Vec3f>(10, 20);
+  for (int c = 0; c < 3; ++c) {
+    const int k = int(code[c]);
+    const float f = code[c] - k;
+    const float expect =
+        SrgbToLinear(k / 255.f) + f * (SrgbToLinear((k + 1) / 255.f) - SrgbToLinear(k / 255.f));
+    EXPECT_NEAR(rgb[c], expect, 1e-6) << c;
+    EXPECT_FALSE(clipped[c]);
+  }
+}
+
+TEST(JpegDecode, GrayJpegIsLeftToOpenCv) {
+  const std::string path = ScratchDir() + "/g.jpg";
+  cv::Mat gray;
+  cv::cvtColor(Picture(), gray, cv::COLOR_BGR2GRAY);
+  ASSERT_TRUE(cv::imwrite(path, gray));
+  EXPECT_TRUE(DecodeJpegFractional(path).empty());
+  const Photo photo = DecodePhoto(path);
+  EXPECT_FALSE(photo.fractional_codes);
+  EXPECT_EQ(photo.pixels.type(), CV_8UC1);
+}
+
+TEST(JpegDecode, TruncatedJpegIsRefusedNamingIt) {
+  const std::string path = ScratchDir() + "/t.jpg";
+  ASSERT_TRUE(cv::imwrite(path, Picture(), {cv::IMWRITE_JPEG_QUALITY, 95}));
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+  std::string message;
+  EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(path); }, path, &message));
+  EXPECT_NE(message.find("JPEG"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace lumislab

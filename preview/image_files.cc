@@ -24,4 +24,15 @@ void WriteImage(const std::string& path, const ImageF& image, double exposure_fa
   }
 }
 
+void WriteImageOrPicture(const std::string& path, const ImageF& image, const Rgb8Image& picture) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".exr") {
+    WriteExr(path, image, {"R", "G", "B"});
+  } else if (ext == ".png") {
+    WriteRgb8File(path, picture.width, picture.height, picture.rgb);
+  } else {
+    throw BadInput(path + ": output must end in .exr or .png");
+  }
+}
+
 }  // namespace lumislab

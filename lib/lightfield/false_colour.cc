@@ -126,7 +126,7 @@ FalseColourScale AutoScale(const std::vector<float>& values, bool log) {
     scale.max = 1;
   } else if (log) {
     scale.max = std::pow(10.0, std::ceil(std::log10(top)));
-    scale.min = std::pow(10.0, std::floor(std::log10(top / 1000)));
+    scale.min = scale.max / 1000;
   } else {
     const double step = LinearStep(0, top);
     scale.min = 0;
@@ -175,10 +175,16 @@ Rgb8Image RenderFalseColour(const std::vector<float>& values, int width, int hei
                   std::to_string(width) + "x" + std::to_string(height) + " picture");
   const int s = std::max(1, height / 320);  // text and bar scale
   const int total_height = std::max(height, 120 * s);
-  Rgb8Image image(width + BarPanelWidth(height), total_height, kPanel);
+  const std::string unit_line = options.unit + (scale.log ? " (log)" : "");
+  Rgb8Image image(width + std::max(BarPanelWidth(height), TextWidth(unit_line, s) + 20 * s),
+                  total_height, kPanel);
   const std::vector<double> ticks = scale.Ticks();
+  // No iso-line at the bottom tick: at 0 it would outline every unlit surface.
+  std::vector<double> levels;
+  for (const double tick : ticks)
+    if (scale.Position(tick) > 1e-9) levels.push_back(tick);
   const std::vector<uint8_t> iso = options.iso_lines
-                                       ? IsoLineMask(values, width, height, ticks, scale.log)
+                                       ? IsoLineMask(values, width, height, levels, scale.log)
                                        : std::vector<uint8_t>(values.size(), 0);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -197,7 +203,7 @@ Rgb8Image RenderFalseColour(const std::vector<float>& values, int width, int hei
   // level, labelled to its right; the unit above it.
   const int bar_x0 = width + 10 * s, bar_x1 = bar_x0 + 16 * s;
   const int bar_y0 = 24 * s, bar_y1 = total_height - 10 * s;
-  DrawText(image, bar_x0, 8 * s, options.unit + (scale.log ? " (log)" : ""), kText, s);
+  DrawText(image, bar_x0, 8 * s, unit_line, kText, s);
   for (int y = bar_y0; y < bar_y1; ++y) {
     const Rgb8 c = Viridis(1.0 - double(y - bar_y0) / (bar_y1 - 1 - bar_y0));
     FillRect(image, bar_x0, y, bar_x1, y + 1, c);
@@ -214,8 +220,53 @@ Rgb8Image RenderFalseColour(const std::vector<float>& values, int width, int hei
   return image;
 }
 
+FalseColourScale FalseColourRequest::Resolve(const std::vector<float>& values) const {
+  if (!(max > min)) return AutoScale(values, log);
+  FalseColourScale scale{min, max, log};
+  scale.Check("false-colour range");
+  return scale;
+}
+
+void ParseFalseColourRange(const std::string& text, const std::string& option,
+                           FalseColourRequest* request) {
+  if (text == "auto") {
+    request->min = request->max = 0;
+    return;
+  }
+  const size_t colon = text.find(':');
+  double min = NAN, max = NAN;
+  try {
+    size_t used_min = 0, used_max = 0;
+    min = std::stod(text.substr(0, colon), &used_min);
+    max = std::stod(text.substr(colon + 1), &used_max);
+    if (colon == std::string::npos || used_min != colon || used_max != text.size() - colon - 1)
+      min = max = NAN;
+  } catch (const std::exception&) {
+    min = max = NAN;
+  }
+  FalseColourScale scale{min, max, request->log};
+  if (std::isnan(min) || std::isnan(max))
+    throw InputError(option, "", "min:max (e.g. 0:500) or auto", text);
+  scale.Check(option);
+  request->min = min;
+  request->max = max;
+}
+
+Rgb8Image FalseColourPicture(const ImageF& irradiance, const FalseColourRequest& request,
+                             const std::string& unit, double mm_per_pixel,
+                             const std::string& title) {
+  const std::vector<float> values = PixelLuminance(irradiance);
+  FalseColourOptions options;
+  options.scale = request.Resolve(values);
+  options.unit = unit;
+  options.mm_per_pixel = mm_per_pixel;
+  options.title = title;
+  return RenderFalseColour(values, irradiance.width, irradiance.height, options);
+}
+
 std::string FormatTick(double value, double step) {
   char text[32];
+  if (std::abs(value) < 1e-9 * std::abs(step)) value = 0;  // no "-0.0" from k * step
   const double magnitude = std::abs(value);
   if (magnitude >= 1e6 || (magnitude > 0 && magnitude < 1e-3)) {
     std::snprintf(text, sizeof text, "%.3g", value);

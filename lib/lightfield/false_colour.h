@@ -35,7 +35,7 @@ struct FalseColourScale {
 };
 
 // The scale for an image when the user gives none: linear from 0 to the largest value rounded
-// up to a nice number; log from 1/1000 of that to it, both rounded out to decades. An image
+// up to a nice number; log from 1/1000 of that to it, the top rounded up to a decade. An image
 // without light gives [0, 1] ([1e-3, 1] log).
 FalseColourScale AutoScale(const std::vector<float>& values, bool log);
 
@@ -64,6 +64,24 @@ struct FalseColourOptions {
 Rgb8Image RenderFalseColour(const std::vector<float>& values, int width, int height,
                             const FalseColourOptions& options);
 int BarPanelWidth(int height);
+
+// What a user asks for (lumislab-preview --view false-colour, lumislab-export irradiance): the
+// scale's kind and range, automatic (AutoScale of the picture's values) unless max > min.
+struct FalseColourRequest {
+  bool log = false;         // --false-colour-scale log
+  double min = 0, max = 0;  // --false-colour-range min:max; max <= min: automatic
+  FalseColourScale Resolve(const std::vector<float>& values) const;
+};
+// "min:max" (finite numbers, min < max; min > 0 for log) or "auto" into `request`; BadInput
+// naming `option` otherwise.
+void ParseFalseColourRange(const std::string& text, const std::string& option,
+                           FalseColourRequest* request);
+
+// The whole picture of a linear RGB irradiance image: its PixelLuminance through the resolved
+// scale, iso-lines, the bar in `unit`, a scale bar when mm_per_pixel > 0 and the title.
+Rgb8Image FalseColourPicture(const ImageF& irradiance, const FalseColourRequest& request,
+                             const std::string& unit, double mm_per_pixel,
+                             const std::string& title = "");
 
 // "1500", "0.25", "2e+05": a tick value with as many decimals as the ticks' step needs.
 std::string FormatTick(double value, double step);

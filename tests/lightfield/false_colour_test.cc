@@ -61,6 +61,7 @@ TEST(FalseColour, LinearAndLogTicks) {
   EXPECT_EQ(FormatTick(0.25, 0.05), "0.25");
   EXPECT_EQ(FormatTick(1500, 500), "1500");
   EXPECT_EQ(FormatTick(0.01, 0.01), "0.01");
+  EXPECT_EQ(FormatTick(-1e-17, 0.5), "0.0");
 }
 
 TEST(FalseColour, AutoScaleCoversThe995thPercentile) {
@@ -72,7 +73,7 @@ TEST(FalseColour, AutoScaleCoversThe995thPercentile) {
   EXPECT_DOUBLE_EQ(linear.max, 100);  // 99.4 rounded up to the tick step 10
   const FalseColourScale log = AutoScale(values, true);
   EXPECT_DOUBLE_EQ(log.max, 100);
-  EXPECT_DOUBLE_EQ(log.min, 0.01);
+  EXPECT_DOUBLE_EQ(log.min, 0.1);  // three decades
   const FalseColourScale dark = AutoScale(std::vector<float>(10, 0.f), false);
   EXPECT_EQ(dark.max, 1);
 }

@@ -104,14 +104,16 @@ PolarPlot MakePolarPlot(const PolarPlotData& data, int size) {
   for (const double tick : scale.Ticks()) {  // grid circles (arcs over the shown gamma range)
     if (tick <= 0) continue;
     PolarPlot::Line arc{{}, kGrid, 1, 0};
-    for (int k = 0; k <= 360; ++k) {
-      const double g = (-gamma_max + k * gamma_max / 180) * M_PI / 180;
+    for (int k = 0; k <= int(gamma_max); ++k) {  // 2-degree chords: 0.04 px from the circle
+      const double g = (-gamma_max + 2 * k) * M_PI / 180;
       arc.xy.push_back(cx + tick * pixels_per_unit * std::sin(g));
       arc.xy.push_back(cy + tick * pixels_per_unit * std::cos(g));
     }
     plot.lines.push_back(arc);
+    // Labelled where the circle meets the right-hand 90-degree line, away from the curves
+    // (brightest near gamma = 0).
     plot.texts.push_back(
-        {cx + 4, cy + tick * pixels_per_unit - 8, FormatTick(tick, step), 11, -1, kLabel});
+        {cx + tick * pixels_per_unit, cy - 8, FormatTick(tick, step), 11, 0, kLabel});
   }
   for (int g = -int(gamma_max); g <= int(gamma_max); g += 15) {  // radial lines
     if (!half && g == 180) continue;                             // the same line as -180
@@ -120,7 +122,9 @@ PolarPlot MakePolarPlot(const PolarPlotData& data, int size) {
     plot.lines.push_back(
         {{cx, cy, cx + radius * ex, cy + radius * ey}, g == 0 ? kAxis : kGrid, 1, 0});
     if (g % 30 == 0)
-      plot.texts.push_back({cx + (radius + 16) * ex, cy + (radius + 12) * ey,
+      plot.texts.push_back({cx + (radius + 16) * ex,
+                            // 90 degrees: below its line, the circles' labels are above it
+                            cy + (radius + 12) * ey + (std::abs(g) == 90 ? 10 : 0),
                             std::to_string(std::abs(g)) + "\u00B0", 11, 0, kLabel});
   }
   const std::string unit_label = "I in " + data.unit;

@@ -62,6 +62,10 @@ TEST(FalseColour, LinearAndLogTicks) {
   EXPECT_EQ(FormatTick(1500, 500), "1500");
   EXPECT_EQ(FormatTick(0.01, 0.01), "0.01");
   EXPECT_EQ(FormatTick(-1e-17, 0.5), "0.0");
+  EXPECT_EQ(IrradianceUnitLabel("lux"), "lx");
+  EXPECT_EQ(IrradianceUnitLabel("W/m^2"), "W/m\u00B2");
+  EXPECT_EQ(IntensityUnitLabel("lux"), "cd");
+  EXPECT_EQ(IntensityUnitLabel("W/m^2"), "W/sr");
 }
 
 TEST(FalseColour, AutoScaleCoversThe995thPercentile) {

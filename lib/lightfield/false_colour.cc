@@ -89,7 +89,7 @@ double FalseColourScale::Position(double value) const {
 
 std::vector<double> FalseColourScale::Ticks() const {
   if (!log) return LinearTicks(min, max);
-  const bool fine = std::log10(max / min) < 3;
+  const bool fine = std::log10(max / min) <= 3 + 1e-9;  // the automatic 3 decades included
   std::vector<double> ticks;
   for (int e = int(std::floor(std::log10(min))); e <= int(std::ceil(std::log10(max))); ++e)
     for (const double m : {1.0, 2.0, 5.0}) {

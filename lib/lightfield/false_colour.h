@@ -28,7 +28,7 @@ struct FalseColourScale {
   // Position in [0, 1] (clamped; values below min, and NaN, give 0).
   double Position(double value) const;
   // "Nice" values inside [min, max]: linear, multiples of 1, 2 or 5 x 10^k giving 4-10 ticks;
-  // log, the decades (with 2 and 5 of each when the range spans under 3 decades).
+  // log, the decades (with 2 and 5 of each when the range spans at most 3 decades).
   std::vector<double> Ticks() const;
   // BadInput naming `what` unless min < max, both finite, and min > 0 for log.
   void Check(const std::string& what) const;

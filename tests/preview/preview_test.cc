@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/exr_io.h"
 #include "core/geometry.h"
 #include "core/slab.h"
 #include "lib/lightfield/camera.h"
@@ -17,6 +18,7 @@
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/scenes.h"
+#include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
@@ -278,6 +280,21 @@ TEST(PreviewCommandLine, FalseColourView) {
   const cv::Mat picture = cv::imread(png);
   EXPECT_EQ(picture.rows, 120);
   EXPECT_EQ(picture.cols, 120 + BarPanelWidth(120));
+  // The .exr is the irradiance, the same from OpenGL and from the CPU reference (at D = d both
+  // are exact up to the bilinear texels, §4.5).
+  const std::string gl = (dir / "gl.exr").string(), cpu = (dir / "cpu.exr").string();
+  for (const auto& [out, extra] :
+       {std::pair{gl, std::vector<std::string>{"--no-shadows"}},
+        std::pair{cpu, std::vector<std::string>{"--reference", "--samples", "1"}}}) {
+    std::vector<std::string> args = {"--slab", slab,     "--scene",      "plane", "--size",
+                                     "60x60",  "--view", "false-colour", "--out", out};
+    args.insert(args.end(), extra.begin(), extra.end());
+    ASSERT_EQ(RunPreviewWith(args), 0) << extra[0];
+  }
+  const double error =
+      CompareImages(ReadExr(gl, {"R", "G", "B"}), ReadExr(cpu, {"R", "G", "B"})).relative_l2;
+  std::printf("false-colour irradiance, OpenGL vs reference: %.2e\n", error);
+  EXPECT_LT(error, 2e-3);
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--false-colour-range", "2:1"},
         {"--false-colour-range", "0:x"},

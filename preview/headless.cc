@@ -36,10 +36,15 @@ double Median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-void WriteOutput(const PreviewConfig& config, const Renderer& renderer) {
+void WriteOutput(const PreviewConfig& config, const SceneSetup& setup, const SlabInfo& info,
+                 const Renderer& renderer) {
   if (config.out.empty()) return;
   const ImageF image = renderer.Read();
-  WriteImage(config.out, image, ExposureFactor(image, config.exposure_stops, config.auto_exposure));
+  if (config.false_colour)
+    WriteImageOrPicture(config.out, image, FalseColourView(config, setup, info, image));
+  else
+    WriteImage(config.out, image,
+               ExposureFactor(image, config.exposure_stops, config.auto_exposure));
 }
 
 // Renders again with the other accumulation format and logs how far sRGBE is from float.
@@ -80,7 +85,8 @@ void RunBench(const PreviewConfig& config, const SceneSetup& setup, double aspec
 
 // --watch: polls the slab folder, re-rendering and rewriting --out as positions arrive, until
 // all of them are in or a stop signal arrives.
-void WatchSlab(const PreviewConfig& config, SlabInfo info, Renderer& renderer) {
+void WatchSlab(const PreviewConfig& config, const SceneSetup& setup, SlabInfo info,
+               Renderer& renderer) {
   while (renderer.PositionCount() < info.grid.count() && !StopRequested()) {
     std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
     try {
@@ -95,7 +101,7 @@ void WatchSlab(const PreviewConfig& config, SlabInfo info, Renderer& renderer) {
     // the finished slab, byte for byte).
     if (renderer.PositionCount() == info.grid.count()) renderer.SetOptions(renderer.options());
     renderer.Render();
-    WriteOutput(config, renderer);
+    WriteOutput(config, setup, info, renderer);
     LogInfo("positions ", renderer.PositionCount(), "/", info.grid.count(), " (new: ", added.size(),
             ")");
   }
@@ -118,13 +124,13 @@ int RunHeadless(const PreviewConfig& config, const SlabInfo& info) {
   LoadNewPositions(config.slab_dir, info, renderer, config.threads);
   if (!config.watch) CheckListedPositionsLoaded(config.slab_dir, info, renderer);
   renderer.Render();
-  WriteOutput(config, renderer);
+  WriteOutput(config, setup, info, renderer);
   LogInfo("rendered ", renderer.PositionCount(), "/", info.grid.count(), " positions, ",
           setup.mesh.triangles(), " triangles, ", width, "x", height,
           config.out.empty() ? "" : " -> " + config.out);
   if (config.report_srgbe_error || config.srgbe) ReportSrgbeError(renderer);
   if (config.bench) RunBench(config, setup, aspect, renderer);
-  if (config.watch) WatchSlab(config, info, renderer);
+  if (config.watch) WatchSlab(config, setup, info, renderer);
   return 0;
 }
 

@@ -7,11 +7,15 @@
 #include <vector>
 
 #include "core/image.h"
+#include "lib/lightfield/raster.h"
 
 namespace lumislab {
 
 // 8-bit RGB, rows top first (width * height * 3 bytes), as a PNG.
 void WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+// .exr (linear RGB, `image`) or .png (`picture`, e.g. a false-colour view); BadInput for other
+// endings.
+void WriteImageOrPicture(const std::string& path, const ImageF& image, const Rgb8Image& picture);
 // .exr (linear RGB) or .png (times exposure_factor, sRGB 8-bit); BadInput for other endings.
 void WriteImage(const std::string& path, const ImageF& image, double exposure_factor);
 

@@ -9,6 +9,7 @@
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/scene.h"
 #include "preview/image_files.h"
+#include "preview/run_preview.h"
 
 namespace lumislab {
 namespace {
@@ -41,8 +42,12 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!image.complete) throw Failure("stopped by a signal; " + config.out + " not written");
-  WriteImage(config.out, image.image,
-             ExposureFactor(image.image, config.exposure_stops, config.auto_exposure));
+  if (config.false_colour)  // the irradiance, before albedo: as the OpenGL false-colour view
+    WriteImageOrPicture(config.out, image.irradiance,
+                        FalseColourView(config, setup, info, image.irradiance));
+  else
+    WriteImage(config.out, image.image,
+               ExposureFactor(image.image, config.exposure_stops, config.auto_exposure));
   if (analytic)
     LogInfo("analytic image of ", config.analytic, " (", luminaire.emitters.size(), " emitters), ",
             setup.mesh.triangles(), " triangles, ", view.width(), "x", view.height(), " in ",

@@ -106,6 +106,7 @@ uniform int u_layers[LIGHTS_PER_PASS];
 uniform bool u_shadows;
 uniform float u_offset_scale;  // normal offset per mm of distance (one shadow texel)
 uniform float u_radiance_scale;
+uniform bool u_unit_albedo;  // irradiance view (false colour): E before the materials
 uniform bool u_srgbe;
 uniform usampler2D u_previous;
 uniform vec2 u_grid_half;  // half extent of the filter centres: the union of all spot cones
@@ -141,7 +142,7 @@ void main() {
     vec3 intensity = texture(u_intensity, vec3(uv, float(u_layers[k]))).rgb;
     sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
   }
-  vec3 radiance = sum * v_albedo * u_radiance_scale;
+  vec3 radiance = sum * (u_unit_albedo ? vec3(1.0) : v_albedo) * u_radiance_scale;
   o_float = vec4(radiance, 1.0);
   if (u_srgbe) {
     vec3 previous = DecodeSrgbe(texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r);
@@ -434,6 +435,7 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glUniform1i(Loc(p, "u_shadows"), options_.shadows);
   glUniform1i(Loc(p, "u_srgbe"), options_.srgbe);
   glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
+  glUniform1i(Loc(p, "u_unit_albedo"), options_.unit_albedo ? 1 : 0);
   const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);
   glUniform2f(Loc(p, "u_grid_half"), float(corner.x()), float(corner.y()));
   // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.

@@ -27,6 +27,9 @@ struct RenderOptions {
   bool shadow_pcf = false;  // 2x2 filtered depth compare (softer edges, ~15 % slower)
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
   bool cull_back_faces = false;  // camera passes only: see into a closed room from outside
+  // Albedo 1 everywhere: with radiance_scale 1 the image is the irradiance E arriving at each
+  // surface (W/m^2), which --view false-colour maps.
+  bool unit_albedo = false;
 };
 
 constexpr int kLightsPerPass = 64;

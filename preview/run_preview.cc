@@ -26,6 +26,9 @@ namespace {
 // What the command line gives beyond PreviewConfig.
 struct CommandLineExtras {
   std::string size = "400x400";
+  std::string view = "normal";
+  std::string false_colour_range = "auto";
+  std::string false_colour_scale = "linear";
   bool write_test_slab = false;
 };
 
@@ -46,9 +49,22 @@ void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ex
                  "plane mode: side W in mm (default: window D/d)");
 }
 
-void AddRenderOptions(CLI::App& app, PreviewConfig& config) {
+void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
   app.add_option("--exposure", config.exposure_stops, "exposure in stops (on top of auto)");
   app.add_flag("!--no-auto-exposure", config.auto_exposure, "no automatic exposure");
+  app.add_option("--view", extras.view,
+                 "normal (radiance, tone-mapped) | false-colour (the irradiance arriving at each "
+                 "pixel, before albedo, in the slab's unit: viridis, colour bar, iso-lines at its "
+                 "ticks; .png gets that picture, .exr the irradiance)")
+      ->check(CLI::IsMember({"normal", "false-colour"}))
+      ->capture_default_str();
+  app.add_option("--false-colour-range", extras.false_colour_range,
+                 "--view false-colour: min:max in the slab's unit, or auto (0 .. the 99.5th "
+                 "percentile rounded up; log: 3 decades below it)")
+      ->capture_default_str();
+  app.add_option("--false-colour-scale", extras.false_colour_scale, "linear | log")
+      ->check(CLI::IsMember({"linear", "log"}))
+      ->capture_default_str();
   app.add_flag("!--no-shadows", config.shadows, "no shadow maps");
   app.add_flag("--srgbe", config.srgbe, "sRGBE-packed accumulation (paper §4.2)");
   app.add_flag("--srgbe-error", config.report_srgbe_error,
@@ -96,6 +112,14 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
     throw InputError("--shadow-size", "shadow-size", "16..4096",
                      std::to_string(config.shadow_size));
   }
+  config.false_colour = extras.view == "false-colour";
+  config.false_colour_scale.log = extras.false_colour_scale == "log";
+  ParseFalseColourRange(extras.false_colour_range, "--false-colour-range",
+                        &config.false_colour_scale);
+  // The window draws the normal view only until its false-colour toggle exists (it flips
+  // config.false_colour and draws FalseColourView).
+  if (config.false_colour && config.window)
+    throw BadInput("--view false-colour is for headless output (--out x.png) so far, not --window");
   if (config.reference || !config.analytic.empty()) {
     const char* mode = config.reference ? "--reference" : "--analytic";
     for (const auto& [set, option] : {std::pair{config.window, "--window"},
@@ -163,7 +187,8 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.srgbe = config.srgbe;
   options.shadow_size = config.shadow_size;
   options.shadow_pcf = config.shadow_pcf;
-  if (setup.plane) options.radiance_scale = 1.0;
+  if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
+  options.unit_albedo = config.false_colour;
   options.cull_back_faces = setup.closed_room;
   return options;
 }
@@ -198,6 +223,15 @@ std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, c
   return added;
 }
 
+Rgb8Image FalseColourView(const PreviewConfig& config, const SceneSetup& setup,
+                          const SlabInfo& info, const ImageF& irradiance) {
+  const double mm_per_pixel = setup.plane ? setup.extent / irradiance.width : 0;
+  const std::string title =
+      setup.plane ? "plane at " + FormatTick(setup.plane_z, 1) + " mm" : std::string();
+  return FalseColourPicture(irradiance, config.false_colour_scale, IrradianceUnitLabel(info.units),
+                            mm_per_pixel, title);
+}
+
 bool ParseSize(const std::string& text, int* width, int* height) {
   static const std::regex pattern("([0-9]{1,5})x([0-9]{1,5})");
   std::smatch match;
@@ -221,7 +255,7 @@ int RunPreview(int argc, char** argv) {
   CommandLineExtras extras;
   AddCommonOptions(&app, &common);
   AddSceneOptions(app, config, extras);
-  AddRenderOptions(app, config);
+  AddRenderOptions(app, config, extras);
   AddModeOptions(app, config, extras);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   config.threads = StartTool("preview", common);

@@ -9,6 +9,7 @@
 
 #include "core/image.h"
 #include "core/slab.h"
+#include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/scene_setup.h"
 #include "preview/renderer.h"
 
@@ -21,6 +22,11 @@ struct PreviewConfig {
   std::string out;            // headless output (.exr linear, .png tone-mapped)
   double exposure_stops = 0;  // PNG / window exposure; NaN-free: 0 + auto
   bool auto_exposure = true;
+  // --view false-colour: the irradiance arriving at each pixel (W/m^2 or lux, before albedo and
+  // tone mapping) through lib/lightfield/false_colour.h, with colour bar and iso-lines; the
+  // window's toggle flips `false_colour` (MakeRenderOptions then gives unit albedo).
+  bool false_colour = false;
+  FalseColourRequest false_colour_scale;  // --false-colour-range, --false-colour-scale
   bool shadows = true;
   bool srgbe = false;
   int shadow_size = 512;
@@ -53,6 +59,12 @@ std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config);
 // `threads` threads); returns the positions loaded.
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
                                                   Renderer& renderer, int threads);
+// The picture --out gets in false colour: `irradiance` (the renderer's image with unit albedo and
+// radiance scale 1, or the reference's irradiance) with the bar in the slab's unit; on the plane
+// a scale bar (its extent over `width` pixels) and the plane's distance as the title.
+Rgb8Image FalseColourView(const PreviewConfig& config, const SceneSetup& setup,
+                          const SlabInfo& info, const ImageF& irradiance);
+
 // Strict "WxH" (digits only, each 1..8192): false for anything else ("400x400junk").
 bool ParseSize(const std::string& text, int* width, int* height);
 

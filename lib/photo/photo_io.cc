@@ -411,6 +411,18 @@ void WriteImageFile(const std::string& path, const cv::Mat& image, const std::ve
   });
 }
 
+void WriteRgb8File(const std::string& path, int width, int height,
+                   const std::vector<uint8_t>& rgb) {
+  if (rgb.size() != size_t(width) * height * 3) throw Failure(path + ": RGB buffer size mismatch");
+  cv::Mat bgr(height, width, CV_8UC3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const uint8_t* p = &rgb[(size_t(y) * width + x) * 3];
+      bgr.at<cv::Vec3b>(y, x) = cv::Vec3b(p[2], p[1], p[0]);
+    }
+  WriteImageFile(path, bgr);
+}
+
 cv::Mat PhotoCodes(const ImageF& linear, PhotoEncoding encoding) {
   LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "PhotoCodes: 1 or 3 channels");
   const bool srgb = encoding == PhotoEncoding::kSrgb8Png;

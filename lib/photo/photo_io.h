@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
@@ -139,6 +140,9 @@ cv::Mat LinearGray(const Photo& photo);
 // cv::imwrite's (e.g. IMWRITE_JPEG_QUALITY, q).
 void WriteImageFile(const std::string& path, const cv::Mat& image,
                     const std::vector<int>& params = {});
+// 8-bit RGB (width * height * 3 bytes, RGB interleaved, row 0 on top: lib/lightfield's Rgb8Image
+// and the preview's tone-mapped frames) through WriteImageFile (PNG by the path's ending).
+void WriteRgb8File(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 
 // How the synthetic camera stores a photo of normalised linear RGB values (ImageF, 3 channels).
 enum class PhotoEncoding {

@@ -61,7 +61,9 @@ void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string
 }
 
 SlabInfo TruthSlabInfo(const SynthScene& scene, int resolution) {
-  return SlabInfo::FromDataset(DatasetSkeleton(scene), resolution);
+  SlabInfo info = SlabInfo::FromDataset(DatasetSkeleton(scene), resolution);
+  info.units = "W/m^2";  // TruthPosition's values are irradiance in W/m^2, not relative
+  return info;
 }
 
 SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution) {

@@ -2,18 +2,23 @@
 // irradiance against the analytic irradiance of a point-emitter luminaire, partial slabs and
 // incremental (--watch) accumulation, cached shadow maps, sRGBE accumulation error.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/exr_io.h"
 #include "core/geometry.h"
 #include "core/slab.h"
 #include "lib/lightfield/camera.h"
+#include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/scenes.h"
+#include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
@@ -212,6 +217,29 @@ TEST_F(PreviewSlabFiles, SrgbeAccumulationStaysCloseToFloat) {
   EXPECT_GT(error, 0.0);  // it is really packed
 }
 
+// --view false-colour maps the irradiance before the materials: with every albedo 0.5 the normal
+// view is 0.5 / pi of the unit-albedo one, pixel for pixel.
+TEST_F(PreviewSlabFiles, UnitAlbedoIsTheIrradianceBeforeTheMaterials) {
+  SceneSetup setup = MakeSceneSetup("crypt", info_);
+  for (Eigen::Vector3f& albedo : setup.mesh.albedo) albedo = {0.5f, 0.5f, 0.5f};
+  RenderOptions irradiance_view;
+  irradiance_view.radiance_scale = 1;
+  irradiance_view.unit_albedo = true;
+  ImageF images[2];
+  for (int k = 0; k < 2; ++k) {
+    Renderer renderer(info_, 96, 96, k == 0 ? RenderOptions{} : irradiance_view);
+    renderer.SetScene(setup.mesh);
+    renderer.SetPose(setup.pose);
+    renderer.SetCamera(OrbitCamera(setup, 1.0));
+    Upload(renderer, ScanSlabPositions(dir_.string(), info_));
+    renderer.Render();
+    images[k] = renderer.Read();
+  }
+  for (float& v : images[0].data) v *= float(M_PI / 0.5);
+  EXPECT_LE(RelativeDifference(images[0], images[1]), 1e-5);
+  EXPECT_GT(*std::max_element(images[1].data.begin(), images[1].data.end()), 0);
+}
+
 int RunPreviewWith(std::vector<std::string> args) {
   args.insert(args.begin(), "lumislab-preview");
   std::vector<char*> argv;
@@ -235,6 +263,55 @@ TEST(PreviewCommandLine, SizeIsCheckedStrictly) {
   EXPECT_EQ(code, 2);
   EXPECT_NE(err.find("--size"), std::string::npos) << err;
   EXPECT_NE(err.find("400x400junk"), std::string::npos) << err;
+}
+
+// The false-colour PNG is the picture with its colour bar to the right (wider than --size); the
+// EXR keeps the irradiance; a bad range or the window is refused (exit 2), nothing written.
+TEST(PreviewCommandLine, FalseColourView) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("lumislab_false_colour_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string slab = (dir / "slab").string(), png = (dir / "fc.png").string();
+  WriteTruthSlab(DefaultScene().luminaire, DefaultSlabInfo(3, 3, 10, 40), slab, 2);
+  EXPECT_EQ(RunPreviewWith({"--slab", slab, "--scene", "plane", "--size", "120x120", "--view",
+                            "false-colour", "--false-colour-range", "0:2", "--out", png}),
+            0);
+  const cv::Mat picture = cv::imread(png);
+  EXPECT_EQ(picture.rows, 120);
+  EXPECT_EQ(picture.cols, 120 + BarPanelWidth(120));
+  // The .exr is the irradiance, the same from OpenGL and from the CPU reference (at D = d both
+  // are exact up to the bilinear texels, §4.5).
+  const std::string gl = (dir / "gl.exr").string(), cpu = (dir / "cpu.exr").string();
+  for (const auto& [out, extra] :
+       {std::pair{gl, std::vector<std::string>{"--no-shadows"}},
+        std::pair{cpu, std::vector<std::string>{"--reference", "--samples", "1"}}}) {
+    std::vector<std::string> args = {"--slab", slab,     "--scene",      "plane", "--size",
+                                     "60x60",  "--view", "false-colour", "--out", out};
+    args.insert(args.end(), extra.begin(), extra.end());
+    ASSERT_EQ(RunPreviewWith(args), 0) << extra[0];
+  }
+  const double error =
+      CompareImages(ReadExr(gl, {"R", "G", "B"}), ReadExr(cpu, {"R", "G", "B"})).relative_l2;
+  std::printf("false-colour irradiance, OpenGL vs reference: %.2e\n", error);
+  EXPECT_LT(error, 2e-3);
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"--false-colour-range", "2:1"},
+        {"--false-colour-range", "0:x"},
+        {"--false-colour-range", "0:5", "--false-colour-scale", "log"},
+        {"--view", "false-color"},
+        {"--window"}}) {
+    std::vector<std::string> args = {
+        "--slab", slab,           "--scene", "plane",
+        "--view", "false-colour", "--out",   (dir / "bad.png").string()};
+    args.insert(args.end(), bad.begin(), bad.end());
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(RunPreviewWith(args), 2) << bad[0];
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(err.find(bad[0]), std::string::npos) << err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(PreviewCommandLine, HelpNamesLlvmpipeThreads) {

@@ -39,7 +39,7 @@ double Median(std::vector<double> v) {
 void WriteOutput(const PreviewConfig& config, const Renderer& renderer) {
   if (config.out.empty()) return;
   const ImageF image = renderer.Read();
-  WriteImage(config.out, image, ExposureFactor(image, config.exposure_stops, config.auto_exposure));
+  WriteImage(config.out, image, config.tone);
 }
 
 // Renders again with the other accumulation format and logs how far sRGBE is from float.
@@ -104,9 +104,9 @@ void WatchSlab(const PreviewConfig& config, SlabInfo info, Renderer& renderer) {
 }  // namespace
 
 int RunHeadless(const PreviewConfig& config, const SlabInfo& info) {
-  OffscreenContext context(16, 16);
-  LogDebug("GL renderer: ", context.Renderer());
-  const SceneSetup setup = MakeSceneSetup(config.scene, info);
+  const HeadlessContext context(config.backend == Backend::kEgl);
+  LogInfo("backend ", BackendName(config.backend), ": ", context.Renderer());
+  const SceneSetup setup = MakePreviewSetup(config, info);
   const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
   const double aspect = double(width) / height;

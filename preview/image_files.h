@@ -7,12 +7,13 @@
 #include <vector>
 
 #include "core/image.h"
+#include "lib/lightfield/tone_map.h"
 
 namespace lumislab {
 
 // 8-bit RGB, rows top first (width * height * 3 bytes), as a PNG.
 void WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
-// .exr (linear RGB) or .png (times exposure_factor, sRGB 8-bit); BadInput for other endings.
-void WriteImage(const std::string& path, const ImageF& image, double exposure_factor);
+// .exr (linear RGB) or .png (ToneMapToSrgb8 under `tone`); BadInput for other endings.
+void WriteImage(const std::string& path, const ImageF& image, const ToneMapping& tone);
 
 }  // namespace lumislab

@@ -24,7 +24,7 @@ std::vector<PointSource> PointSources(const Luminaire& luminaire) {
 }  // namespace
 
 int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
-  const SceneSetup setup = MakeSceneSetup(config.scene, info);
+  const SceneSetup setup = MakePreviewSetup(config, info);
   ReferenceOptions options;
   options.samples = config.samples;
   options.threads = config.threads;
@@ -41,8 +41,7 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!image.complete) throw Failure("stopped by a signal; " + config.out + " not written");
-  WriteImage(config.out, image.image,
-             ExposureFactor(image.image, config.exposure_stops, config.auto_exposure));
+  WriteImage(config.out, image.image, config.tone);
   if (analytic)
     LogInfo("analytic image of ", config.analytic, " (", luminaire.emitters.size(), " emitters), ",
             setup.mesh.triangles(), " triangles, ", view.width(), "x", view.height(), " in ",

@@ -244,9 +244,10 @@ void ApplyRequests(WindowState& s, int fb_w, int fb_h) {
   s.options_changed = false;
   if (s.pose_changed) s.renderer->SetPose(PoseFromValues(s.config.scene.pose));
   s.pose_changed = false;
+  if (fb_w != s.config.width || fb_h != s.config.height) s.camera_changed = true;  // aspect
   s.config.width = fb_w;
   s.config.height = fb_h;
-  if (fb_w > 0 && fb_h > 0) s.renderer->Resize(fb_w, fb_h);
+  s.renderer->Resize(fb_w, fb_h);
   if (s.setup.plane) {
     s.renderer->SetCamera(PlaneView(s.setup.plane_z, s.setup.extent));
   } else if (s.camera_changed) {
@@ -292,8 +293,10 @@ bool Frame(WindowState& s, GLFWwindow* window, double seconds) {
   ApplyRequests(s, fb_w, fb_h);
   const auto start = Clock::now();
   const int added = s.renderer->Render();
-  if (added > 0)
+  if (added > 0) {
     s.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    s.render_lights = added;
+  }
   UpdatePicture(s, added > 0);
 
   ImGui_ImplOpenGL3_NewFrame();

@@ -13,8 +13,10 @@ namespace lumislab {
 namespace {
 
 void Status(WindowState& s) {
-  ImGui::Text("%.1f fps  (frame %.1f ms, GL %.1f ms)", s.frame_ms > 0 ? 1000 / s.frame_ms : 0.0,
-              s.frame_ms, s.render_ms);
+  // A frame that adds no light only draws the picture and the panel; the last render is the
+  // frame that did (all lights after a camera, pose or option change; new positions otherwise).
+  ImGui::Text("%.1f fps (frame %.1f ms)  last render %.0f ms, %d lights",
+              s.frame_ms > 0 ? 1000 / s.frame_ms : 0.0, s.frame_ms, s.render_ms, s.render_lights);
   ImGui::Text("positions %d/%d", s.renderer->PositionCount(), s.info.grid.count());
   if (s.last_arrived.first >= 0) {
     ImGui::SameLine();

@@ -46,7 +46,9 @@ struct WindowState {
   // What the panel reports.
   std::pair<int, int> last_arrived{-1, -1};
   Clock::time_point last_poll = Clock::now();
-  double frame_ms = 0, render_ms = 0;  // last frame, and its Render() (the GL work)
+  double frame_ms = 0;   // the last frame's work (events, render, picture, panel)
+  double render_ms = 0;  // the last Render() that added light, and how many lights
+  int render_lights = 0;
   int frames = 0;
   std::string last_saved;  // the last screenshot's path
 };

@@ -1,6 +1,7 @@
 #include "lib/lightfield/tone_map.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/error.h"
@@ -93,10 +94,46 @@ double ApplyToneCurve(double x, ToneCurve curve) {
   return std::clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
 }
 
+namespace {
+
+// The sRGB encoding's code boundaries: code k (1..255) starts at the linear value whose encoded
+// value is (k - 0.5) / 255, so SrgbByte(v) is the number of boundaries <= v: the rounded code of
+// the exact curve. To find it without a pow() or a search per value (the window tone-maps each
+// new image: a 1080p picture is six million values), a table gives the code at the start of
+// each of 4096 equal steps of [0, 1]; no step holds more than one boundary (the curve's steepest
+// slope, 12.92 * 255 codes per unit, is 0.8 codes per step), so one or two comparisons finish.
+constexpr int kSteps = 4096;
+
+struct SrgbTables {
+  std::array<double, 256> bounds{};  // bounds[k - 1]: where code k starts; bounds[255] = inf
+  std::array<uint8_t, kSteps + 1> step_code{};
+  SrgbTables() {
+    for (int k = 1; k <= 255; ++k) {
+      const double c = (k - 0.5) / 255.0;
+      bounds[k - 1] = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    }
+    bounds[255] = INFINITY;
+    for (int i = 0; i <= kSteps; ++i)
+      step_code[i] =
+          uint8_t(std::upper_bound(bounds.begin(), bounds.begin() + 255, double(i) / kSteps) -
+                  bounds.begin());
+  }
+};
+
+const SrgbTables& Tables() {
+  static const SrgbTables tables;
+  return tables;
+}
+
+}  // namespace
+
 uint8_t SrgbByte(double linear) {
-  const double v = std::clamp(linear, 0.0, 1.0);
-  const double encoded = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-  return uint8_t(std::clamp(encoded * 255.0 + 0.5, 0.0, 255.0));
+  if (!(linear > 0)) return 0;  // negatives and NaN
+  if (linear >= 1) return 255;
+  const SrgbTables& t = Tables();
+  int code = t.step_code[int(linear * kSteps)];
+  while (linear >= t.bounds[code]) ++code;  // bounds[255] = inf stops it
+  return uint8_t(code);
 }
 
 std::vector<uint8_t> EncodeSrgb8(const ImageF& image, double exposure_factor, ToneCurve curve) {

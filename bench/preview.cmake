@@ -9,7 +9,8 @@ if(TARGET lumislab_preview_renderer)
   # The renderer on a real GPU through EGL vs OSMesa; links neither (both are dlopen()ed), so the
   # binary and a few libraries can be carried to a GPU node.
   add_executable(preview_gpu_check ${CMAKE_CURRENT_LIST_DIR}/preview_gpu_check.cc)
-  target_link_libraries(preview_gpu_check PRIVATE lumislab_preview_renderer lumislab_lightfield
+  target_link_libraries(preview_gpu_check PRIVATE lumislab_preview_renderer lumislab_preview_egl
+                        lumislab_lightfield
                         lumislab_synthetic ${CMAKE_DL_LIBS})
   lumislab_warnings(preview_gpu_check)
 endif()

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
 #include "lib/synthetic/truth.h"
+#include "preview/egl_context.h"
 #include "preview/renderer.h"
 
 namespace lumislab {
@@ -27,19 +29,7 @@ namespace {
 
 using Proc = void (*)();
 
-// --- EGL (types from the EGL 1.5 headers, spelled out to need no headers at build time) ---
-using EGLDisplay = void*;
-using EGLConfig = void*;
-using EGLContext = void*;
-using EGLint = int32_t;
-constexpr EGLint kEglNone = 0x3038, kEglSurfaceType = 0x3033, kEglPbufferBit = 0x0001,
-                 kEglRenderableType = 0x3040, kEglOpenglBit = 0x0008, kEglOpenglApi = 0x30A2,
-                 kEglContextMajor = 0x3098, kEglContextMinor = 0x30FB,
-                 kEglContextProfileMask = 0x30FD, kEglCoreProfileBit = 0x1,
-                 kEglPlatformDevice = 0x313F;
-
-void* g_egl_proc_source = nullptr;
-Proc (*g_get_proc)(const char*) = nullptr;
+Proc (*g_get_proc)(const char*) = nullptr;  // OSMesa's, for glad
 GLADapiproc LoadProc(const char* name) { return reinterpret_cast<GLADapiproc>(g_get_proc(name)); }
 
 template <typename F>
@@ -47,53 +37,6 @@ F Sym(void* lib, const char* name) {
   void* p = dlsym(lib, name);
   if (!p) throw Failure(std::string("missing symbol ") + name);
   return reinterpret_cast<F>(p);
-}
-
-void MakeEglContext() {
-  void* lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_GLOBAL);
-  if (!lib) throw Failure(std::string("cannot open libEGL.so.1: ") + dlerror());
-  g_egl_proc_source = lib;
-  auto get_proc = Sym<Proc (*)(const char*)>(lib, "eglGetProcAddress");
-  g_get_proc = get_proc;
-  auto initialize = Sym<unsigned (*)(EGLDisplay, EGLint*, EGLint*)>(lib, "eglInitialize");
-  auto choose = Sym<unsigned (*)(EGLDisplay, const EGLint*, EGLConfig*, EGLint, EGLint*)>(
-      lib, "eglChooseConfig");
-  auto bind_api = Sym<unsigned (*)(unsigned)>(lib, "eglBindAPI");
-  auto create = Sym<EGLContext (*)(EGLDisplay, EGLConfig, EGLContext, const EGLint*)>(
-      lib, "eglCreateContext");
-  auto make_current =
-      Sym<unsigned (*)(EGLDisplay, void*, void*, EGLContext)>(lib, "eglMakeCurrent");
-  // A device display (no window system): first EGL device.
-  using QueryDevices = unsigned (*)(EGLint, void**, EGLint*);
-  using GetPlatformDisplay = EGLDisplay (*)(unsigned, void*, const EGLint*);
-  auto query_devices = reinterpret_cast<QueryDevices>(get_proc("eglQueryDevicesEXT"));
-  auto platform_display =
-      reinterpret_cast<GetPlatformDisplay>(get_proc("eglGetPlatformDisplayEXT"));
-  EGLDisplay display = nullptr;
-  if (query_devices && platform_display) {
-    void* devices[8];
-    EGLint n = 0;
-    if (query_devices(8, devices, &n) && n > 0)
-      display = platform_display(kEglPlatformDevice, devices[0], nullptr);
-  }
-  if (!display) display = Sym<EGLDisplay (*)(void*)>(lib, "eglGetDisplay")(nullptr);
-  EGLint major = 0, minor = 0;
-  if (!display || !initialize(display, &major, &minor)) throw Failure("eglInitialize failed");
-  const EGLint config_attribs[] = {kEglSurfaceType, kEglPbufferBit, kEglRenderableType,
-                                   kEglOpenglBit, kEglNone};
-  EGLConfig config = nullptr;
-  EGLint count = 0;
-  if (!choose(display, config_attribs, &config, 1, &count) || count < 1)
-    throw Failure("eglChooseConfig found no OpenGL config");
-  if (!bind_api(kEglOpenglApi)) throw Failure("eglBindAPI(OpenGL) failed");
-  const EGLint context_attribs[] = {
-      kEglContextMajor,   4,       kEglContextMinor, 5, kEglContextProfileMask,
-      kEglCoreProfileBit, kEglNone};
-  EGLContext context = create(display, config, nullptr, context_attribs);
-  if (!context) throw Failure("eglCreateContext (GL 4.5 core) failed");
-  // Surfaceless: the renderer draws only into its own framebuffers.
-  if (!make_current(display, nullptr, nullptr, context)) throw Failure("eglMakeCurrent failed");
-  std::printf("EGL %d.%d\n", major, minor);
 }
 
 std::vector<unsigned char> g_osmesa_buffer(16 * 16 * 4);
@@ -135,8 +78,16 @@ int Run(int argc, char** argv) {
           "usage: preview_gpu_check --context egl|osmesa [--out x.exr] "
           "[--reference y.exr] [--frames N]");
   }
-  context == "egl" ? MakeEglContext() : MakeOsmesaContext();
-  if (!gladLoadGL(LoadProc)) throw Failure("gladLoadGL failed");
+  // EGL: any device, Mesa's software one included, so that EGL and OSMesa can be compared
+  // where there is no GPU.
+  std::unique_ptr<EglContext> egl;
+  if (context == "egl") {
+    egl = std::make_unique<EglContext>(EglContext::Device::kAnyDevice);
+    std::printf("%s\n", egl->Version().c_str());
+  } else {
+    MakeOsmesaContext();
+    if (!gladLoadGL(LoadProc)) throw Failure("gladLoadGL failed");
+  }
   std::printf("context %s: GL_RENDERER %s, GL_VERSION %s\n", context.c_str(),
               reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
               reinterpret_cast<const char*>(glGetString(GL_VERSION)));

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "preview/egl_context.h"
 
 namespace lumislab {
 namespace {
@@ -65,6 +66,19 @@ OffscreenContext::~OffscreenContext() {
 std::string OffscreenContext::Renderer() const {
   const GLubyte* renderer = glGetString(GL_RENDERER);
   return renderer ? reinterpret_cast<const char*>(renderer) : "?";
+}
+
+HeadlessContext::HeadlessContext(bool egl) {
+  if (egl)
+    egl_ = std::make_unique<EglContext>(EglContext::Device::kGpu);
+  else
+    osmesa_ = std::make_unique<OffscreenContext>(16, 16);
+}
+
+HeadlessContext::~HeadlessContext() = default;
+
+std::string HeadlessContext::Renderer() const {
+  return egl_ ? egl_->Renderer() : osmesa_->Renderer();
 }
 
 WindowContext::WindowContext(int width, int height, const std::string& title) {

@@ -1,5 +1,6 @@
-// GL contexts of the preview: OSMesa offscreen (headless renders, tests, benchmarks) and a GLFW
-// window, both loading GL 4.5 core through the same glad loader (docs/design.md §6).
+// GL contexts of the preview: OSMesa offscreen (headless renders, tests, benchmarks), EGL
+// (headless on a GPU, preview/egl_context.h) and a GLFW window, all loading GL 4.5 core through
+// the same glad loader (docs/design.md §6).
 #pragma once
 
 #include <memory>
@@ -23,6 +24,22 @@ class OffscreenContext {
  private:
   void* context_ = nullptr;
   std::vector<unsigned char> buffer_;
+};
+
+class EglContext;
+
+// The context of a headless run (--backend osmesa | egl), current from construction.
+class HeadlessContext {
+ public:
+  explicit HeadlessContext(bool egl);
+  ~HeadlessContext();
+  HeadlessContext(const HeadlessContext&) = delete;
+  HeadlessContext& operator=(const HeadlessContext&) = delete;
+  std::string Renderer() const;
+
+ private:
+  std::unique_ptr<OffscreenContext> osmesa_;
+  std::unique_ptr<EglContext> egl_;
 };
 
 // A GLFW window with a GL 4.5 core context (needs a display; Xvfb works).

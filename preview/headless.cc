@@ -43,8 +43,7 @@ void WriteOutput(const PreviewConfig& config, const SceneSetup& setup, const Sla
   if (config.false_colour)
     WriteImageOrPicture(config.out, image, FalseColourView(config, setup, info, image));
   else
-    WriteImage(config.out, image,
-               ExposureFactor(image, config.exposure_stops, config.auto_exposure));
+    WriteImage(config.out, image, config.tone);
 }
 
 // Renders again with the other accumulation format and logs how far sRGBE is from float.
@@ -110,9 +109,9 @@ void WatchSlab(const PreviewConfig& config, const SceneSetup& setup, SlabInfo in
 }  // namespace
 
 int RunHeadless(const PreviewConfig& config, const SlabInfo& info) {
-  OffscreenContext context(16, 16);
-  LogDebug("GL renderer: ", context.Renderer());
-  const SceneSetup setup = MakeSceneSetup(config.scene, info);
+  const HeadlessContext context(config.backend == Backend::kEgl);
+  LogInfo("backend ", BackendName(config.backend), ": ", context.Renderer());
+  const SceneSetup setup = MakePreviewSetup(config, info);
   const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
   const double aspect = double(width) / height;

@@ -1,5 +1,6 @@
-// Headless lumislab-preview (OSMesa): one render into --out, optionally the sRGBE-vs-float
-// report, a --bench timing and --watch polling that re-renders as positions arrive.
+// Headless lumislab-preview (--backend osmesa, or egl on a GPU): one render into --out,
+// optionally the sRGBE-vs-float report, a --bench timing and --watch polling that re-renders as
+// positions arrive.
 #pragma once
 
 #include "core/slab.h"

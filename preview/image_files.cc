@@ -13,12 +13,12 @@ void WritePng(const std::string& path, int width, int height, const std::vector<
   WriteRgb8File(path, width, height, rgb);
 }
 
-void WriteImage(const std::string& path, const ImageF& image, double exposure_factor) {
+void WriteImage(const std::string& path, const ImageF& image, const ToneMapping& tone) {
   const std::string ext = std::filesystem::path(path).extension().string();
   if (ext == ".exr") {
     WriteExr(path, image, {"R", "G", "B"});
   } else if (ext == ".png") {
-    WritePng(path, image.width, image.height, EncodeSrgb8(image, exposure_factor));
+    WritePng(path, image.width, image.height, ToneMapToSrgb8(image, tone));
   } else {
     throw BadInput(path + ": output must end in .exr or .png");
   }

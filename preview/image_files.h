@@ -8,6 +8,7 @@
 
 #include "core/image.h"
 #include "lib/lightfield/raster.h"
+#include "lib/lightfield/tone_map.h"
 
 namespace lumislab {
 
@@ -16,7 +17,7 @@ void WritePng(const std::string& path, int width, int height, const std::vector<
 // .exr (linear RGB, `image`) or .png (`picture`, e.g. a false-colour view); BadInput for other
 // endings.
 void WriteImageOrPicture(const std::string& path, const ImageF& image, const Rgb8Image& picture);
-// .exr (linear RGB) or .png (times exposure_factor, sRGB 8-bit); BadInput for other endings.
-void WriteImage(const std::string& path, const ImageF& image, double exposure_factor);
+// .exr (linear RGB) or .png (ToneMapToSrgb8 under `tone`); BadInput for other endings.
+void WriteImage(const std::string& path, const ImageF& image, const ToneMapping& tone);
 
 }  // namespace lumislab

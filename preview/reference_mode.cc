@@ -25,7 +25,7 @@ std::vector<PointSource> PointSources(const Luminaire& luminaire) {
 }  // namespace
 
 int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
-  const SceneSetup setup = MakeSceneSetup(config.scene, info);
+  const SceneSetup setup = MakePreviewSetup(config, info);
   ReferenceOptions options;
   options.samples = config.samples;
   options.threads = config.threads;
@@ -46,8 +46,7 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
     WriteImageOrPicture(config.out, image.irradiance,
                         FalseColourView(config, setup, info, image.irradiance));
   else
-    WriteImage(config.out, image.image,
-               ExposureFactor(image.image, config.exposure_stops, config.auto_exposure));
+    WriteImage(config.out, image.image, config.tone);
   if (analytic)
     LogInfo("analytic image of ", config.analytic, " (", luminaire.emitters.size(), " emitters), ",
             setup.mesh.triangles(), " triangles, ", view.width(), "x", view.height(), " in ",

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <regex>
+#include <sstream>
 #include <thread>
 
 #include "core/atomic_file.h"
@@ -30,6 +31,11 @@ struct CommandLineExtras {
   std::string false_colour_range = "auto";
   std::string false_colour_scale = "linear";
   bool write_test_slab = false;
+  std::string tone_map = ToneCurveName(ToneMapping().curve);
+  std::string auto_exposure = AutoExposureName(ToneMapping().auto_exposure);
+  bool no_auto_exposure = false;
+  std::string backend;  // empty: osmesa, or window with --window
+  bool window = false;
 };
 
 void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -41,6 +47,11 @@ void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ex
                  "luminaire frame in the scene: x,y,z (mm),rx,ry,rz (degrees, R = Rz Ry Rx)")
       ->delimiter(',')
       ->expected(6);
+  app.add_option("--camera", config.camera,
+                 "orbit camera: yaw,pitch (degrees),distance,target x,y,z (mm, scene frame); "
+                 "default: the scene's")
+      ->delimiter(',')
+      ->expected(6);
   app.add_option("--size", extras.size, "image size WxH")->capture_default_str();
   app.add_option("--out", config.out, "headless output: .exr (linear) or .png (tone-mapped)");
   app.add_option("--receiver-plane", config.scene.receiver_plane_mm,
@@ -50,8 +61,16 @@ void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ex
 }
 
 void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
-  app.add_option("--exposure", config.exposure_stops, "exposure in stops (on top of auto)");
-  app.add_flag("!--no-auto-exposure", config.auto_exposure, "no automatic exposure");
+  app.add_option("--exposure", config.tone.exposure_stops, "exposure in stops (on top of auto)");
+  app.add_option("--tone-map", extras.tone_map,
+                 "PNG and window: linear (clip at 1) | filmic (ACES fit: a shoulder instead of "
+                 "clipping)")
+      ->capture_default_str();
+  app.add_option("--auto-exposure", extras.auto_exposure,
+                 "lit (log-average of the lit pixels to 0.18) | p99 (99th percentile to 0.8) | "
+                 "off")
+      ->capture_default_str();
+  app.add_flag("--no-auto-exposure", extras.no_auto_exposure, "--auto-exposure off");
   app.add_option("--view", extras.view,
                  "normal (radiance, tone-mapped) | false-colour (the irradiance arriving at each "
                  "pixel, before albedo, in the slab's unit: viridis, colour bar, iso-lines at its "
@@ -78,7 +97,11 @@ void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ext
   app.add_option("--poll", config.poll_s, "--watch polling interval (s)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_flag("--window", config.window, "interactive GLFW window (needs a display)");
+  app.add_option("--backend", extras.backend,
+                 "osmesa (headless, llvmpipe; the default) | egl (headless on a GPU) | window "
+                 "(GLFW with controls; needs a display)");
+  app.add_flag("--window", extras.window, "--backend window");
+  app.add_flag("!--no-ui", config.ui, "window: no controls panel (the picture only)");
   app.add_option("--screenshot", config.screenshot,
                  "--window: save the window to this PNG once all positions are in, then quit");
   app.add_flag("--bench", config.bench, "time frames with a moving camera");
@@ -103,11 +126,53 @@ void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ext
                "d=750, window 1200 at 300) into --slab when it has no slab.json (demos, tests)");
 }
 
+Backend ParseBackend(const CommandLineExtras& extras) {
+  if (extras.backend.empty()) return extras.window ? Backend::kWindow : Backend::kOsmesa;
+  for (Backend b : {Backend::kOsmesa, Backend::kEgl, Backend::kWindow}) {
+    if (extras.backend != BackendName(b)) continue;
+    if (extras.window && b != Backend::kWindow)
+      throw BadInput("--window is --backend window; it contradicts --backend " + extras.backend);
+    return b;
+  }
+  throw InputError("--backend", "", "osmesa | egl | window", extras.backend);
+}
+
+void CheckCamera(const PreviewConfig& config) {
+  if (config.camera.empty()) return;
+  if (config.scene.name == "plane")
+    throw BadInput("--camera: the plane view (--scene plane) has no orbit camera");
+  const char* names[] = {"yaw", "pitch", "distance", "target x", "target y", "target z"};
+  for (size_t k = 0; k < config.camera.size(); ++k) {
+    const double v = config.camera[k];
+    const bool ok = k < 2    ? std::abs(v) <= 36000
+                    : k == 2 ? v >= 1 && v <= kMaxDistanceMm
+                             : std::abs(v) <= kMaxCoordinateMm;
+    if (!std::isfinite(v) || !ok)
+      throw InputError("--camera", names[k],
+                       k < 2    ? "an angle within 36000 degrees"
+                       : k == 2 ? "a distance in [1, 1e5] mm"
+                                : "a coordinate within 1e6 mm",
+                       std::to_string(v));
+  }
+  if (std::abs(config.camera[1]) >= 90)
+    throw InputError("--camera", "pitch", "within (-90, 90) degrees",
+                     std::to_string(config.camera[1]));
+}
+
 // Checks what CLI11 cannot; fills the size.
 void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   if (!ParseSize(extras.size, &config.width, &config.height)) {
     throw InputError("--size", "size", "WxH, each 1..8192, e.g. 400x400", extras.size);
   }
+  config.backend = ParseBackend(extras);
+  const bool window = config.backend == Backend::kWindow;
+  config.tone.curve = ParseToneCurve(extras.tone_map, "--tone-map");
+  config.tone.auto_exposure = ParseAutoExposure(extras.auto_exposure, "--auto-exposure");
+  if (extras.no_auto_exposure) config.tone.auto_exposure = AutoExposure::kOff;
+  if (!std::isfinite(config.tone.exposure_stops) || std::abs(config.tone.exposure_stops) > 64)
+    throw InputError("--exposure", "", "stops within [-64, 64]",
+                     std::to_string(config.tone.exposure_stops));
+  CheckCamera(config);
   if (config.shadow_size < 16 || config.shadow_size > 4096) {
     throw InputError("--shadow-size", "shadow-size", "16..4096",
                      std::to_string(config.shadow_size));
@@ -116,13 +181,10 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   config.false_colour_scale.log = extras.false_colour_scale == "log";
   ParseFalseColourRange(extras.false_colour_range, "--false-colour-range",
                         &config.false_colour_scale);
-  // The window draws the normal view only until its false-colour toggle exists (it flips
-  // config.false_colour and draws FalseColourView).
-  if (config.false_colour && config.window)
-    throw BadInput("--view false-colour is for headless output (--out x.png) so far, not --window");
   if (config.reference || !config.analytic.empty()) {
     const char* mode = config.reference ? "--reference" : "--analytic";
-    for (const auto& [set, option] : {std::pair{config.window, "--window"},
+    for (const auto& [set, option] : {std::pair{window, "--window"},
+                                      {config.backend == Backend::kEgl, "--backend egl"},
                                       {config.watch, "--watch"},
                                       {config.bench, "--bench"},
                                       {config.srgbe, "--srgbe"},
@@ -134,7 +196,7 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
     if (config.samples < 1 || config.samples > 64)
       throw InputError("--samples", "", "1 .. 64", std::to_string(config.samples));
   }
-  if (!config.window && config.out.empty() && !config.bench) {
+  if (!window && config.out.empty() && !config.bench) {
     throw BadInput("headless mode needs --out <file.exr|.png> (or --bench, or --window)");
   }
   // 0 means "the default" for the plane; anything else must be a distance a lab could mean.
@@ -176,10 +238,41 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     return 0;
   }
   if (config.reference || !config.analytic.empty()) return RunReferenceMode(config, *info);
-  return config.window ? RunWindow(config, *info) : RunHeadless(config, *info);
+  return config.backend == Backend::kWindow ? RunWindow(config, *info) : RunHeadless(config, *info);
 }
 
 }  // namespace
+
+const char* BackendName(Backend backend) {
+  switch (backend) {
+    case Backend::kOsmesa:
+      return "osmesa";
+    case Backend::kEgl:
+      return "egl";
+    case Backend::kWindow:
+      return "window";
+  }
+  return "?";
+}
+
+SceneSetup MakePreviewSetup(const PreviewConfig& config, const SlabInfo& info) {
+  SceneSetup setup = MakeSceneSetup(config.scene, info);
+  if (!config.camera.empty()) SetCameraValues(config.camera, setup);
+  return setup;
+}
+
+std::vector<double> CameraValues(const SceneSetup& setup) {
+  return {setup.camera_yaw_deg,    setup.camera_pitch_deg,  setup.camera_distance,
+          setup.camera_target.x(), setup.camera_target.y(), setup.camera_target.z()};
+}
+
+void SetCameraValues(const std::vector<double>& values, SceneSetup& setup) {
+  if (values.size() != 6) throw BadInput("--camera needs yaw,pitch,distance,x,y,z");
+  setup.camera_yaw_deg = values[0];
+  setup.camera_pitch_deg = values[1];
+  setup.camera_distance = values[2];
+  setup.camera_target = Eigen::Vector3d(values[3], values[4], values[5]);
+}
 
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
   RenderOptions options;
@@ -241,26 +334,81 @@ bool ParseSize(const std::string& text, int* width, int* height) {
   return *width > 0 && *height > 0 && *width <= 8192 && *height <= 8192;
 }
 
-int RunPreview(int argc, char** argv) {
+std::optional<int> ParsePreviewCommandLine(int argc, char** argv, PreviewConfig& config,
+                                           bool* write_test_slab) {
   CLI::App app{
       "lumislab-preview: the measured luminaire lighting a scene (docs/design.md §4); headless "
-      "(OSMesa, --out) or in a window (--window)"};
+      "(--backend osmesa or egl, --out) or in a window with controls (--backend window)"};
   app.footer(
       "--threads sizes lumislab's own CPU work (deriving E' of the slab positions as they are "
       "loaded; the whole render with --reference or --analytic). The OpenGL renderer's threads are "
       "llvmpipe's: set them with the LP_NUM_THREADS "
       "environment variable (default: all cores).");
-  PreviewConfig config;
   CommonOptions common;
   CommandLineExtras extras;
   AddCommonOptions(&app, &common);
   AddSceneOptions(app, config, extras);
   AddRenderOptions(app, config, extras);
   AddModeOptions(app, config, extras);
-  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
+  if (const auto code = ParseCommandLine(app, argc, argv)) return code;
   config.threads = StartTool("preview", common);
   CheckOptions(extras, config);
-  return Run(config, extras.write_test_slab);
+  if (write_test_slab) *write_test_slab = extras.write_test_slab;
+  return std::nullopt;
+}
+
+std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& out) {
+  std::ostringstream line;
+  line.precision(6);
+  auto arg = [&](const std::string& text) {
+    const bool plain = !text.empty() && text.find_first_not_of(
+                                            "abcdefghijklmnopqrstuvwxyz"
+                                            "ABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                            "0123456789_-+=.,/:@%") == std::string::npos;
+    if (plain) return " " + text;
+    std::string quoted = " '";
+    for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+  };
+  auto values = [&](const std::vector<double>& v) {
+    std::ostringstream list;
+    list.precision(6);
+    for (size_t k = 0; k < v.size(); ++k)
+      list << (k ? "," : "") << (std::abs(v[k]) < 5e-7 ? 0.0 : v[k]);
+    return list.str();
+  };
+  line << "lumislab-preview" << arg("--slab") << arg(config.slab_dir) << arg("--scene")
+       << arg(config.scene.name);
+  if (!config.scene.pose.empty()) line << arg("--luminaire-pose") << arg(values(config.scene.pose));
+  if (config.scene.receiver_plane_mm != 0)
+    line << arg("--receiver-plane") << arg(values({config.scene.receiver_plane_mm}));
+  if (config.scene.extent_mm != 0) line << arg("--extent") << arg(values({config.scene.extent_mm}));
+  if (!config.camera.empty()) line << arg("--camera") << arg(values(config.camera));
+  line << arg("--size") << arg(std::to_string(config.width) + "x" + std::to_string(config.height));
+  if (config.false_colour) {
+    line << arg("--view") << arg("false-colour");
+    if (config.false_colour_scale.log) line << arg("--false-colour-scale") << arg("log");
+    if (config.false_colour_scale.max > config.false_colour_scale.min)
+      line << arg("--false-colour-range")
+           << arg(values({config.false_colour_scale.min}) + ":" +
+                  values({config.false_colour_scale.max}));
+  }
+  line << arg("--exposure") << arg(values({config.tone.exposure_stops})) << arg("--tone-map")
+       << arg(ToneCurveName(config.tone.curve)) << arg("--auto-exposure")
+       << arg(AutoExposureName(config.tone.auto_exposure));
+  if (!config.shadows) line << arg("--no-shadows");
+  line << arg("--shadow-size") << arg(std::to_string(config.shadow_size));
+  if (config.shadow_pcf) line << arg("--shadow-pcf");
+  if (config.srgbe) line << arg("--srgbe");
+  line << arg("--out") << arg(out);
+  return line.str();
+}
+
+int RunPreview(int argc, char** argv) {
+  PreviewConfig config;
+  bool write_test_slab = false;
+  if (const auto code = ParsePreviewCommandLine(argc, argv, config, &write_test_slab)) return *code;
+  return Run(config, write_test_slab);
 }
 
 }  // namespace lumislab

@@ -11,17 +11,25 @@
 #include "core/slab.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/scene_setup.h"
+#include "lib/lightfield/tone_map.h"
 #include "preview/renderer.h"
 
 namespace lumislab {
+
+// Where the preview's OpenGL runs (--backend): OSMesa (llvmpipe, headless, everywhere), EGL
+// (headless on a GPU; refused when EGL offers only a software renderer) or a GLFW window.
+enum class Backend { kOsmesa, kEgl, kWindow };
+const char* BackendName(Backend backend);
 
 struct PreviewConfig {
   std::string slab_dir;
   SceneRequest scene;  // name, pose, receiver plane D and extent
   int width = 400, height = 400;
-  std::string out;            // headless output (.exr linear, .png tone-mapped)
-  double exposure_stops = 0;  // PNG / window exposure; NaN-free: 0 + auto
-  bool auto_exposure = true;
+  std::string out;   // headless output (.exr linear, .png tone-mapped)
+  ToneMapping tone;  // PNG / window: exposure stops, automatic exposure, tone curve
+  // Orbit camera yaw, pitch (degrees), distance (mm), target x, y, z (mm, scene frame); empty:
+  // the scene's default. The window's orbit and fly moves both change these six.
+  std::vector<double> camera;
   // --view false-colour: the irradiance arriving at each pixel (W/m^2 or lux, before albedo and
   // tone mapping) through lib/lightfield/false_colour.h, with colour bar and iso-lines; the
   // window's toggle flips `false_colour` (MakeRenderOptions then gives unit albedo).
@@ -33,7 +41,8 @@ struct PreviewConfig {
   bool shadow_pcf = false;
   bool watch = false;
   double poll_s = 0.5;
-  bool window = false;
+  Backend backend = Backend::kOsmesa;  // --backend; --window is --backend window
+  bool ui = true;                      // window: the controls panel (--no-ui: the picture only)
   bool bench = false;
   int bench_frames = 10;
   std::string screenshot;  // window: save this file after the first complete frame, then quit
@@ -48,6 +57,20 @@ struct PreviewConfig {
 
 // The whole tool: command line, then the window or the headless run.
 int RunPreview(int argc, char** argv);
+
+// Parses the command line into `config` (help, version and CLI11 errors: the exit code to
+// return; bad values: BadInput). `write_test_slab` receives --write-test-slab.
+std::optional<int> ParsePreviewCommandLine(int argc, char** argv, PreviewConfig& config,
+                                           bool* write_test_slab);
+// The headless command line that renders what `config` describes into `out` (the window's
+// "command line" line and its screenshot log): every setting the window changes is a flag.
+std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& out);
+
+// The scene of the configuration: MakeSceneSetup, then --camera.
+SceneSetup MakePreviewSetup(const PreviewConfig& config, const SlabInfo& info);
+// The orbit camera of `setup` as the six --camera values, and back.
+std::vector<double> CameraValues(const SceneSetup& setup);
+void SetCameraValues(const std::vector<double>& values, SceneSetup& setup);
 
 // Renderer options from the command line, for the scene it sets up (one place for both contexts).
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);

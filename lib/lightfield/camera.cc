@@ -1,5 +1,6 @@
 #include "lib/lightfield/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -53,6 +54,25 @@ Eigen::Isometry3d PoseFromValues(const std::vector<double>& v) {
                       .toRotationMatrix();
   pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
   return pose;
+}
+
+std::vector<double> ValuesFromPose(const Eigen::Isometry3d& pose) {
+  // R = Rz(c) Ry(b) Rx(a): R20 = -sin b, R21 = cos b sin a, R22 = cos b cos a,
+  // R10 = sin c cos b, R00 = cos c cos b.
+  const Eigen::Matrix3d r = pose.linear();
+  const double b = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
+  double a = 0, c = 0;
+  if (std::abs(r(2, 0)) < 1 - 1e-12) {
+    a = std::atan2(r(2, 1), r(2, 2));
+    c = std::atan2(r(1, 0), r(0, 0));
+  } else {  // gimbal lock: a = 0, R01 = -sin c, R11 = cos c
+    c = std::atan2(-r(0, 1), r(1, 1));
+  }
+  const double k = 180.0 / M_PI;
+  const Eigen::Vector3d t = pose.translation();
+  std::vector<double> values = {t.x(), t.y(), t.z(), a * k, b * k, c * k};
+  for (double& v : values) v = std::abs(v) < 1e-9 ? 0.0 : v;  // fields and command lines show 0
+  return values;
 }
 
 }  // namespace lumislab

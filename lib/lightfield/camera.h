@@ -18,5 +18,8 @@ Eigen::Matrix4f LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target
 Eigen::Matrix4f PlaneView(double plane_z_mm, double extent_mm);
 // Pose from "x,y,z,rx,ry,rz" (mm, degrees; R = Rz Ry Rx); BadInput unless 6 values.
 Eigen::Isometry3d PoseFromValues(const std::vector<double>& values);
+// The inverse: x,y,z,rx,ry,rz with ry in [-90, 90] and rx, rz in (-180, 180] (rx = 0 at
+// ry = +-90, where only rz - rx or rz + rx is defined).
+std::vector<double> ValuesFromPose(const Eigen::Isometry3d& pose);
 
 }  // namespace lumislab

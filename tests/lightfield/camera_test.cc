@@ -122,5 +122,23 @@ TEST(LightFieldSceneSetup, RoomsHangTheLuminaireAndTheCameraLooksAtTheTarget) {
   EXPECT_TRUE(s.pose.isApprox(PoseFromValues({1, 2, 3, 0, 0, 0})));
 }
 
+// The window shows a pose as the six --luminaire-pose values; they must give the pose back.
+TEST(LightFieldCamera, ValuesFromPoseInvertsPoseFromValues) {
+  const std::vector<std::vector<double>> cases = {{10, -20, 30, 25, -40, 70},
+                                                  {250, 2300, -150, 90, 0, 0},
+                                                  {0, 0, 0, -170, 80, 179},
+                                                  {1, 2, 3, 0, 90, 30},  // gimbal lock
+                                                  {1, 2, 3, 0, -90, -30}};
+  for (const auto& values : cases) {
+    const std::vector<double> back = ValuesFromPose(PoseFromValues(values));
+    ASSERT_EQ(back.size(), 6u);
+    const Eigen::Isometry3d a = PoseFromValues(values), b = PoseFromValues(back);
+    EXPECT_LT((a.matrix() - b.matrix()).norm(), 1e-9) << values[3] << " " << values[4];
+    if (std::abs(values[4]) < 90) {
+      for (int k = 0; k < 6; ++k) EXPECT_NEAR(back[k], values[k], 1e-9) << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace lumislab

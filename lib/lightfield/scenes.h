@@ -19,8 +19,6 @@ struct Mesh {
   // Quad a-b-c-d (counter-clockwise seen from the side its normal points to).
   void AddQuad(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
                const Eigen::Vector3f& d, const Eigen::Vector3f& colour);
-  // Axis-aligned box, faces pointing out.
-  void AddBox(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, const Eigen::Vector3f& colour);
   void Append(const Mesh& other);
 };
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace lumislab {
@@ -34,6 +35,25 @@ float Along(float lo, float hi, float t) {
   return 0.5f * (lo + hi) + 0.5f * (hi - lo) * t;
 }
 
+// Quad a-b-c-d of a curved surface with its normals there (unit, on the side the quad faces;
+// the vertex order is reversed if the quad's own normal points away from them). Both renderers
+// interpolate the normals alike; the shadows follow the flat triangles.
+void AddSmoothQuad(Mesh& m, V a, V b, const V& c, V d, V na, V nb, const V& nc, V nd,
+                   const V& colour) {
+  if (((b - a).cross(c - a) + (c - a).cross(d - a)).dot(na + nb + nc + nd) < 0) {
+    std::swap(b, d);
+    std::swap(nb, nd);
+  }
+  auto triangle = [&](const V& p, const V& q, const V& r, const V& np, const V& nq, const V& nr) {
+    if ((q - p).cross(r - p).norm() == 0) return;
+    for (const V* v : {&p, &q, &r}) m.positions.push_back(*v);
+    for (const V* n : {&np, &nq, &nr}) m.normals.push_back(n->normalized());
+    for (int k = 0; k < 3; ++k) m.albedo.push_back(colour);
+  };
+  triangle(a, b, c, na, nb, nc);
+  triangle(a, c, d, na, nc, nd);
+}
+
 }  // namespace
 
 void AddQuadFacing(Mesh& m, const V& a, const V& b, const V& c, const V& d, const V& towards,
@@ -62,24 +82,29 @@ void AddBoxFaces(Mesh& m, const V& lo, const V& hi, unsigned faces, const V& col
 void AddGroinVault(Mesh& m, float x0, float x1, float z0, float z1, float spring, float rise,
                    int segments, const V& colour) {
   const Profile p(segments);
-  const V down(0, -1, 0);
+  const float sx = 0.5f * (x1 - x0), sz = 0.5f * (z1 - z0);
   auto height = [&](int k) { return p.s[k] == 0 ? spring : spring + rise * p.s[k]; };
+  // The barrels' normals at profile point k: (0, -s sin, rise cos) for the one whose height
+  // follows z (into the bay at the springing, down at the crown), likewise along x.
+  auto normal_z = [&](int k) { return V(0, -sz * p.s[k], -rise * p.c[k]).normalized(); };
+  auto normal_x = [&](int k) { return V(-rise * p.c[k], -sx * p.s[k], 0).normalized(); };
   for (int k = 0; k < segments; ++k) {
     const float h0 = height(k), h1 = height(k + 1);
     const float a0 = std::abs(p.c[k]), a1 = std::abs(p.c[k + 1]);
+    const V nz0 = normal_z(k), nz1 = normal_z(k + 1), nx0 = normal_x(k), nx1 = normal_x(k + 1);
     // Webs against the edges x = x1 and x = x0: height follows z; the inner edge is the groin.
     for (const float side : {1.0f, -1.0f}) {
       const float outer = side > 0 ? x1 : x0;
       const float za = Along(z0, z1, p.c[k]), zb = Along(z0, z1, p.c[k + 1]);
-      AddQuadFacing(m, {Along(x0, x1, side * a0), h0, za}, {outer, h0, za}, {outer, h1, zb},
-                    {Along(x0, x1, side * a1), h1, zb}, down, colour);
+      AddSmoothQuad(m, {Along(x0, x1, side * a0), h0, za}, {outer, h0, za}, {outer, h1, zb},
+                    {Along(x0, x1, side * a1), h1, zb}, nz0, nz0, nz1, nz1, colour);
     }
     // Webs against z = z1 and z = z0: height follows x.
     for (const float side : {1.0f, -1.0f}) {
       const float outer = side > 0 ? z1 : z0;
       const float xa = Along(x0, x1, p.c[k]), xb = Along(x0, x1, p.c[k + 1]);
-      AddQuadFacing(m, {xa, h0, Along(z0, z1, side * a0)}, {xa, h0, outer}, {xb, h1, outer},
-                    {xb, h1, Along(z0, z1, side * a1)}, down, colour);
+      AddSmoothQuad(m, {xa, h0, Along(z0, z1, side * a0)}, {xa, h0, outer}, {xb, h1, outer},
+                    {xb, h1, Along(z0, z1, side * a1)}, nx0, nx0, nx1, nx1, colour);
     }
   }
 }
@@ -94,9 +119,9 @@ void AddColumn(Mesh& m, float x, float z, float y0, float y1, const ColumnStyle&
     const float a0 = 2 * kPi * k / style.sides, a1 = 2 * kPi * (k + 1) / style.sides;
     const V p0(x + style.radius * std::cos(a0), 0, z + style.radius * std::sin(a0));
     const V p1(x + style.radius * std::cos(a1), 0, z + style.radius * std::sin(a1));
-    const V out = 0.5f * (p0 + p1) - V(x, 0, z);
-    AddQuadFacing(m, p0 + V(0, shaft0, 0), p1 + V(0, shaft0, 0), p1 + V(0, shaft1, 0),
-                  p0 + V(0, shaft1, 0), out, colour);
+    const V n0(std::cos(a0), 0, std::sin(a0)), n1(std::cos(a1), 0, std::sin(a1));  // round
+    AddSmoothQuad(m, p0 + V(0, shaft0, 0), p1 + V(0, shaft0, 0), p1 + V(0, shaft1, 0),
+                  p0 + V(0, shaft1, 0), n0, n1, n1, n0, colour);
   }
 }
 
@@ -114,11 +139,11 @@ void AddArcadeWall(Mesh& m, const std::vector<float>& xs, float half_pier, float
     const Eigen::Vector2f centre(0.5f * (lo + hi), spring);
     for (int k = 0; k < segments; ++k) {
       const Eigen::Vector2f q0 = point(k), q1 = point(k + 1);
-      // Intrados, facing the arch's centre; the wall above the arch, front and back.
-      const Eigen::Vector2f in = centre - 0.5f * (q0 + q1);
-      AddQuadFacing(m, {q0.x(), q0.y(), z_front}, {q1.x(), q1.y(), z_front},
-                    {q1.x(), q1.y(), z_back}, {q0.x(), q0.y(), z_back}, V(in.x(), in.y(), 0),
-                    colour);
+      // Intrados, facing the arch's centre (round); the wall above the arch, front and back.
+      const Eigen::Vector2f in0 = (centre - q0).normalized(), in1 = (centre - q1).normalized();
+      const V n0(in0.x(), in0.y(), 0), n1(in1.x(), in1.y(), 0);
+      AddSmoothQuad(m, {q0.x(), q0.y(), z_front}, {q1.x(), q1.y(), z_front},
+                    {q1.x(), q1.y(), z_back}, {q0.x(), q0.y(), z_back}, n0, n1, n1, n0, colour);
       for (const float z : {z_front, z_back}) {
         AddQuadFacing(m, {q0.x(), q0.y(), z}, {q1.x(), q1.y(), z}, {q1.x(), top, z},
                       {q0.x(), top, z}, z == z_front ? front : back, colour);

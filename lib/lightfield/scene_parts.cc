@@ -5,11 +5,13 @@
 #include <utility>
 #include <vector>
 
+#include "core/geometry.h"
+
 namespace lumislab {
 namespace scene_parts {
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
+constexpr float kPiF = float(kPi);
 
 // Half-ellipse profile over [-1, 1]: offsets c_k (exactly -1, 0, 1 at the ends and the middle)
 // and heights s_k = sin(pi k / n) (exactly 0 and 1 there), mirror-symmetric to the last bit so
@@ -18,7 +20,7 @@ struct Profile {
   std::vector<float> c, s;
   explicit Profile(int n) : c(n + 1), s(n + 1) {
     for (int k = 0; 2 * k <= n; ++k) {
-      const float angle = kPi * k / n;
+      const float angle = kPiF * k / n;
       c[k] = 2 * k == n ? 0.0f : (k == 0 ? -1.0f : -std::cos(angle));
       s[k] = 2 * k == n ? 1.0f : (k == 0 ? 0.0f : std::sin(angle));
       c[n - k] = -c[k];
@@ -116,7 +118,7 @@ void AddColumn(Mesh& m, float x, float z, float y0, float y1, const ColumnStyle&
   AddBoxFaces(m, {x - b, y0, z - b}, {x + b, shaft0, z + b}, kSides | kPlusY, trim);
   AddBoxFaces(m, {x - c, shaft1, z - c}, {x + c, y1, z + c}, kSides | kMinusY | kPlusY, trim);
   for (int k = 0; k < style.sides; ++k) {
-    const float a0 = 2 * kPi * k / style.sides, a1 = 2 * kPi * (k + 1) / style.sides;
+    const float a0 = 2 * kPiF * k / style.sides, a1 = 2 * kPiF * (k + 1) / style.sides;
     const V p0(x + style.radius * std::cos(a0), 0, z + style.radius * std::sin(a0));
     const V p1(x + style.radius * std::cos(a1), 0, z + style.radius * std::sin(a1));
     const V n0(std::cos(a0), 0, std::sin(a0)), n1(std::cos(a1), 0, std::sin(a1));  // round

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/geometry.h"
 #include "lib/lightfield/scene_parts.h"
 
 namespace lumislab {
@@ -139,10 +140,9 @@ Mesh CloisterSide(const CloisterPlan& p) {
 void AddWell(Mesh& m, float x, float z, float radius, float rim, float height, float water,
              int sides, const V& stone, const V& dark) {
   using scene_parts::AddQuadFacing;
-  constexpr float kPi = 3.14159265358979f;
   const float inner = radius - rim;
   for (int k = 0; k < sides; ++k) {
-    const float a0 = 2 * kPi * k / sides, a1 = 2 * kPi * (k + 1) / sides;
+    const float a0 = 2 * float(kPi) * k / sides, a1 = 2 * float(kPi) * (k + 1) / sides;
     const V u0(std::cos(a0), 0, std::sin(a0)), u1(std::cos(a1), 0, std::sin(a1));
     const V c(x, 0, z), out = 0.5f * (u0 + u1);
     const V o0 = c + radius * u0, o1 = c + radius * u1, i0 = c + inner * u0, i1 = c + inner * u1;

@@ -290,6 +290,41 @@ TEST_F(LightFieldSceneFiles, LoadsAnObjFile) {
   for (const Eigen::Vector3f& n : m.normals) EXPECT_NEAR(n.y(), 1, 1e-5);  // 1-4-3-2 faces +y
 }
 
+// A material's diffuse texture (OBJ map_Kd, here a 2 x 1 PPM) multiplies its colour Kd at each
+// corner's texture coordinate, linearised through the sRGB curve; a texture that is not there
+// leaves the colour alone.
+TEST_F(LightFieldSceneFiles, DiffuseTexturesColourTheVertices) {
+  Write("tex.ppm", std::string("P6\n2 1\n255\n") + std::string("\xff\x00\x80\x00\xff\x40", 6));
+  Write("quad.mtl",
+        "newmtl textured\nKd 1 0.5 1\nmap_Kd tex.ppm\n"
+        "newmtl missing\nKd 0.2 0.3 0.4\nmap_Kd nowhere.ppm\n");
+  const std::string quad =
+      "v 0 0 0\nv 1000 0 0\nv 1000 0 1000\nv 0 0 1000\n"
+      "vt 0.25 0.5\nvt 0.75 0.5\nvt 0.75 0.5\nvt 0.25 0.5\n";
+  const Mesh textured = LoadSceneFile(
+      Write("textured.obj", "mtllib quad.mtl\n" + quad + "usemtl textured\nf 1/1 4/4 3/3 2/2\n"));
+  ASSERT_EQ(textured.triangles(), 2u);
+  auto linear = [](double code) {  // the sRGB curve's inverse
+    const double v = code / 255;
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+  };
+  for (size_t k = 0; k < textured.positions.size(); ++k) {
+    // u = 0.25 is the left texel's centre (x = 0 here), u = 0.75 the right one's.
+    const Eigen::Vector3d expected = textured.positions[k].x() == 0
+                                         ? Eigen::Vector3d(1, 0, linear(128))
+                                         : Eigen::Vector3d(0, 0.5, linear(64));
+    EXPECT_TRUE(textured.albedo[k].cast<double>().isApprox(expected, 1e-5))
+        << textured.albedo[k].transpose() << " at " << textured.positions[k].transpose();
+  }
+  testing::internal::CaptureStderr();
+  const Mesh missing = LoadSceneFile(
+      Write("missing.obj", "mtllib quad.mtl\n" + quad + "usemtl missing\nf 1/1 4/4 3/3 2/2\n"));
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("nowhere.ppm"), std::string::npos) << err;
+  for (const Eigen::Vector3f& a : missing.albedo)
+    EXPECT_TRUE(a.isApprox(Eigen::Vector3f(0.2f, 0.3f, 0.4f)));
+}
+
 TEST_F(LightFieldSceneFiles, RefusesMissingAndNonMeshFilesNamingThem) {
   ExpectBadInputNaming((dir_ / "missing.obj").string());
   ExpectBadInputNaming(Write("notes.txt", "this is not a scene\n"));

@@ -16,8 +16,9 @@ packages=(
   # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), DNG and TIFF writing (libtiff),
   # colour JPEGs decoded with their fractional codes (libjpeg-turbo)
   libraw-dev libexif-dev libtiff-dev libjpeg-dev
-  # preview: the window's on-screen controls (Dear ImGui 1.86 with its GLFW and OpenGL 3 backends)
-  libimgui-dev
+  # preview: the window's on-screen controls (Dear ImGui 1.86 with its GLFW and OpenGL 3 backends);
+  # lib/lightfield: scene files' textures (stb_image)
+  libimgui-dev libstb-dev
   # pipelines/Snakefile: batch conversion as a workflow that also runs on a cluster
   snakemake
   xvfb xauth x11-apps

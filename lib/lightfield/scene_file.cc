@@ -27,6 +27,7 @@
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/stop_signal.h"
+#include "lib/lightfield/scene_texture.h"
 #include "lib/lightfield/scenes.h"
 
 namespace lumislab {
@@ -61,6 +62,11 @@ Mesh ImportWithAssimp(const std::string& path) {
         std::isfinite(diffuse.r) && std::isfinite(diffuse.g) && std::isfinite(diffuse.b)) {
       colour = V(diffuse.r, diffuse.g, diffuse.b);
     }
+    // A diffuse texture multiplies the colour (as OBJ's map_Kd and glTF's base colour do),
+    // sampled at each corner's texture coordinate.
+    DiffuseTexture texture;
+    if (mesh->mMaterialIndex < scene->mNumMaterials && mesh->mTextureCoords[0] != nullptr)
+      texture = LoadDiffuseTexture(*scene, *scene->mMaterials[mesh->mMaterialIndex], path);
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
       if (face.mNumIndices != 3) continue;
@@ -79,7 +85,12 @@ Mesh ImportWithAssimp(const std::string& path) {
               "finite coordinates", "NaN or Inf");
         m.positions.emplace_back(p.x, p.y, p.z);
         m.normals.emplace_back(n.x, n.y, n.z);
-        m.albedo.push_back(colour);
+        if (texture.empty()) {
+          m.albedo.push_back(colour);
+        } else {
+          const aiVector3D& uv = mesh->mTextureCoords[0][face.mIndices[c]];
+          m.albedo.push_back(colour.cwiseProduct(texture.Sample(uv.x, uv.y)));
+        }
       }
     }
   }

@@ -18,15 +18,18 @@ SceneSetup PlaneSetup(const SceneRequest& request, const SlabInfo& info) {
   return s;
 }
 
-// A built-in room: the luminaire hangs at `pose`, shining down; the camera looks in from above.
-SceneSetup RoomSetup(Mesh mesh, const std::vector<double>& pose, double camera_distance) {
+// A built-in room seen from inside: the luminaire at `pose` (x, y, z, rx, ry, rz: tilted down
+// by rx, turned about the vertical by ry), the orbit camera around `target` from a point in the
+// room.
+SceneSetup RoomSetup(Mesh mesh, const std::vector<double>& pose, const Eigen::Vector3d& target,
+                     double distance, double yaw_deg, double pitch_deg) {
   SceneSetup s;
   s.mesh = std::move(mesh);
   s.pose = PoseFromValues(pose);
-  s.camera_target = {0, 500, 0};
-  s.camera_distance = camera_distance;
-  s.camera_yaw_deg = 35;
-  s.camera_pitch_deg = 38;
+  s.camera_target = target;
+  s.camera_distance = distance;
+  s.camera_yaw_deg = yaw_deg;
+  s.camera_pitch_deg = pitch_deg;
   s.closed_room = true;
   return s;
 }
@@ -54,9 +57,16 @@ SceneSetup MakeSceneSetup(const SceneRequest& request, const SlabInfo& info) {
   if (request.name == "plane") {
     s = PlaneSetup(request, info);
   } else if (request.name == "crypt") {
-    s = RoomSetup(MakeCrypt(), {250, 2300, -150, 90, 0, 0}, 3900);
+    // 0.6 m from the west wall, 1.5 m high, aimed east and 6 degrees down along the crypt: the
+    // first columns (1.6 m ahead) throw their shadows over floor, columns and east wall, the
+    // window's cone reaches up into the vaults; the camera in the north-west corner, looking
+    // over the light's shoulder.
+    s = RoomSetup(MakeCrypt(), {-2700, 1500, 0, 6, 90, 0}, {0, 900, 0}, 4119, -49, 15.5);
   } else if (request.name == "cloister") {
-    s = RoomSetup(MakeCloister(), {900, 3700, 900, 90, 0, 0}, 9000);
+    // In the garth 2.5 m before the north arcade, 1.2 m high, aimed at it and 10 degrees up: the
+    // columns' shadows across the gallery's floor and outer wall, its vaults lit through the
+    // arches; the camera further back in the garth.
+    s = RoomSetup(MakeCloister(), {0, 1200, 2500, -10, 0, 0}, {200, 2000, 6000}, 6600, -160, -3);
   } else {
     s = FileSetup(request.name);
   }

@@ -2,87 +2,14 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <vector>
+
+#include "core/geometry.h"
+#include "lib/lightfield/scene_parts.h"
 
 namespace lumislab {
-namespace {
 
 using V = Eigen::Vector3f;
-constexpr float kPi = 3.14159265358979f;
-
-// A pillar of `sides` facets (radius r) from y0 to y1 at (x, z), with a square base and capital.
-void AddPillar(Mesh& m, float x, float z, float r, float y0, float y1, int sides, const V& colour) {
-  const float cap = 0.12f * (y1 - y0);
-  m.AddBox({x - 1.4f * r, y0, z - 1.4f * r}, {x + 1.4f * r, y0 + cap, z + 1.4f * r}, colour);
-  m.AddBox({x - 1.4f * r, y1 - cap, z - 1.4f * r}, {x + 1.4f * r, y1, z + 1.4f * r}, colour);
-  for (int k = 0; k < sides; ++k) {
-    const float a0 = 2 * kPi * k / sides;
-    const float a1 = 2 * kPi * (k + 1) / sides;
-    const V p0(x + r * std::cos(a0), 0, z + r * std::sin(a0));
-    const V p1(x + r * std::cos(a1), 0, z + r * std::sin(a1));
-    const V lo0 = p0 + V(0, y0 + cap, 0), lo1 = p1 + V(0, y0 + cap, 0);
-    const V hi0 = p0 + V(0, y1 - cap, 0), hi1 = p1 + V(0, y1 - cap, 0);
-    m.AddQuad(lo1, lo0, hi0, hi1, colour);
-  }
-}
-
-// An arch between pillar tops a and b (at height y), `thickness` across, `segments` pieces of a
-// half ellipse (rise 0.3 span), the spandrels filled up to a band 0.1 span above the crown, closed
-// on top and at both ends: a solid whose faces all point out.
-void AddArch(Mesh& m, const V& a, const V& b, float y, float thickness, int segments,
-             const V& colour) {
-  const V axis = (b - a);
-  const float span = axis.norm();
-  const V dir = axis / span;
-  // dir x up: with the quads below, the intrados faces down and each spandrel away from the arch.
-  const V side = dir.cross(V(0, 1, 0)).normalized() * (0.5f * thickness);
-  const float half = 0.5f * span;
-  const float rise = 0.3f * span;  // elliptical arch, flatter than a half circle
-  const float top = y + rise + 0.1f * span;
-  const V centre = 0.5f * (a + b) + V(0, y, 0);
-  for (int k = 0; k < segments; ++k) {
-    const float t0 = kPi * k / segments;
-    const float t1 = kPi * (k + 1) / segments;
-    const V q0 = centre - dir * (half * std::cos(t0)) + V(0, rise * std::sin(t0), 0);
-    const V q1 = centre - dir * (half * std::cos(t1)) + V(0, rise * std::sin(t1), 0);
-    // Intrados (underside of the arch), facing down/in.
-    m.AddQuad(q0 - side, q1 - side, q1 + side, q0 + side, colour);
-    // Spandrel faces on both sides: from the curve up to the top band.
-    const V u0(q0.x(), top, q0.z()), u1(q1.x(), top, q1.z());
-    m.AddQuad(q0 + side, q1 + side, u1 + side, u0 + side, colour);
-    m.AddQuad(q1 - side, q0 - side, u0 - side, u1 - side, colour);
-  }
-  // Top band (extrados) facing up, and the two ends (they show at a pillar's outer corner).
-  const V e0 = centre - dir * half, e1 = centre + dir * half;
-  const V top0(e0.x(), top, e0.z()), top1(e1.x(), top, e1.z());
-  m.AddQuad(top0 + side, top1 + side, top1 - side, top0 - side, colour);
-  m.AddQuad(e0 - side, e0 + side, top0 + side, top0 - side, colour);
-  m.AddQuad(e1 + side, e1 - side, top1 - side, top1 + side, colour);
-}
-
-void AddRoom(Mesh& m, const V& lo, const V& hi, const V& floor, const V& wall, const V& ceiling) {
-  // Floor and ceiling (facing in), four walls facing in, each split in 4x4 quads.
-  const int n = 4;
-  for (int a = 0; a < n; ++a) {
-    for (int b = 0; b < n; ++b) {
-      const float x0 = lo.x() + (hi.x() - lo.x()) * a / n,
-                  x1 = lo.x() + (hi.x() - lo.x()) * (a + 1) / n;
-      const float z0 = lo.z() + (hi.z() - lo.z()) * b / n,
-                  z1 = lo.z() + (hi.z() - lo.z()) * (b + 1) / n;
-      const float y0 = lo.y() + (hi.y() - lo.y()) * b / n,
-                  y1 = lo.y() + (hi.y() - lo.y()) * (b + 1) / n;
-      m.AddQuad({x0, lo.y(), z1}, {x1, lo.y(), z1}, {x1, lo.y(), z0}, {x0, lo.y(), z0}, floor);
-      m.AddQuad({x0, hi.y(), z0}, {x1, hi.y(), z0}, {x1, hi.y(), z1}, {x0, hi.y(), z1}, ceiling);
-      m.AddQuad({x0, y0, lo.z()}, {x1, y0, lo.z()}, {x1, y1, lo.z()}, {x0, y1, lo.z()}, wall);
-      m.AddQuad({x1, y0, hi.z()}, {x0, y0, hi.z()}, {x0, y1, hi.z()}, {x1, y1, hi.z()}, wall);
-      const float w0 = lo.z() + (hi.z() - lo.z()) * a / n,
-                  w1 = lo.z() + (hi.z() - lo.z()) * (a + 1) / n;
-      m.AddQuad({lo.x(), y0, w1}, {lo.x(), y0, w0}, {lo.x(), y1, w0}, {lo.x(), y1, w1}, wall);
-      m.AddQuad({hi.x(), y0, w0}, {hi.x(), y0, w1}, {hi.x(), y1, w1}, {hi.x(), y1, w0}, wall);
-    }
-  }
-}
-
-}  // namespace
 
 void Mesh::AddTriangle(const V& a, const V& b, const V& c, const V& colour) {
   V n = (b - a).cross(c - a);
@@ -100,62 +27,163 @@ void Mesh::AddQuad(const V& a, const V& b, const V& c, const V& d, const V& colo
   AddTriangle(a, c, d, colour);
 }
 
-void Mesh::AddBox(const V& lo, const V& hi, const V& colour) {
-  const V p[8] = {{lo.x(), lo.y(), lo.z()}, {hi.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), lo.z()},
-                  {lo.x(), hi.y(), lo.z()}, {lo.x(), lo.y(), hi.z()}, {hi.x(), lo.y(), hi.z()},
-                  {hi.x(), hi.y(), hi.z()}, {lo.x(), hi.y(), hi.z()}};
-  AddQuad(p[0], p[3], p[2], p[1], colour);  // -z
-  AddQuad(p[4], p[5], p[6], p[7], colour);  // +z
-  AddQuad(p[0], p[4], p[7], p[3], colour);  // -x
-  AddQuad(p[1], p[2], p[6], p[5], colour);  // +x
-  AddQuad(p[0], p[1], p[5], p[4], colour);  // -y
-  AddQuad(p[3], p[7], p[6], p[2], colour);  // +y
-}
-
 void Mesh::Append(const Mesh& other) {
   positions.insert(positions.end(), other.positions.begin(), other.positions.end());
   normals.insert(normals.end(), other.normals.begin(), other.normals.end());
   albedo.insert(albedo.end(), other.albedo.begin(), other.albedo.end());
 }
 
+// The crypt: 3 x 3 bays of 2.2 m under groin vaults (spring 1.9 m, crown 2.8 m), the inner four
+// bay corners carried by columns, the outer ones springing from the walls; a flagged floor and
+// an altar against the east wall. The walls are single quads that rise past the vault's crown:
+// the vault's edges lie on them, so the room is closed without matching the lunettes' vertices.
 Mesh MakeCrypt() {
-  // 6 m x 3 m high x 6 m room, 2x2 pillars joined by 4 arches, a low altar box.
+  using namespace scene_parts;
   Mesh m;
-  const V stone(0.6f, 0.55f, 0.5f), floor(0.45f, 0.42f, 0.4f), light(0.75f, 0.72f, 0.68f);
-  AddRoom(m, {-3000, 0, -3000}, {3000, 3000, 3000}, floor, light, stone);
-  const float p = 1200, height = 1600;
-  for (float x : {-p, p}) {
-    for (float z : {-p, p}) AddPillar(m, x, z, 150, 0, height, 8, stone);
+  const V flags_a(0.42f, 0.38f, 0.33f), flags_b(0.52f, 0.47f, 0.40f);
+  const V wall(0.62f, 0.57f, 0.49f), plaster(0.80f, 0.77f, 0.70f);
+  const V column(0.58f, 0.42f, 0.31f), trim(0.66f, 0.60f, 0.52f), altar(0.50f, 0.44f, 0.38f);
+  const float bay = 2200, half = 1.5f * bay, spring = 1900, rise = 900;
+  const float xs[4] = {-half, -0.5f * bay, 0.5f * bay, half};
+  AddTiledFloor(m, -half, half, -half, half, 3, 3, flags_a, flags_b);
+  const float top = spring + rise + 100;  // walls rise past the crown
+  AddQuadFacing(m, {-half, 0, -half}, {half, 0, -half}, {half, top, -half}, {-half, top, -half},
+                V(0, 0, 1), wall);
+  AddQuadFacing(m, {-half, 0, half}, {half, 0, half}, {half, top, half}, {-half, top, half},
+                V(0, 0, -1), wall);
+  AddQuadFacing(m, {-half, 0, -half}, {-half, 0, half}, {-half, top, half}, {-half, top, -half},
+                V(1, 0, 0), wall);
+  AddQuadFacing(m, {half, 0, -half}, {half, 0, half}, {half, top, half}, {half, top, -half},
+                V(-1, 0, 0), wall);
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k)
+      AddGroinVault(m, xs[i], xs[i + 1], xs[k], xs[k + 1], spring, rise, 6, plaster);
   }
-  AddArch(m, {-p, 0, -p}, {p, 0, -p}, height, 300, 6, light);
-  AddArch(m, {-p, 0, p}, {p, 0, p}, height, 300, 6, light);
-  AddArch(m, {-p, 0, -p}, {-p, 0, p}, height, 300, 6, light);
-  AddArch(m, {p, 0, -p}, {p, 0, p}, height, 300, 6, light);
-  m.AddBox({-400, 0, -250}, {400, 700, 250}, V(0.7f, 0.6f, 0.45f));
+  ColumnStyle style;
+  style.radius = 170;
+  style.sides = 8;
+  style.base_half = 250;
+  style.base_height = 220;
+  style.cap_half = 270;
+  style.cap_height = 200;
+  for (const float x : {xs[1], xs[2]}) {
+    for (const float z : {xs[1], xs[2]}) AddColumn(m, x, z, 0, spring, style, column, trim);
+  }
+  // Altar block against the east wall, in the middle bay.
+  AddBoxFaces(m, {half - 700, 0, -800}, {half, 1000, 800}, kMinusX | kPlusY | kMinusZ | kPlusZ,
+              altar);
   return m;
 }
 
-Mesh MakeCloister() {
-  // 16 m square courtyard walk: 7x7 ring of pillars with arches between neighbours, a room.
+namespace {
+
+// One side of the cloister (the north, z > 0; the others are it turned): the arcade wall of
+// five round arches on four columns between corner piers, the gallery behind it under six groin
+// vaults (the last one the corner bay), its tiled floor, the lean-to roof seen from the garth
+// and the outer wall up to the sky.
+struct CloisterPlan {
+  float garth = 5000;       // inner face of the arcade at z = garth
+  float thickness = 400;    // arcade wall (and the columns' abacus)
+  float gallery = 3000;     // from the arcade's back to the outer wall
+  float spring = 2200;      // arches and vaults
+  float vault_rise = 1100;  // gallery vault: crown 3.3 m
+  float arcade_top = 3600;  // top of the arcade wall, where the roof starts
+  float eaves = 5000;       // the roof meets the outer wall
+  float sky = 7000;         // a dark ceiling over everything: the courtyard is closed
+  int bays = 5;
+  float outer() const { return garth + thickness + gallery; }
+};
+
+Mesh CloisterSide(const CloisterPlan& p) {
+  using namespace scene_parts;
   Mesh m;
-  const V stone(0.62f, 0.58f, 0.52f), floor(0.4f, 0.42f, 0.38f), light(0.78f, 0.75f, 0.7f);
-  AddRoom(m, {-8000, 0, -8000}, {8000, 4000, 8000}, floor, light, stone);
-  const int n = 7;
-  const float spacing = 1800, height = 2000, start = -0.5f * spacing * (n - 1);
-  std::vector<V> ring;
-  for (int a = 0; a < n; ++a) {
-    for (int b = 0; b < n; ++b) {
-      if (a != 0 && a != n - 1 && b != 0 && b != n - 1 && a != n / 2 && b != n / 2) continue;
-      const float x = start + a * spacing, z = start + b * spacing;
-      AddPillar(m, x, z, 140, 0, height, 24, stone);
-      if (a + 1 < n && (b == 0 || b == n - 1 || b == n / 2)) {
-        AddArch(m, {x, 0, z}, {x + spacing, 0, z}, height, 280, 24, light);
-      }
-      if (b + 1 < n && (a == 0 || a == n - 1 || a == n / 2)) {
-        AddArch(m, {x, 0, z}, {x, 0, z + spacing}, height, 280, 24, light);
-      }
+  const V stone(0.68f, 0.62f, 0.52f), marble(0.80f, 0.78f, 0.73f), trim(0.60f, 0.56f, 0.50f);
+  const V plaster(0.82f, 0.80f, 0.74f), wall(0.72f, 0.66f, 0.56f), roof(0.50f, 0.26f, 0.18f);
+  const V tile_a(0.55f, 0.33f, 0.22f), tile_b(0.64f, 0.44f, 0.31f);
+  const float g = p.garth, t = p.thickness, r = p.outer();
+  // Column centres on the arcade's mid-line; the first and last are the corner piers' centres.
+  const float pitch = (2 * g + t) / p.bays;
+  std::vector<float> xs;
+  for (int k = 0; k <= p.bays; ++k)
+    xs.push_back(k == p.bays ? g + 0.5f * t : -(g + 0.5f * t) + k * pitch);
+  AddArcadeWall(m, xs, 0.5f * t, g, g + t, p.spring, p.arcade_top, 24, stone);
+  ColumnStyle style;
+  style.radius = 120;
+  style.sides = 24;
+  style.base_half = 190;
+  style.base_height = 250;
+  style.cap_half = 0.5f * t;
+  style.cap_height = 220;
+  for (int k = 1; k < p.bays; ++k)
+    AddColumn(m, xs[k], g + 0.5f * t, 0, p.spring, style, marble, trim);
+  AddBoxFaces(m, {g, 0, g}, {g + t, p.arcade_top, g + t}, kSides, stone);  // north-east pier
+  // Gallery vaults: bays between the columns, the end ones out to the crossing galleries' arcade
+  // faces, then the corner bay.
+  std::vector<float> bays = xs;
+  bays.front() = -(g + t);
+  bays.back() = g + t;
+  bays.push_back(r);
+  for (size_t k = 0; k + 1 < bays.size(); ++k) {
+    AddGroinVault(m, bays[k], bays[k + 1], g + t, r, p.spring, p.vault_rise, 18, plaster);
+  }
+  // Floor: this side's strip of the pinwheel around the garth (x from -g to r).
+  AddTiledFloor(m, -g, r, g, r, 13, 3, tile_a, tile_b);
+  // Roof from the arcade's top edge to the eaves on the outer wall (seen from the garth), and
+  // the outer wall from the floor to the sky.
+  AddQuadFacing(m, {-g, p.arcade_top, g}, {g, p.arcade_top, g}, {r, p.eaves, r}, {-r, p.eaves, r},
+                V(0, 1, -1), roof);
+  AddQuadFacing(m, {-r, 0, r}, {r, 0, r}, {r, p.sky, r}, {-r, p.sky, r}, V(0, 0, -1), wall);
+  return m;
+}
+
+// A round basin (`sides` facets) at (x, z): outer wall, rim, inner wall and the water.
+void AddWell(Mesh& m, float x, float z, float radius, float rim, float height, float water,
+             int sides, const V& stone, const V& dark) {
+  using scene_parts::AddQuadFacing;
+  const float inner = radius - rim;
+  for (int k = 0; k < sides; ++k) {
+    const float a0 = 2 * float(kPi) * k / sides, a1 = 2 * float(kPi) * (k + 1) / sides;
+    const V u0(std::cos(a0), 0, std::sin(a0)), u1(std::cos(a1), 0, std::sin(a1));
+    const V c(x, 0, z), out = 0.5f * (u0 + u1);
+    const V o0 = c + radius * u0, o1 = c + radius * u1, i0 = c + inner * u0, i1 = c + inner * u1;
+    const V up(0, height, 0), wet(0, water, 0);
+    AddQuadFacing(m, o0, o1, o1 + up, o0 + up, out, stone);
+    AddQuadFacing(m, o0 + up, o1 + up, i1 + up, i0 + up, V(0, 1, 0), stone);
+    AddQuadFacing(m, i0 + wet, i1 + wet, i1 + up, i0 + up, -out, stone);
+    m.AddTriangle(c + wet, i1 + wet, i0 + wet, dark);
+  }
+}
+
+}  // namespace
+
+// The cloister: a 10 m garth (lawn, gravel cross paths, a well) inside four arcades of five
+// round arches on columns, galleries 3 m wide under groin vaults, lean-to roofs and outer walls;
+// a dark flat sky at 7 m closes the courtyard, so every ray from inside meets a surface.
+Mesh MakeCloister() {
+  using namespace scene_parts;
+  const CloisterPlan p;
+  Mesh m;
+  for (int turn = 0; turn < 4; ++turn) {
+    Mesh side = CloisterSide(p);
+    RotateQuarterTurns(side, turn);
+    m.Append(side);
+  }
+  const V grass(0.16f, 0.30f, 0.10f), gravel(0.58f, 0.55f, 0.48f);
+  const V stone(0.62f, 0.60f, 0.56f), water(0.04f, 0.06f, 0.08f), sky(0.08f, 0.11f, 0.20f);
+  // Garth: lawn quarters between two gravel paths 1.6 m wide crossing at the well.
+  const float g = p.garth, w = 800;
+  const float cuts[4] = {-g, -w, w, g};
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      AddQuadFacing(m, {cuts[i], 0, cuts[k]}, {cuts[i + 1], 0, cuts[k]},
+                    {cuts[i + 1], 0, cuts[k + 1]}, {cuts[i], 0, cuts[k + 1]}, V(0, 1, 0),
+                    (i == 1 || k == 1) ? gravel : grass);
     }
   }
+  AddWell(m, 0, 0, 700, 150, 650, 350, 32, stone, water);
+  const float r = p.outer();
+  AddQuadFacing(m, {-r, p.sky, -r}, {r, p.sky, -r}, {r, p.sky, r}, {-r, p.sky, r}, V(0, -1, 0),
+                sky);
   return m;
 }
 

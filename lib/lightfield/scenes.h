@@ -1,6 +1,7 @@
 // Scenes for the preview: triangle soups with per-vertex normal and Lambertian albedo, in the
-// scene (world) frame, mm. Built-in crypt (~500 triangles) and cloister (~8000 triangles): rooms
-// with pillars and arches that cast shadows, like the paper's test scenes; files via Assimp.
+// scene (world) frame, mm. Built-in crypt (~500 triangles) and cloister (~8000 triangles): closed
+// vaulted rooms with columns and arches that cast shadows, like the paper's test scenes
+// (docs/design.md §4.4; built from lib/lightfield/scene_parts.h); files via Assimp.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,18 +20,20 @@ struct Mesh {
   // Quad a-b-c-d (counter-clockwise seen from the side its normal points to).
   void AddQuad(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c,
                const Eigen::Vector3f& d, const Eigen::Vector3f& colour);
-  // Axis-aligned box, faces pointing out.
-  void AddBox(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, const Eigen::Vector3f& colour);
   void Append(const Mesh& other);
 };
 
-// A room (floor y = 0, walls facing in, ceiling), y up. Luminaire hangs near the ceiling.
-Mesh MakeCrypt();     // ~500 triangles
-Mesh MakeCloister();  // ~8000 triangles
+// Closed rooms, floor y = 0, y up, every surface facing the inside (solids in them facing out).
+// The crypt: 6.6 m square, 3 x 3 groin-vaulted bays on four columns (546 triangles).
+Mesh MakeCrypt();
+// The cloister: a 10 m garth with a well, four arcades, vaulted galleries, roofs, outer walls
+// and a dark sky at 7 m; 16.8 m square (7932 triangles).
+Mesh MakeCloister();
 // The receiver plane z = plane_z of the luminaire frame, square of side extent, normal -z.
 Mesh MakeReceiverPlane(double plane_z_mm, double extent_mm);
 // OBJ / glTF / PLY / ... through Assimp, in a child process (lib/lightfield/scene_file.cc): the
-// flattened triangles. BadInput naming the file when it is not a regular file, the importer
+// flattened triangles, albedo the material's diffuse colour times its diffuse texture at each
+// corner (lib/lightfield/scene_texture.h; a missing texture is a warning). BadInput naming the file when it is not a regular file, the importer
 // refuses it, crashes on it or runs past `timeout_s` (then it is killed), or the scene has no
 // triangles, a non-finite vertex, a face naming a missing vertex or more than
 // kMaxSceneTriangles triangles; Failure when StopRequested() ends the wait.

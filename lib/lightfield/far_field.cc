@@ -6,14 +6,13 @@
 
 #include "core/basis.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/parallel.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/reference_render.h"
 
 namespace lumislab {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // True when (s, t) is inside the window and the texels its bilinear lookup reads are all seen.
 bool SeenAt(const SlabLayout& layout, const ImageF& mask, double s, double t) {

@@ -16,10 +16,10 @@
 namespace lumislab {
 namespace {
 
-constexpr int kMaxAngles = 100000;
+constexpr int kMaxLdtAngles = 100000;
 constexpr char kRadiometricLamp[] = "radiometric: W/sr per 1000 W";
 
-std::string Trim(const std::string& s) {
+std::string TrimField(const std::string& s) {
   size_t a = 0, b = s.size();
   while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
   while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
@@ -28,7 +28,7 @@ std::string Trim(const std::string& s) {
 
 // A number as EULUMDAT files print it: a decimal comma is common (European software).
 bool ParseNumber(std::string text, double* v) {
-  text = Trim(text);
+  text = TrimField(text);
   std::replace(text.begin(), text.end(), ',', '.');
   char* end = nullptr;
   *v = std::strtod(text.c_str(), &end);
@@ -47,7 +47,7 @@ class Lines {
   }
   std::string Text(const std::string& field) {
     if (next_ >= lines_.size()) Truncated(field);
-    return Trim(lines_[next_++]);
+    return TrimField(lines_[next_++]);
   }
   double Number(const std::string& field) {
     const size_t line = next_ + 1;
@@ -138,9 +138,9 @@ IntensityDistribution ParseEulumdat(const std::string& text, const std::string& 
   d.keywords.push_back({"MANUFAC", in.Text("line 1 (company)")});
   const int ityp = in.Int("line 2 (type indicator Ityp)", 0, 3);
   const int isym = in.Int("line 3 (symmetry indicator Isym)", 0, 4);
-  const int mc = in.Int("line 4 (number of C planes Mc)", 1, kMaxAngles);
+  const int mc = in.Int("line 4 (number of C planes Mc)", 1, kMaxLdtAngles);
   in.Number("line 5 (distance between C planes Dc)");
-  const int ng = in.Int("line 6 (number of gamma angles Ng)", 2, kMaxAngles);
+  const int ng = in.Int("line 6 (number of gamma angles Ng)", 2, kMaxLdtAngles);
   in.Number("line 7 (distance between gamma angles Dg)");
   d.keywords.push_back({"TEST", in.Text("line 8 (measurement report number)")});
   d.keywords.push_back({"LUMINAIRE", in.Text("line 9 (luminaire name)")});
@@ -303,7 +303,7 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
      << keyword_or("LUMCAT", "") << "\n";
   const std::string base = name.substr(name.find_last_of('/') + 1);
   os << field(base) << "\n"
-     << field(Trim(d.Keyword("ISSUEDATE") + " " + d.Keyword("TESTLAB"))) << "\n";
+     << field(TrimField(d.Keyword("ISSUEDATE") + " " + d.Keyword("TESTLAB"))) << "\n";
   for (double v : {length, width, height, length, width, height, height, height, height})
     os << Num(v, 8) << "\n";
   os << Num(100.0 * d.FluxWithin(90) / flux, 8) << "\n"  // DFF: gamma < 90 is downward

@@ -17,7 +17,7 @@ const char* const kIesRequiredKeywords[4] = {"TEST", "TESTLAB", "ISSUEDATE", "MA
 
 namespace {
 
-constexpr int kMaxAngles = 100000;  // far above any real file; bounds memory on hostile input
+constexpr int kMaxIesAngles = 100000;  // far above any real file; bounds memory on hostile input
 constexpr double kFeetToMm = 304.8;
 
 std::vector<std::string> SplitLines(const std::string& text) {
@@ -151,7 +151,7 @@ IntensityDistribution ParseIes(const std::string& text, const std::string& name)
     // Lamp-to-luminaire geometry, then the pairs of tilt angle and multiplying factor. Read and
     // recorded; not applied, since they describe the lamp at other mounting tilts.
     const int geometry = in.NextInt("TILT=INCLUDE lamp-to-luminaire geometry", 1, 3);
-    const int pairs = in.NextInt("TILT=INCLUDE number of angle/factor pairs", 1, kMaxAngles);
+    const int pairs = in.NextInt("TILT=INCLUDE number of angle/factor pairs", 1, kMaxIesAngles);
     std::ostringstream os;
     os << "INCLUDE geometry " << geometry << ", " << pairs << " pairs:";
     std::vector<double> angles(pairs);
@@ -166,8 +166,8 @@ IntensityDistribution ParseIes(const std::string& text, const std::string& name)
   const int lamps = in.NextInt("number of lamps", 1, 1000000);
   const double lumens = in.Next("lumens per lamp");
   const double multiplier = in.NextPositive("candela multiplier");
-  const int n_vertical = in.NextInt("number of vertical angles", 1, kMaxAngles);
-  const int n_horizontal = in.NextInt("number of horizontal angles", 1, kMaxAngles);
+  const int n_vertical = in.NextInt("number of vertical angles", 1, kMaxIesAngles);
+  const int n_horizontal = in.NextInt("number of horizontal angles", 1, kMaxIesAngles);
   const int line_type = in.Line();
   const int type = in.NextInt("photometric type", 1, 3);
   if (type != 1)

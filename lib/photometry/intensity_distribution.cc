@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/input_file.h"
 #include "core/log.h"
 #include "lib/photometry/eulumdat.h"
@@ -14,7 +15,6 @@
 namespace lumislab {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kAngleTolerance = 1e-6;  // degrees: files print angles with a few decimals
 
 bool Near(double a, double b) { return std::abs(a - b) <= kAngleTolerance; }

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../cli/test_util.h"
+#include "core/geometry.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/photometry/eulumdat.h"
 #include "lib/photometry/ies.h"
@@ -22,8 +23,6 @@ namespace {
 using testing::FreshDir;
 using testing::RunTool;
 using testing::ShellQuote;
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The default scene's emitters 1 and 1.5 mm behind S (the slab's parallax error is then 0.1 %,
 // docs/design.md §4.5) on its 9 x 7 grid at 48 texels: a complete truth slab in a folder.

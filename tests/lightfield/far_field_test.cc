@@ -6,13 +6,12 @@
 
 #include <cmath>
 
+#include "core/geometry.h"
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
 
 namespace lumislab {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The default scene's setup (d = 750 mm, 9 x 7 grid, h = 5 mm, 1.2 m window) at 120 texels, its
 // two emitters moved to 1 and 1.5 mm behind S: the slab's own parallax error, first order in

@@ -8,14 +8,13 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "lib/photometry/eulumdat.h"
 #include "lib/photometry/ies.h"
 #include "lib/photometry/intensity_distribution.h"
 
 namespace lumislab {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string DataPath(const std::string& name) {
   return std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/ies/" + name;

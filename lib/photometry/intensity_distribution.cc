@@ -28,8 +28,10 @@ bool Locate(const std::vector<double>& grid, double x, size_t* i0, double* f) {
     return Near(x, grid[0]);
   }
   if (x < grid.front() - kAngleTolerance || x > grid.back() + kAngleTolerance) return false;
-  size_t k = 0;
-  while (k + 2 < grid.size() && x > grid[k + 1]) ++k;
+  // The last k with grid[k] < x (or 0), at most size - 2.
+  const size_t k = std::min<size_t>(
+      grid.size() - 2, size_t(std::max<std::ptrdiff_t>(
+                           0, std::lower_bound(grid.begin(), grid.end(), x) - grid.begin() - 1)));
   *i0 = k;
   *f = std::clamp((x - grid[k]) / (grid[k + 1] - grid[k]), 0.0, 1.0);
   return true;

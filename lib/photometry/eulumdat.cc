@@ -225,6 +225,10 @@ IntensityDistribution ParseEulumdat(const std::string& text, const std::string& 
                    std::to_string(mc) + " stores " + std::to_string(expected) +
                    " planes, but the C angles list " + std::to_string(d.c_deg.size()) +
                    " in its range");
+  if (d.c_deg.size() * ng > in.TokensLeft())
+    throw BadInput(name + ": the intensities: " + std::to_string(d.c_deg.size()) + " planes x " +
+                   std::to_string(ng) + " angles, the file has " + std::to_string(in.TokensLeft()) +
+                   " values left (truncated, or wrong counts)");
   d.values.resize(d.c_deg.size() * ng);
   for (size_t c = 0; c < d.c_deg.size(); ++c)
     for (int g = 0; g < ng; ++g)

@@ -183,6 +183,14 @@ IntensityDistribution ParseIes(const std::string& text, const std::string& name)
       in.Next(old_factor ? "ballast-lamp photometric factor" : "future use / file generation type");
   d.input_watts = in.Next("input watts");
   const double factor = multiplier * ballast * (old_factor && second > 0 ? second : 1.0);
+  // The counts must fit the numbers the file holds before anything is sized by them.
+  const size_t needed = size_t(n_vertical) + n_horizontal + size_t(n_vertical) * n_horizontal;
+  if (needed > in.Left())
+    throw BadInput(name + ": line " + std::to_string(line_type) + ": " +
+                   std::to_string(n_vertical) + " vertical x " + std::to_string(n_horizontal) +
+                   " horizontal angles need " + std::to_string(needed) +
+                   " numbers after this line, the file has " + std::to_string(in.Left()) +
+                   " (truncated, or wrong counts)");
   d.gamma_deg.resize(n_vertical);
   for (int k = 0; k < n_vertical; ++k)
     d.gamma_deg[k] = in.Next("vertical angle " + std::to_string(k + 1));

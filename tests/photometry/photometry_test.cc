@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -214,7 +215,9 @@ TEST(Eulumdat, ReadsTheIsymLayoutsAndDecimalCommas) {
   const std::string cut = os.str().substr(0, os.str().rfind("0\n"));
   const auto [code, message] = Thrown([&] { ParseEulumdat(cut, "f.ldt"); });
   EXPECT_EQ(code, 2);
-  EXPECT_NE(message.find("f.ldt: intensity 2 of C plane 90"), std::string::npos) << message;
+  EXPECT_NE(message.find("f.ldt: the intensities: 2 planes x 2 angles, the file has 3 values left"),
+            std::string::npos)
+      << message;
 }
 
 std::string ReadText(const std::string& path) { return ReadTextFile(path); }
@@ -255,10 +258,12 @@ TEST(Ies, BadInputNamesTheFileAndTheField) {
     const char* expected;  // in the message
   };
   const Case cases[] = {
-      {"truncated", one.substr(0, one.size() / 2), "bad.ies: candela value"},
+      {"truncated", one.substr(0, one.size() / 2),
+       "bad.ies: line 27: 74 vertical x 12 horizontal angles need 974 numbers after this line, "
+       "the file has 418"},
       {"cut before the data", one.substr(0, one.find("TILT")), "bad.ies: no TILT= line"},
       {"fewer vertical angles than counted", Replace(seven, "24 -1 1 37", "24 -1 1 38"),
-       "bad.ies: candela value 37 of horizontal angle 1: the file ends"},
+       "bad.ies: line 22: 38 vertical x 1 horizontal angles need 77 numbers"},
       {"more values than counted", Replace(seven, "24 -1 1 37", "24 -1 1 36"),
        "bad.ies: line 28: 2 number(s) after the last candela value"},
       {"NaN value", Replace(seven, " 102 90", " nan 90"),
@@ -282,6 +287,34 @@ TEST(Ies, BadInputNamesTheFileAndTheField) {
   const auto [code, message] = Thrown([&] { ReadIntensityFile(DataPath("missing.ies")); });
   EXPECT_EQ(code, 2);
   EXPECT_NE(message.find("missing.ies"), std::string::npos);
+}
+
+// Hostile input: thousands of truncations and byte changes of the real files either read or are
+// refused as bad input (exit 2), never a crash, a hang or an allocation sized by a wild count.
+TEST(Ies, MutatedFilesAreReadOrRefused) {
+  std::mt19937 rng(11);
+  for (const Reference& r : kReferences) {
+    const std::string text = ReadText(DataPath(r.file));
+    const IntensityDistribution d = ParseIes(text, r.file);
+    const std::string ldt = FormatEulumdat(d, "x.ldt");
+    for (int k = 0; k < 500; ++k) {
+      for (const std::string* original : {&text, &ldt}) {
+        std::string bad = *original;
+        std::uniform_int_distribution<size_t> at(0, bad.size() - 1);
+        if (k % 4 == 0) {
+          bad.resize(at(rng));
+        } else {
+          for (int m = 0; m < 1 + k % 3; ++m)
+            bad[at(rng)] = "0123456789 -.,e\n9"[std::uniform_int_distribution<int>(0, 17)(rng)];
+        }
+        try {
+          (original == &text ? ParseIes : ParseEulumdat)(bad, "m");
+        } catch (const Error& e) {
+          ASSERT_EQ(e.exit_code(), 2) << e.what();
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -191,6 +191,29 @@ TEST(ExportFormats, BadInputIsExitTwoAndWritesNothing) {
       << r.output;
 }
 
+// A slab scaled with a lux meter (units "lux") gives candela and lumen: IES without the
+// radiometric keyword, TM-25 with the luminous flux column.
+TEST(ExportFormats, LuxSlabsArePhotometric) {
+  const std::string dir = FreshDir("export_lux");
+  SlabInfo info = DefaultSlabInfo(3, 3, 5, 16);
+  info.units = "lux";
+  WriteTruthSlab(Data().luminaire, info, dir + "/slab", 2);
+  auto r = RunTool("lumislab-export", "ies --slab " + ShellQuote(dir) + " --out " +
+                                          ShellQuote(dir + "/x.ies") + kKeywords);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(" lm over the seen directions"), std::string::npos) << r.output;
+  const IntensityDistribution d = ReadIes(dir + "/x.ies");
+  EXPECT_TRUE(d.photometric);
+  EXPECT_EQ(d.Keyword("_UNITS"), "");
+  r = RunTool("lumislab-export", "tm25 --slab " + ShellQuote(dir) + " --out " +
+                                     ShellQuote(dir + "/x.ray") + " --rays 100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Tm25RaySet rays = ReadTm25(dir + "/x.ray");
+  EXPECT_TRUE(rays.photometric);
+  EXPECT_NEAR(rays.luminous_flux_lm, rays.FluxSum(), 1e-4 * rays.FluxSum());
+  EXPECT_TRUE(std::isnan(rays.radiant_flux_w));
+}
+
 // The exported intensity of a luminaire whose one emitter is a measured IES file (1.ies, a real
 // 9218 lm luminaire, as the scene's "distribution"), against that file: relative L2 over the
 // directions the screen saw, and the flux in those directions. Returns the relative L2.

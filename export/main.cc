@@ -1,9 +1,10 @@
-// lumislab-export: the subcommands come from plots_cli (irradiance, polar).
-// (The photometry work's main.cc adds formats_cli's set the same way; the merge keeps one main.)
+// lumislab-export: the subcommands come from formats_cli (info, ies, ldt, tm25) and plots_cli
+// (irradiance, polar).
 #include <CLI/CLI.hpp>
 
 #include "core/command_line.h"
 #include "core/error.h"
+#include "export/formats_cli.h"
 #include "export/plots_cli.h"
 
 namespace lumislab {
@@ -16,9 +17,11 @@ int RunExport(int argc, char** argv) {
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);
+  const ParsedCommand formats = AddFormatCommands(app, &common);
   const ParsedCommand plots = AddPlotCommands(app, &common);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("export", common);
+  if (const auto code = formats(threads)) return *code;
   if (const auto code = plots(threads)) return *code;
   return 2;  // unreachable: CLI11 requires one subcommand
 }

@@ -1,13 +1,6 @@
-// The far-field intensity of a slab (docs/design.md §4.9), the input of the polar plot:
-//   I(w) = ∫_S L(u, v, w) cos(theta) du dv,
-// with the exact model's L~ = (1/h^2) Σ_ij (R^2/cos^2 theta) Φ_ij(u, v) E_ij(s, t) (§3.3). Towards
-// a fixed direction w every (u, v) looks at (s, t) = (u, v) + d (w_x, w_y) / w_z, and R = d / cos
-// theta is the same for all, so
-//   I(w) = (d^2 / cos^3 theta) Σ_ij (1/h^2) ∫ Φ_ij(u, v) E_ij((u, v) + d w_xy / w_z) du dv,
-// the inner integral by BellQuadrature's N x N rule.
-// **Minimal stand-in**: the photometry work (lumislab-export ies/ldt, issue 11) builds the full
-// far field under the same names and interface; this file keeps only what the polar plot needs,
-// so that the two merge into one implementation (theirs).
+// What a slab says about the luminaire far away and as rays (docs/design.md §5.17): the
+// far-field intensity I(w) = integral over S of L(x, w) cos(theta) dA, from the exact model of
+// §3.3, and rays importance-sampled from the slab's radiance (TM-25 export). GL-free.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,35 +12,62 @@
 
 namespace lumislab {
 
-// Rec. 709 luminance: the one channel the far field carries (W/sr for W/m^2 slabs, cd for lux).
+// Rec. 709 luminance: the one channel far-field and ray files carry (lux slabs give cd and lm,
+// W/m^2 slabs W/sr and W, as calib/scale.json's radiometer reading weighs RGB, §5.16).
 inline Eigen::Vector3d LuminanceWeights() { return {0.2126, 0.7152, 0.0722}; }
 
-// Every position the slab lists (E_ij and mask) by linear index j * nu + i, empty for the
-// others, read on `threads` threads; a damaged file is exit 2 (ReadSlabPosition).
+// Every position the slab lists, E_ij and mask, by linear index j * nu + i (empty for the
+// others), read on `threads` threads (ReadSlabPosition: a damaged file is exit 2).
 std::vector<SlabPosition> ReadSlabPositions(const std::string& slab_dir, const SlabInfo& info,
                                             int threads);
 
 struct FarFieldOptions {
-  int samples = 4;  // N x N bell quadrature per position
-  Eigen::Vector3d channel_weights = LuminanceWeights();
+  int samples = 4;                                       // N x N bell quadrature per position
+  Eigen::Vector3d channel_weights = LuminanceWeights();  // RGB -> the one channel
   int threads = 1;
 };
 
-// I on a C / gamma grid (degrees, photometry type C: gamma = 0 along +z, C = 0 towards +x, C = 90
-// towards +y; docs/design.md §5.17).
+// I on a C / gamma grid (degrees, type C: gamma = 0 along +z, C = 0 towards +x, C = 90 towards
+// +y; docs/design.md §5.17).
 struct FarField {
   std::vector<double> c_deg, gamma_deg;
-  std::vector<double> values;  // values[ic * gamma_deg.size() + ig], W/sr (cd for lux slabs)
-  std::vector<uint8_t> seen;   // 1: every sample of every position landed on seen texels
+  std::vector<double> values;  // values[ic * gamma_deg.size() + ig]: W/sr (cd for lux slabs)
+  std::vector<uint8_t> seen;   // 1: every sample of every position saw the direction
   int unseen = 0;              // directions not seen (value 0), those behind S included
   int behind = 0;              // of which gamma >= 90: behind S, never seen
 };
 
-// The formula above for each (C, gamma); a direction is seen when every sample lands inside the
-// window on texels whose bilinear neighbours are all seen (mask 1), else its value is 0 (the slab
-// lacks part of its light). Positions with an empty image are left out.
+// I(w) = d^2 / (cos^3 theta 10^6) sum_ij sum_k (w_k / h^2) E_ij(q_k + d tan(theta) (cos C,
+// sin C)) (W/sr): the exact model's radiance (R^2 / cos^2 theta) E_ij / h^2 with R = d / cos
+// theta for every point q of S, times cos theta, integrated over S with the bell quadrature of
+// each position (BellQuadrature, N x N points q_k of weight w_k). A direction is seen when every
+// point lands inside the window on texels whose bilinear neighbours are all seen (mask 1);
+// otherwise, and for gamma >= 90 (light leaves S towards +z only), its value is 0. Positions
+// with an empty image are left out (the caller decides whether a partial slab may be used).
 FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                          const std::vector<double>& c_deg, const std::vector<double>& gamma_deg,
                          const FarFieldOptions& options);
+
+struct SlabRay {
+  Eigen::Vector3d origin_mm;  // on S (z = 0), luminaire frame
+  Eigen::Vector3d direction;  // unit, z > 0
+};
+struct SlabRays {
+  std::vector<SlabRay> rays;
+  double flux_per_ray = 0;   // W (lm for lux slabs); the same for every ray
+  double total_flux = 0;     // the slab's flux: sum over positions and seen texels of E dA
+  double negative_flux = 0;  // estimate of the light field's negative part, left out
+};
+
+// N rays distributed as the slab's light field (the exact model, §3.3): through texel dA of M,
+// basis function ij sends Phi_ij(u, v) E_ij(s, t) / h^2 du dv dA (W), so the flux density over
+// (u, v, s, t) is sum_ij Phi_ij E_ij / h^2. E_ij is signed (the dual filter has negative lobes)
+// while the sum is the light field, so the rays are drawn from |E_ij| dA (position and seen
+// texel), (u, v) from Phi_ij by rejection, (s, t) uniformly in the texel, and kept with
+// probability max(0, sum Phi E) / sum Phi |E| over the positions at (u, v). Every ray carries
+// total_flux / N. Deterministic for a seed.
+SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                        int64_t count, uint64_t seed,
+                        const Eigen::Vector3d& channel_weights = LuminanceWeights());
 
 }  // namespace lumislab

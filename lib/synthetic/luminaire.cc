@@ -1,6 +1,11 @@
 #include "lib/synthetic/luminaire.h"
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+
+#include "core/error.h"
+#include "core/geometry.h"
 
 namespace lumislab {
 namespace {
@@ -19,9 +24,32 @@ double PowCos(double c, double p) {
 
 }  // namespace
 
-Eigen::Vector3d Emitter::Intensity(const Eigen::Vector3d& w) const {
-  if (!(w.z() > 0)) return Eigen::Vector3d::Zero();
-  return PowCos(w.z(), lobe_exponent) * intensity_w_sr;
+MeasuredLobe MeasuredLobe::Load(const std::string& file, const Eigen::Vector3d& rotation_deg) {
+  MeasuredLobe lobe;
+  lobe.distribution = std::make_shared<const IntensityDistribution>(ReadIntensityFile(file));
+  lobe.file = file;
+  lobe.rotation_deg = rotation_deg;
+  const Eigen::Vector3d r = rotation_deg * kPi / 180;
+  lobe.luminaire_from_file = (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
+                              Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+                              Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
+                                 .toRotationMatrix();
+  const std::vector<double>& v = lobe.distribution->values;
+  lobe.peak = *std::max_element(v.begin(), v.end());
+  if (!(lobe.peak > 0)) throw BadInput(file + ": no light in the distribution (every value 0)");
+  return lobe;
+}
+
+double MeasuredLobe::Shape(const Eigen::Vector3d& w) const {
+  const Eigen::Vector3d local = luminaire_from_file.transpose() * w;
+  const double gamma = std::acos(std::clamp(local.z(), -1.0, 1.0)) * 180 / kPi;
+  const double c = std::atan2(local.y(), local.x()) * 180 / kPi;
+  return distribution->Intensity(c, gamma) / peak;
+}
+
+double Emitter::Shape(const Eigen::Vector3d& w) const {
+  if (!(w.z() > 0)) return 0;
+  return measured ? measured->Shape(w) : PowCos(w.z(), lobe_exponent);
 }
 
 double EmitterIrradianceFactor(const Emitter& e, double d_mm, double s_mm, double t_mm,
@@ -35,8 +63,10 @@ double EmitterIrradianceFactor(const Emitter& e, double d_mm, double s_mm, doubl
   *v_mm = p.y() + dy * a;
   if (!(dz > 0)) return 0;
   const double r2 = dx * dx + dy * dy + dz * dz;  // mm^2
-  const double cos_m = dz / std::sqrt(r2);
+  const double r = std::sqrt(r2);
+  const double cos_m = dz / r;
   // I cos / r^2 with r in metres: the plane M is normal to z, as is the lobe axis.
+  if (e.measured) return e.Shape(Eigen::Vector3d(dx, dy, dz) / r) * cos_m * 1e6 / r2;
   return PowCos(cos_m, e.lobe_exponent + 1) * 1e6 / r2;
 }
 

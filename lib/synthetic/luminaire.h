@@ -4,20 +4,43 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "core/basis.h"
+#include "lib/photometry/intensity_distribution.h"
 
 namespace lumislab {
 
-// One point emitter. Intensity towards direction w (unit) is I0 cos^n(angle of w to +z) for
-// w_z > 0 and zero behind.
+// A measured far-field distribution (IES or EULUMDAT file, docs/design.md §5.10, §5.17) as an
+// emitter's lobe: the file's intensity divided by its peak, its gamma = 0 axis and C = 0 plane
+// turned into the luminaire frame by `luminaire_from_file` (R = Rz Ry Rx of rotation_deg).
+struct MeasuredLobe {
+  std::shared_ptr<const IntensityDistribution> distribution;
+  std::string file;  // the path it was read from
+  Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d luminaire_from_file = Eigen::Matrix3d::Identity();
+  double peak = 1;  // the largest value of the file (cd or W/sr)
+
+  // Reads the file (BadInput naming it) and sets the rotation.
+  static MeasuredLobe Load(const std::string& file, const Eigen::Vector3d& rotation_deg);
+  // The file's intensity towards unit direction w (luminaire frame) over its peak.
+  double Shape(const Eigen::Vector3d& w) const;
+};
+
+// One point emitter. Intensity towards direction w (unit) is I0 cos^n(angle of w to +z), or
+// I0 times a measured lobe, for w_z > 0 and zero behind.
 struct Emitter {
   Eigen::Vector3d position_mm;     // luminaire frame, z < 0 (behind S)
-  Eigen::Vector3d intensity_w_sr;  // I0 per RGB channel, W/sr
+  Eigen::Vector3d intensity_w_sr;  // I0 per RGB channel, W/sr (a measured lobe's peak)
   double lobe_exponent = 0;        // n >= 0
-  // I0 cos^n(angle of the unit direction w to +z), zero for w_z <= 0 (W/sr).
-  Eigen::Vector3d Intensity(const Eigen::Vector3d& w) const;
+  std::shared_ptr<const MeasuredLobe> measured = nullptr;  // set: replaces cos^n
+
+  // cos^n(angle of the unit direction w to +z) or the measured lobe, zero for w_z <= 0.
+  double Shape(const Eigen::Vector3d& w) const;
+  // I0 Shape(w) (W/sr).
+  Eigen::Vector3d Intensity(const Eigen::Vector3d& w) const { return Shape(w) * intensity_w_sr; }
 };
 
 struct Luminaire {

@@ -57,7 +57,28 @@ Luminaire ParseLuminaire(const JsonView& root) {
     const JsonView intensity = e["intensity_w_sr"];
     for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
     if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr");
-    emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
+    if (e.Has("distribution") == e.Has("lobe_exponent"))
+      e.Fail("either lobe_exponent or distribution (a measured IES / EULUMDAT file)");
+    if (e.Has("lobe_exponent")) {
+      emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
+    } else {
+      // {"file": "x.ies" | "x.ldt", "rotation_deg": [rx, ry, rz]}: the file relative to the
+      // JSON file's folder; R = Rz Ry Rx turns its gamma = 0 axis into the luminaire frame.
+      const JsonView d = e["distribution"];
+      for (const std::string& key : d.Keys())
+        if (key != "file" && key != "rotation_deg") d[key].Fail("file or rotation_deg");
+      std::filesystem::path file = d["file"].String();
+      if (file.is_relative()) file = std::filesystem::path(d.file()).parent_path() / file;
+      Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
+      if (d.Has("rotation_deg")) {
+        const std::vector<double> r = d["rotation_deg"].Numbers(3);
+        for (int a = 0; a < 3; ++a) rotation[a] = r[a];
+        for (double x : r)
+          if (std::abs(x) > 36000) d["rotation_deg"].Fail("three angles within 36000 degrees");
+      }
+      emitter.measured =
+          std::make_shared<const MeasuredLobe>(MeasuredLobe::Load(file.string(), rotation));
+    }
     luminaire.emitters.push_back(emitter);
   }
   return luminaire;

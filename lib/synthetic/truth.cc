@@ -1,6 +1,7 @@
 #include "lib/synthetic/truth.h"
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
@@ -109,10 +110,22 @@ void WriteTruthCamera(const SynthScene& scene, const std::string& path) {
 
 void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
   nlohmann::json emitters = nlohmann::json::array();
-  for (const Emitter& e : luminaire.emitters)
-    emitters.push_back({{"position_mm", Vec(e.position_mm)},
-                        {"intensity_w_sr", Vec(e.intensity_w_sr)},
-                        {"lobe_exponent", e.lobe_exponent}});
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  for (size_t k = 0; k < luminaire.emitters.size(); ++k) {
+    const Emitter& e = luminaire.emitters[k];
+    nlohmann::json j = {{"position_mm", Vec(e.position_mm)},
+                        {"intensity_w_sr", Vec(e.intensity_w_sr)}};
+    if (e.measured) {
+      // A copy of the measured file beside luminaire.json, so the dataset stands on its own.
+      const std::string name = "emitter_" + std::to_string(k) +
+                               std::filesystem::path(e.measured->file).extension().string();
+      WriteTextAtomically((folder / name).string(), ReadTextFile(e.measured->file));
+      j["distribution"] = {{"file", name}, {"rotation_deg", Vec(e.measured->rotation_deg)}};
+    } else {
+      j["lobe_exponent"] = e.lobe_exponent;
+    }
+    emitters.push_back(j);
+  }
   nlohmann::json j;
   j["schema_version"] = 1;
   j["luminaire"] = {{"emitters", emitters}};

@@ -46,6 +46,35 @@ TEST(SceneFile, DefaultSceneIsValid) {
               0, 1e-9);
 }
 
+// An emitter's measured distribution (an IES or EULUMDAT file) instead of cos^n: exactly one of
+// the two, the file named when it is bad.
+TEST(SceneFile, MeasuredDistributionEmitters) {
+  const std::string ies = std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/ies/7.ies";
+  const std::string measured =
+      "\"distribution\": {\"file\": \"" + ies + "\", \"rotation_deg\": [0, 0, 90]}";
+  std::string text = DefaultSceneJson();
+  text.replace(text.find("\"lobe_exponent\": 8"), 18, measured);
+  const SynthScene scene = ParseScene(text, "scene.json");
+  const Emitter& e = scene.luminaire.emitters[0];
+  ASSERT_TRUE(e.measured);
+  // 7.ies is axial: its intensity over its peak (269 cd at gamma 0), whatever the rotation.
+  EXPECT_NEAR(e.Shape(Eigen::Vector3d(0, 0, 1)), 1, 1e-12);
+  const double g = 30 * 3.14159265358979 / 180;
+  EXPECT_NEAR(e.Shape(Eigen::Vector3d(std::sin(g), 0, std::cos(g))), 200.0 / 269,
+              1e-9);  // 200 cd at 30 degrees
+  EXPECT_EQ(e.Shape(Eigen::Vector3d(0, 0, -1)), 0);
+  EXPECT_NE(ParseError("\"lobe_exponent\": 8", measured + ", \"lobe_exponent\": 8")
+                .find("luminaire.emitters[0]: expected either lobe_exponent or distribution"),
+            std::string::npos);
+  EXPECT_NE(ParseError("\"lobe_exponent\": 8", "\"distribution\": {\"file\": \"none.ies\"}")
+                .find("none.ies: photometric file not found"),
+            std::string::npos);
+  EXPECT_NE(ParseError("\"lobe_exponent\": 8",
+                       "\"distribution\": {\"file\": \"" + ies + "\", \"rotate\": 1}")
+                .find("luminaire.emitters[0].distribution.rotate: expected file or rotation_deg"),
+            std::string::npos);
+}
+
 TEST(SceneFile, BadFieldsNameFileAndField) {
   EXPECT_EQ(ParseError("\"lobe_exponent\": 8", "\"lobe_exponent\": \"x\""),
             "scene.json: luminaire.emitters[0].lobe_exponent: expected number in [0, 1e+06], got "

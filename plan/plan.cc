@@ -131,10 +131,6 @@ ErrorTerms PredictError(const PlanInput& in, const PlanSetting& s, double D) {
   return e;
 }
 
-double LabSeconds(const PlanInput& in, const PlanSetting& s) {
-  return s.positions() * (in.move_s + in.slides * in.brackets * in.exposure_s);
-}
-
 PlanInput PlanInputFromScene(const SynthScene& scene) {
   PlanInput in;
   in.distance_mm = scene.distance_mm;
@@ -161,7 +157,7 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
   p.covers = SettingCovers(in, s);
   p.at_d = PredictError(in, s, in.distance_mm);
   p.at_D = PredictError(in, s, in.D());
-  p.lab_s = LabSeconds(in, s);
+  p.lab_s = in.lab.Seconds(s.positions());
   p.roi_max = ScreenHoldsRoi(in, s);
   p.reachable = p.at_D.total <= in.target;
   if ((in.roi_w_mm > 0 && in.roi_w_mm > p.roi_max.u_mm + 1e-9) ||
@@ -410,18 +406,7 @@ int RunPlan(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--resolution", resolution, "evaluate: slab resolution (default 150)")
       ->check(CLI::Range(8, 1000));
-  app.add_option("--move-s", in.move_s, "lab model: stage move and settle per position, s")
-      ->check(FiniteIn(0, 1e6))
-      ->capture_default_str();
-  app.add_option("--exposure-s", in.exposure_s, "lab model: one exposure with readout, s")
-      ->check(FiniteIn(0, 1e6))
-      ->capture_default_str();
-  app.add_option("--slides", in.slides, "lab model: slides per position")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
-  app.add_option("--brackets", in.brackets, "lab model: exposures per slide")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
+  AddLabModelOptions(&app, &in.lab, /*brackets_option=*/true);
   app.add_option("--json", json_out, "also write the plan as JSON to this file");
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   StartTool("plan", common);

@@ -174,6 +174,24 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
         " mm is outside the model's calibrated range: the study measured more error than it "
         "predicts there (h = 20 mm, 5 x 5, default scene: 0.32 % at d, 0.88 % at 2d; §4.8)");
   }
+  // Receivers near S (D -> 0): the parallax error is first order in a = z/(d + z) |1 - d/D|,
+  // bounded by 2 a sum|c_m| (§4.5) for the deepest light. Once that reaches 1 the expansion the
+  // model rests on does not converge (measured on the default scene: 0.05 d, 2 a sum|c_m| = 1.7;
+  // §8.2): no prediction holds, whatever the grid.
+  double z_max = 0;
+  for (const LightPoint& l : in.light) z_max = std::max(z_max, l.z);
+  const double first_order = 2 * z_max / (in.distance_mm + z_max) *
+                             std::abs(1 - in.distance_mm / in.D()) * SumAbsDual(s.k_max);
+  if (first_order >= 1) {
+    p.reachable = false;
+    char buf[240];
+    std::snprintf(buf, sizeof buf,
+                  "the receiver plane at D = %.4g mm is too close to S for the method: the "
+                  "first-order parallax bound 2 a sum|c_m| is %.2f (>= 1) for light %.4g mm "
+                  "behind S, so no error prediction holds there (docs/design.md §8.2)",
+                  in.D(), first_order, z_max);
+    p.warnings.push_back(buf);
+  }
   if (!p.covers) {
     p.reachable = false;
     p.warnings.push_back(

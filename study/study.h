@@ -21,7 +21,11 @@ struct StudyRow {
   // reaches them through the slab), -1 when none is; and the analytic flux's share there.
   double err_covered[3] = {0, 0, 0};
   double covered[3] = {0, 0, 0};
+  double full_well_e = 0;  // sensor_noise's full well (0: the scene's effects as given)
+  int brackets = 1;        // exposures per slide (the lab model's brackets)
+  double lambda = -1;      // reconstruct --lambda (-1: its default, 1e-4)
   double lab_s = 0, acquire_s = 0, calibrate_s = 0, reconstruct_s = 0, render_s = 0, total_s = 0;
+  double preview_ms = 0;  // median OSMesa frame of the crypt with this slab (not in total_s)
   int positions() const { return nu * nv; }
 };
 
@@ -30,6 +34,8 @@ struct StudyRow {
 std::string StudyCsvHeader();
 std::string StudyCsvLine(const StudyRow& row);
 std::vector<StudyRow> ReadStudyCsv(const std::string& path);
+// The fields of one CSV line (no quoting: the study's values hold no comma).
+std::vector<std::string> SplitCsvLine(const std::string& line);
 
 // Indices of the rows on the Pareto front of (total_s, err[d_index]): no other row is at least
 // as fast and at least as accurate and better in one; one row per key; sorted by time.

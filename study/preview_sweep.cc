@@ -47,29 +47,14 @@ std::string PreviewCsvLine(const PreviewRow& r) {
 }
 
 std::vector<PreviewRow> ReadPreviewCsv(const std::string& path) {
-  std::istringstream in(ReadTextFile(path));
-  std::string line;
-  if (!std::getline(in, line) || line != PreviewCsvHeader())
-    throw BadInput(path + ": line 1: expected the header of lumislab-study's preview CSV, got \"" +
-                   line.substr(0, 60) + "\"");
   std::vector<PreviewRow> rows;
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    const std::vector<std::string> f = SplitCsvLine(line);
-    const auto bad = [&](const std::string& why) {
-      return BadInput(path + ": line " + std::to_string(number) + ": " + why);
-    };
-    if (f.size() != 7) throw bad("expected 7 fields, got " + std::to_string(f.size()));
+  ReadCsvLines(path, PreviewCsvHeader(), 7, [&](const std::vector<std::string>& f) {
     PreviewRow r;
     r.scene = f[0], r.knob = f[1], r.value = f[2];
-    try {
-      r.rel_l2 = std::stod(f[3]), r.p95 = std::stod(f[4]);
-      r.frame_ms = std::stod(f[5]), r.wall_s = std::stod(f[6]);
-    } catch (const std::exception&) {
-      throw bad("a field is not a number");
-    }
+    r.rel_l2 = std::stod(f[3]), r.p95 = std::stod(f[4]);
+    r.frame_ms = std::stod(f[5]), r.wall_s = std::stod(f[6]);
     rows.push_back(r);
-  }
+  });
   return rows;
 }
 

@@ -516,7 +516,7 @@ int RunStudy(int argc, char** argv) {
   WriteTextAtomically(out + "/report.md", report);
   WriteTextAtomically(out + "/study_d.svg", StudySvg(rows, kKnobs, 0));
   WriteTextAtomically(out + "/study_4d.svg", StudySvg(rows, kKnobs, 2));
-  std::cout << ParetoTables(rows) << out << "/report.md\n";
+  std::cout << ParetoTables(rows) << TargetTable(rows) << out << "/report.md\n";
   return 0;
 }
 

@@ -4,6 +4,7 @@
 // irradiance of the exact reference against the analytic image at D = d, 2d, 4d, with the times.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,11 @@ std::string StudyCsvLine(const StudyRow& row);
 std::vector<StudyRow> ReadStudyCsv(const std::string& path);
 // The fields of one CSV line (no quoting: the study's values hold no comma).
 std::vector<std::string> SplitCsvLine(const std::string& line);
+// The data lines of a CSV the study wrote (study.csv, preview.csv): the first line must be
+// `header`, each other line `fields` fields that `parse` accepts (it throws std::exception on a
+// field that is not a number); otherwise bad input naming the file and line.
+void ReadCsvLines(const std::string& path, const std::string& header, size_t fields,
+                  const std::function<void(const std::vector<std::string>&)>& parse);
 
 // Indices of the rows on the Pareto front of (total_s, err[d_index]): no other row is at least
 // as fast and at least as accurate and better in one; one row per key; sorted by time.
@@ -46,6 +52,9 @@ std::vector<size_t> ParetoFront(const std::vector<StudyRow>& rows, int d_index);
 std::string StudyReport(const std::vector<StudyRow>& rows,
                         const std::vector<std::string>& knob_order, const std::string& header);
 std::string ParetoTables(const std::vector<StudyRow>& rows);
+// For targets 5 %, 2 %, 1 %, 0.5 % at D = d and 4d, the measured row of least total time within
+// each (or "none measured"), with its lab, reconstruct, render and preview times.
+std::string TargetTable(const std::vector<StudyRow>& rows);
 // Error at D = d_index against total time, log axes, one curve per knob, the front marked.
 std::string StudySvg(const std::vector<StudyRow>& rows, const std::vector<std::string>& knob_order,
                      int d_index);

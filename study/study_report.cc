@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -74,45 +75,52 @@ std::string StudyCsvLine(const StudyRow& r) {
   return s.str();
 }
 
-std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
+void ReadCsvLines(const std::string& path, const std::string& header, size_t fields,
+                  const std::function<void(const std::vector<std::string>&)>& parse) {
   std::istringstream in(ReadTextFile(path));
   std::string line;
-  if (!std::getline(in, line) || line != StudyCsvHeader())
+  if (!std::getline(in, line) || line != header)
     throw BadInput(path + ": line 1: expected the header of lumislab-study's CSV, got \"" +
                    line.substr(0, 60) + "\"");
-  std::vector<StudyRow> rows;
   for (int number = 2; std::getline(in, line); ++number) {
     if (line.empty()) continue;
     const std::vector<std::string> f = SplitCsvLine(line);
-    const auto bad = [&](const std::string& why) {
-      return BadInput(path + ": line " + std::to_string(number) + ": " + why);
-    };
-    if (f.size() != 36) throw bad("expected 36 fields, got " + std::to_string(f.size()));
-    StudyRow r;
+    const std::string where = path + ": line " + std::to_string(number) + ": ";
+    if (f.size() != fields)
+      throw BadInput(where + "expected " + std::to_string(fields) + " fields, got " +
+                     std::to_string(f.size()));
     try {
-      size_t i = 0;
-      r.knob = f[i++], r.value = f[i++], r.key = f[i++];
-      r.h_mm = std::stod(f[i++]);
-      r.nu = std::stoi(f[i++]), r.nv = std::stoi(f[i++]);
-      ++i;  // positions = nu * nv
-      r.photo_w = std::stoi(f[i++]), r.photo_h = std::stoi(f[i++]);
-      r.k_max = std::stoi(f[i++]), r.slab_res = std::stoi(f[i++]);
-      r.samples = std::stoi(f[i++]), r.render_px = std::stoi(f[i++]);
-      r.full_well_e = std::stod(f[i++]), r.brackets = std::stoi(f[i++]);
-      r.lambda = std::stod(f[i++]);
-      r.slab_rel_l2 = std::stod(f[i++]);
-      for (int k = 0; k < 3; ++k) r.err[k] = std::stod(f[i++]), r.flux[k] = std::stod(f[i++]);
-      for (int k = 0; k < 3; ++k)
-        r.err_covered[k] = std::stod(f[i++]), r.covered[k] = std::stod(f[i++]);
-      r.lab_s = std::stod(f[i++]), r.acquire_s = std::stod(f[i++]);
-      r.calibrate_s = std::stod(f[i++]), r.reconstruct_s = std::stod(f[i++]);
-      r.render_s = std::stod(f[i++]), r.total_s = std::stod(f[i++]);
-      r.preview_ms = std::stod(f[i++]);
+      parse(f);
     } catch (const std::exception&) {
-      throw bad("a field is not a number");
+      throw BadInput(where + "a field is not a number");
     }
-    rows.push_back(r);
   }
+}
+
+std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
+  std::vector<StudyRow> rows;
+  ReadCsvLines(path, StudyCsvHeader(), 36, [&](const std::vector<std::string>& f) {
+    StudyRow r;
+    size_t i = 0;
+    r.knob = f[i++], r.value = f[i++], r.key = f[i++];
+    r.h_mm = std::stod(f[i++]);
+    r.nu = std::stoi(f[i++]), r.nv = std::stoi(f[i++]);
+    ++i;  // positions = nu * nv
+    r.photo_w = std::stoi(f[i++]), r.photo_h = std::stoi(f[i++]);
+    r.k_max = std::stoi(f[i++]), r.slab_res = std::stoi(f[i++]);
+    r.samples = std::stoi(f[i++]), r.render_px = std::stoi(f[i++]);
+    r.full_well_e = std::stod(f[i++]), r.brackets = std::stoi(f[i++]);
+    r.lambda = std::stod(f[i++]);
+    r.slab_rel_l2 = std::stod(f[i++]);
+    for (int k = 0; k < 3; ++k) r.err[k] = std::stod(f[i++]), r.flux[k] = std::stod(f[i++]);
+    for (int k = 0; k < 3; ++k)
+      r.err_covered[k] = std::stod(f[i++]), r.covered[k] = std::stod(f[i++]);
+    r.lab_s = std::stod(f[i++]), r.acquire_s = std::stod(f[i++]);
+    r.calibrate_s = std::stod(f[i++]), r.reconstruct_s = std::stod(f[i++]);
+    r.render_s = std::stod(f[i++]), r.total_s = std::stod(f[i++]);
+    r.preview_ms = std::stod(f[i++]);
+    rows.push_back(r);
+  });
   return rows;
 }
 
@@ -151,6 +159,31 @@ std::string ParetoTables(const std::vector<StudyRow>& rows) {
   return s.str();
 }
 
+std::string TargetTable(const std::vector<StudyRow>& rows) {
+  std::ostringstream s;
+  s << "Cheapest measured setting per target (least total time with the error at D within the "
+       "target):\n\n"
+    << "| target | D | error | total | lab | reconstruct | render | preview frame | knob = value "
+       "| setting |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (int d : {0, 2})
+    for (double target : {0.05, 0.02, 0.01, 0.005}) {
+      const StudyRow* best = nullptr;
+      for (const StudyRow& r : rows)
+        if (r.err[d] <= target && (!best || r.total_s < best->total_s)) best = &r;
+      s << "| " << Percent(target) << " | " << kDLabel[d] << " | ";
+      if (!best) {
+        s << "none measured | | | | | | | |\n";
+        continue;
+      }
+      const StudyRow& r = *best;
+      s << Percent(r.err[d]) << " | " << Seconds(r.total_s) << " | " << Seconds(r.lab_s) << " | "
+        << Seconds(r.reconstruct_s) << " | " << Seconds(r.render_s) << " | "
+        << Fixed(r.preview_ms, "%.3g ms") << " | " << r.knob << " = " << r.value << " | "
+        << Setting(r) << " |\n";
+    }
+  return s.str() + "\n";
+}
+
 std::string StudyReport(const std::vector<StudyRow>& rows,
                         const std::vector<std::string>& knob_order, const std::string& header) {
   std::ostringstream s;
@@ -177,7 +210,7 @@ std::string StudyReport(const std::vector<StudyRow>& rows,
     }
     s << "\n";
   }
-  s << "## Pareto fronts\n\n" << ParetoTables(rows);
+  s << "## Pareto fronts\n\n" << ParetoTables(rows) << TargetTable(rows);
   s << "Plots: `study_d.svg`, `study_4d.svg` (error against total time, log axes, one curve per "
        "knob, the front in red).\n";
   return s.str();

@@ -788,6 +788,9 @@ TEST(HardCases, RandomisedSweep) {
 //    GPU sum: bound 10^-3 (the CPU-GL agreement test's at d, §4.5).
 //  * Every value finite and the flux of each image positive.
 TEST(HardCases, ReceiverPlaneNearTheSamplingPlane) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "accuracy run: the Release build's (the renderers' paths run under the "
+                    "sanitizers in tests/lightfield and tests/preview)";
   const std::string dir = FreshDir("hard_near_s");
   const std::string slab = dir + "/slab";
   const double d = 750, z = 20, sum_c = 67.0 / 39.0;

@@ -200,7 +200,7 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
         std::to_string(RequiredPositions(p.coverage.v_mm, s.h_mm, s.k_max)) +
         " positions at this h and K; the light outside is missing from the slab and the error "
         "predicted here is only that of the covered part");
-  } else if (!p.reachable) {
+  } else if (p.at_D.total > in.target) {
     p.warnings.push_back("the predicted error at D, " + Percent(p.at_D.total) +
                          ", is above the target " + Percent(in.target));
   }

@@ -217,6 +217,93 @@ void Measure(const SynthScene& scene, const Setting& s, const std::string& ds, i
   }
 }
 
+// One sweep point: its knob, the value's label and the whole setting.
+struct Point {
+  std::string knob, value;
+  Setting setting;
+};
+
+// The points of `knobs` around `base`, the first `values` of each knob's list. Spacing keeps the
+// grid's extent (the positions cover the same part of S); extent keeps h and scales the span.
+std::vector<Point> SweepPoints(const std::vector<std::string>& knobs, const Setting& base,
+                               int values, bool quick, const SynthScene& scene) {
+  std::vector<Point> points;
+  const auto positions_for = [](int n0, double span_factor) {
+    return std::max(1, int(std::lround((n0 - 1) * span_factor)) + 1);
+  };
+  for (const std::string& knob : knobs) {
+    if (knob == "spacing")
+      for (double f : First(values, std::vector<double>{2, 1, 0.5})) {
+        Setting s = base;
+        s.h_mm = base.h_mm * f;
+        s.nu = positions_for(base.nu, 1 / f), s.nv = positions_for(base.nv, 1 / f);
+        points.push_back({knob, Num(s.h_mm) + " mm", s});
+      }
+    if (knob == "extent")
+      for (double f : First(values, std::vector<double>{0.5, 1, 1.5})) {
+        Setting s = base;
+        s.nu = positions_for(base.nu, f), s.nv = positions_for(base.nv, f);
+        points.push_back({knob, "x" + Num(f), s});
+      }
+    if (knob == "photo")
+      for (double f : First(values, quick ? std::vector<double>{1, 1.5, 2}
+                                          : std::vector<double>{0.5, 0.75, 1})) {
+        Setting s = base;
+        s.photo_scale = base.photo_scale * f;
+        points.push_back({knob, "x" + Num(s.photo_scale), s});
+      }
+    if (knob == "k_max")
+      for (int k : First(values, std::vector<int>{1, 2, 3})) {
+        Setting s = base;
+        s.k_max = k;
+        points.push_back({knob, std::to_string(k), s});
+      }
+    if (knob == "resolution")
+      for (double f : First(values, std::vector<double>{0.5, 1, 2})) {
+        Setting s = base;
+        s.resolution = std::max(8, int(std::lround(base.resolution * f)));
+        points.push_back({knob, std::to_string(s.resolution), s});
+      }
+    if (knob == "samples")
+      for (int n : First(values, std::vector<int>{1, 2, 4})) {
+        Setting s = base;
+        s.samples = n;
+        points.push_back({knob, std::to_string(n), s});
+      }
+    // Noise: the sensor's full well (electrons at value 1: shot noise of a photo at value x has
+    // relative sigma 1/sqrt(x full_well)), read noise 3 e-; a shorter exposure is a smaller
+    // effective full well.
+    if (knob == "noise")
+      for (double fw : First(values, std::vector<double>{20000, 2000, 200})) {
+        Setting s = base;
+        s.full_well_e = fw;
+        points.push_back({knob, "full well " + std::to_string(int(fw)) + " e-", s});
+      }
+    // Brackets on the noisy camera of the noise knob's middle value: each added stop of +2
+    // exposes 4x longer (clipped highlights are taken from the shorter ones), at the lab's cost
+    // of one more exposure per slide.
+    if (knob == "brackets")
+      for (const auto& stops :
+           First(values, std::vector<std::vector<double>>{{0}, {0, 2}, {0, 2, 4}})) {
+        Setting s = base;
+        s.full_well_e = 2000;
+        // One exposure at stop 0 is what a scene without brackets takes: the noise knob's point.
+        if (stops != std::vector<double>{0} || scene.Stops() != std::vector<double>{0})
+          s.stops = stops;
+        points.push_back(
+            {knob, std::to_string(stops.size()) + " (ev " + StopsName(stops) + ")", s});
+      }
+    // Regularisation of the fit; reconstruct's default 1e-4 is the base itself.
+    if (knob == "lambda")
+      for (double l : First(values, std::vector<double>{1e-4, 1e-2, 1})) {
+        Setting s = base;
+        s.lambda = l == 1e-4 ? -1 : l;
+        points.push_back({knob, Num(l) + (l == 1e-4 ? " (default)" : ""), s});
+      }
+  }
+  return points;
+}
+
 }  // namespace
 
 int RunStudy(int argc, char** argv) {
@@ -331,86 +418,7 @@ int RunStudy(int argc, char** argv) {
   base.samples = o.samples;
   base.render_px = o.render_px > 0 ? o.render_px : (o.quick ? 40 : 96);
 
-  // The points: (knob, value label, setting). Spacing keeps the grid's extent (the positions
-  // cover the same part of S); extent keeps h and scales the grid's span.
-  struct Point {
-    std::string knob, value;
-    Setting setting;
-  };
-  std::vector<Point> points;
-  const auto positions_for = [](int n0, double span_factor) {
-    return std::max(1, int(std::lround((n0 - 1) * span_factor)) + 1);
-  };
-  for (const std::string& knob : knobs) {
-    if (knob == "spacing")
-      for (double f : First(o.values, std::vector<double>{2, 1, 0.5})) {
-        Setting s = base;
-        s.h_mm = base.h_mm * f;
-        s.nu = positions_for(base.nu, 1 / f), s.nv = positions_for(base.nv, 1 / f);
-        points.push_back({knob, Num(s.h_mm) + " mm", s});
-      }
-    if (knob == "extent")
-      for (double f : First(o.values, std::vector<double>{0.5, 1, 1.5})) {
-        Setting s = base;
-        s.nu = positions_for(base.nu, f), s.nv = positions_for(base.nv, f);
-        points.push_back({knob, "x" + Num(f), s});
-      }
-    if (knob == "photo")
-      for (double f : First(o.values, o.quick ? std::vector<double>{1, 1.5, 2}
-                                              : std::vector<double>{0.5, 0.75, 1})) {
-        Setting s = base;
-        s.photo_scale = base.photo_scale * f;
-        points.push_back({knob, "x" + Num(s.photo_scale), s});
-      }
-    if (knob == "k_max")
-      for (int k : First(o.values, std::vector<int>{1, 2, 3})) {
-        Setting s = base;
-        s.k_max = k;
-        points.push_back({knob, std::to_string(k), s});
-      }
-    if (knob == "resolution")
-      for (double f : First(o.values, std::vector<double>{0.5, 1, 2})) {
-        Setting s = base;
-        s.resolution = std::max(8, int(std::lround(base.resolution * f)));
-        points.push_back({knob, std::to_string(s.resolution), s});
-      }
-    if (knob == "samples")
-      for (int n : First(o.values, std::vector<int>{1, 2, 4})) {
-        Setting s = base;
-        s.samples = n;
-        points.push_back({knob, std::to_string(n), s});
-      }
-    // Noise: the sensor's full well (electrons at value 1: shot noise of a photo at value x has
-    // relative sigma 1/sqrt(x full_well)), read noise 3 e-; a shorter exposure is a smaller
-    // effective full well.
-    if (knob == "noise")
-      for (double fw : First(o.values, std::vector<double>{20000, 2000, 200})) {
-        Setting s = base;
-        s.full_well_e = fw;
-        points.push_back({knob, "full well " + std::to_string(int(fw)) + " e-", s});
-      }
-    // Brackets on the noisy camera of the noise knob's middle value: each added stop of +2
-    // exposes 4x longer (clipped highlights are taken from the shorter ones), at the lab's cost
-    // of one more exposure per slide.
-    if (knob == "brackets")
-      for (const auto& stops :
-           First(o.values, std::vector<std::vector<double>>{{0}, {0, 2}, {0, 2, 4}})) {
-        Setting s = base;
-        s.full_well_e = 2000;
-        // One exposure at stop 0 is what a scene without brackets takes: the noise knob's point.
-        if (stops != std::vector<double>{0} || scene.Stops() != std::vector<double>{0})
-          s.stops = stops;
-        points.push_back(
-            {knob, std::to_string(stops.size()) + " (ev " + StopsName(stops) + ")", s});
-      }
-    // Regularisation of the fit; reconstruct's default 1e-4 is the base itself.
-    if (knob == "lambda")
-      for (double l : First(o.values, std::vector<double>{1e-4, 1e-2, 1})) {
-        Setting s = base;
-        s.lambda = l == 1e-4 ? -1 : l;
-        points.push_back({knob, Num(l) + (l == 1e-4 ? " (default)" : ""), s});
-      }
-  }
+  const std::vector<Point> points = SweepPoints(knobs, base, o.values, o.quick, scene);
 
   const std::string csv = out + "/study.csv";
   std::vector<StudyRow> rows = fs::exists(csv) ? ReadStudyCsv(csv) : std::vector<StudyRow>{};

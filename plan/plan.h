@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/lab_model.h"
+
 namespace lumislab {
 
 struct SynthScene;
@@ -30,9 +32,7 @@ struct PlanInput {
   double h_max_mm = 10;      // largest h considered (the study's measured range)
   int resolution_min = 48;   // smallest slab resolution considered (see §4.8)
   int resolution_max = 512;  // largest slab resolution considered
-  // lumislab-study's lab model: positions x (move + slides x brackets x exposure).
-  double move_s = 2, exposure_s = 0.5;
-  int slides = 2, brackets = 1;
+  LabModel lab;  // the lab time of a setting (core/lab_model.h, shared with lumislab-study)
 
   double D() const { return receiver_mm > 0 ? receiver_mm : distance_mm; }
 };
@@ -74,7 +74,6 @@ int RequiredPositions(double half_extent_mm, double h_mm, int k_max);
 bool SettingCovers(const PlanInput& in, const PlanSetting& s);
 
 ErrorTerms PredictError(const PlanInput& in, const PlanSetting& s, double receiver_mm);
-double LabSeconds(const PlanInput& in, const PlanSetting& s);
 
 struct Plan {
   PlanSetting setting;

@@ -1,12 +1,6 @@
 #include "study/study.h"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -19,6 +13,7 @@
 #include "core/command_line.h"
 #include "core/error.h"
 #include "core/json.h"
+#include "core/lab_model.h"
 #include "core/log.h"
 #include "core/slab_compare.h"
 #include "core/stop_signal.h"
@@ -27,6 +22,8 @@
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
+#include "study/preview_sweep.h"
+#include "study/stages.h"
 
 namespace fs = std::filesystem;
 
@@ -34,21 +31,21 @@ namespace lumislab {
 namespace {
 
 // The knobs, in the order of the report.
-const std::vector<std::string> kKnobs = {"spacing", "extent",     "photo",
-                                         "k_max",   "resolution", "samples"};
+const std::vector<std::string> kKnobs = {"spacing", "extent", "photo",    "k_max",  "resolution",
+                                         "samples", "noise",  "brackets", "lambda", "preview"};
 
 struct Options {
   std::string scene = "default";
   std::string out;
   bool quick = false;
   std::string knobs = "all";
-  double move_s = 2.0;      // lab model: stage move and settle per position
-  double exposure_s = 0.5;  // lab model: one exposure (plus readout)
-  int slides = 2;           // T+ and T-
+  LabModel lab;             // its brackets are the scene's (or the brackets knob's)
   double photo_scale = 0;   // base photo size over the scene camera's (0: 1, --quick 0.25)
   int resolution = 0;       // base slab texels per side (0: 150, --quick 48)
   int render_px = 0;        // receiver-plane image side (0: 96, --quick 40)
   int samples = 1;          // base N of the reference
+  int preview_width = 0;    // crypt image W x 3W/4 of the preview knobs and frame times
+  int preview_samples = 8;  // N of the reference the preview knobs are measured against
   bool keep_photos = false;
   int values = 3;  // values per knob: the first 2 or all 3 of each list
 };
@@ -65,72 +62,32 @@ struct Setting {
   int nu = 9, nv = 7;
   double photo_scale = 1;
   int k_max = 1, resolution = 150, samples = 1, render_px = 96;
+  double full_well_e = 0;     // > 0: a sensor_noise effect of this full well replaces the scene's
+  std::vector<double> stops;  // not empty: a brackets effect of these stops replaces the scene's
+  double lambda = -1;         // >= 0: reconstruct --lambda (else its default)
 };
+
+std::string StopsName(const std::vector<double>& stops) {
+  std::string name;
+  for (double s : stops) name += (name.empty() ? "" : "_") + Num(s);
+  return name;
+}
 
 // Everything acquire and reconstruct see: points that agree on it share one dataset folder.
 std::string DatasetName(const Setting& s) {
   return "h" + Num(s.h_mm) + "_" + std::to_string(s.nu) + "x" + std::to_string(s.nv) + "_p" +
-         Num(s.photo_scale) + "_K" + std::to_string(s.k_max) + "_r" + std::to_string(s.resolution);
+         Num(s.photo_scale) + "_K" + std::to_string(s.k_max) + "_r" + std::to_string(s.resolution) +
+         (s.full_well_e > 0 ? "_fw" + std::to_string(int(s.full_well_e)) : "") +
+         (s.stops.empty() ? "" : "_ev" + StopsName(s.stops)) +
+         (s.lambda >= 0 ? "_l" + Num(s.lambda) : "");
 }
 std::string Key(const Setting& s) {
   return DatasetName(s) + "_N" + std::to_string(s.samples) + "_px" + std::to_string(s.render_px);
 }
 
-// The executable `tool` beside this one (build/bin/ or an install's bin/).
-std::string ToolPath(const std::string& tool) {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  const fs::path path = (ec ? fs::path(".") : self.parent_path()) / tool;
-  if (!fs::exists(path))
-    throw Failure(tool + " not found beside lumislab-study (" + path.string() + ")");
-  return path.string();
-}
-
-// Runs `tool args...` with stdout and stderr appended to `log`; returns its wall time. A tool
-// that fails is a failure of the study (exit 1) naming the command and the log.
-double RunStage(const std::string& tool, const std::vector<std::string>& args,
-                const std::string& log) {
-  const std::string path = ToolPath(tool);
-  std::vector<std::string> words = {path};
-  words.insert(words.end(), args.begin(), args.end());
-  std::string line;
-  for (const auto& w : words) line += (line.empty() ? "" : " ") + w;
-  LogInfo("running ", line);
-  const auto start = std::chrono::steady_clock::now();
-  const pid_t pid = fork();
-  if (pid < 0) throw Failure("cannot start " + tool);
-  if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    if (fd >= 0) dup2(fd, 1), dup2(fd, 2), close(fd);
-    std::vector<char*> argv;
-    for (auto& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    execv(path.c_str(), argv.data());
-    _exit(127);
-  }
-  // Polled so that a stop signal reaches the stage too: it finishes its item and leaves what it
-  // wrote valid (§7.6), and the study stops after it.
-  int status = 0;
-  bool forwarded = false;
-  for (;;) {
-    const pid_t done = waitpid(pid, &status, WNOHANG);
-    if (done == pid || (done < 0 && errno != EINTR)) break;
-    if (StopRequested() && !forwarded) kill(pid, SIGTERM), forwarded = true;
-    usleep(20000);
-  }
-  if (StopRequested())
-    throw Failure("stopped by a signal during " + tool + "; run again to continue");
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw Failure(line + " failed (exit " +
-                  std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status)) +
-                  "); see " + log);
-  return seconds;
-}
-
 struct StageTimes {
   double acquire_s = 0, calibrate_s = 0, reconstruct_s = 0;
+  double preview_ms = 0;  // OSMesa frame of the crypt (PreviewFrameMs)
 };
 
 // The scene file of a setting: the study's scene with its grid, camera size, K changed.
@@ -145,20 +102,46 @@ std::string SceneText(const nlohmann::json& base, const Setting& s) {
   scene["camera"]["size_px"] = {int(std::lround(size[0].get<double>() * s.photo_scale)),
                                 int(std::lround(size[1].get<double>() * s.photo_scale))};
   scene["camera"]["focal_px"] = base["camera"]["focal_px"].get<double>() * s.photo_scale;
+  // The render is already at exposure x 2^stop: the sensor's noise on what was exposed first,
+  // then the brackets' clip at 1 (a sensor clips the noisy signal; noise after the clip would
+  // pull clipped pixels below 1, where the merge takes them for valid), then the scene's other
+  // effects in their order.
+  if (s.full_well_e > 0 || !s.stops.empty()) {
+    nlohmann::json effects = nlohmann::json::array();
+    if (s.full_well_e > 0)
+      effects.push_back({{"type", "sensor_noise"}, {"full_well_e", s.full_well_e}, {"seed", 1}});
+    if (!s.stops.empty()) effects.push_back({{"type", "brackets"}, {"stops", s.stops}});
+    for (const auto& e : scene.value("effects", nlohmann::json::array())) {
+      const std::string type = e.value("type", "");
+      if ((type == "brackets" && !s.stops.empty()) || (type == "sensor_noise" && s.full_well_e > 0))
+        continue;
+      effects.push_back(e);
+    }
+    scene["effects"] = effects;
+  }
   return scene.dump(2) + "\n";
+}
+
+std::vector<std::string> ReconstructArgs(const Setting& s, const std::string& ds, int threads) {
+  std::vector<std::string> args = {"--dataset",    ds,
+                                   "--resolution", std::to_string(s.resolution),
+                                   "--threads",    std::to_string(threads)};
+  if (s.lambda >= 0) args.insert(args.end(), {"--lambda", Num(s.lambda, 6)});
+  return args;
 }
 
 // acquire synth -> calibrate screen -> reconstruct in work/<dataset>/, once: a finished dataset
 // keeps its stage times in times.json (written last), and its photos are removed then unless
-// --keep-photos. An interrupted one is continued by the stages' own resumption (§7.4).
+// --keep-photos. An interrupted one is continued by the stages' own resumption (§7.4). Then
+// the preview's frame time on the crypt with this slab (`bench_size`, WxH).
 StageTimes RunChain(const nlohmann::json& base_scene, const Setting& s, const std::string& work,
-                    int threads, bool keep_photos) {
+                    int threads, bool keep_photos, const std::string& bench_size) {
   const std::string dir = work + "/" + DatasetName(s);
   const std::string times_path = dir + "/times.json";
   if (fs::exists(times_path)) {
     const JsonDocument doc = JsonDocument::Load(times_path);
     return {doc.root()["acquire_s"].Number(), doc.root()["calibrate_s"].Number(),
-            doc.root()["reconstruct_s"].Number()};
+            doc.root()["reconstruct_s"].Number(), doc.root()["preview_ms"].Number()};
   }
   MakeDirectories(dir);
   const std::string scene = dir + "/scene.json", ds = dir + "/ds", log = dir + "/log.txt";
@@ -170,10 +153,12 @@ StageTimes RunChain(const nlohmann::json& base_scene, const Setting& s, const st
       {"synth", "--scene", scene, "--out", ds, "--truth-resolution", res, "--threads", t}, log);
   times.calibrate_s =
       RunStage("lumislab-calibrate", {"screen", "--dataset", ds, "--threads", t}, log);
-  times.reconstruct_s =
-      RunStage("lumislab-reconstruct", {"--dataset", ds, "--resolution", res, "--threads", t}, log);
+  times.reconstruct_s = RunStage("lumislab-reconstruct", ReconstructArgs(s, ds, threads), log);
+  times.preview_ms = PreviewFrameMs(ds + "/slab", {"--scene", "crypt", "--size", bench_size},
+                                    dir + "/preview_bench.txt", threads);
   if (!keep_photos) fs::remove_all(ds + "/photos");
-  WriteJsonAtomically(times_path, {{"acquire_s", times.acquire_s},
+  WriteJsonAtomically(times_path, {{"preview_ms", times.preview_ms},
+                                   {"acquire_s", times.acquire_s},
                                    {"calibrate_s", times.calibrate_s},
                                    {"reconstruct_s", times.reconstruct_s}});
   return times;
@@ -232,6 +217,93 @@ void Measure(const SynthScene& scene, const Setting& s, const std::string& ds, i
   }
 }
 
+// One sweep point: its knob, the value's label and the whole setting.
+struct Point {
+  std::string knob, value;
+  Setting setting;
+};
+
+// The points of `knobs` around `base`, the first `values` of each knob's list. Spacing keeps the
+// grid's extent (the positions cover the same part of S); extent keeps h and scales the span.
+std::vector<Point> SweepPoints(const std::vector<std::string>& knobs, const Setting& base,
+                               int values, bool quick, const SynthScene& scene) {
+  std::vector<Point> points;
+  const auto positions_for = [](int n0, double span_factor) {
+    return std::max(1, int(std::lround((n0 - 1) * span_factor)) + 1);
+  };
+  for (const std::string& knob : knobs) {
+    if (knob == "spacing")
+      for (double f : First(values, std::vector<double>{2, 1, 0.5})) {
+        Setting s = base;
+        s.h_mm = base.h_mm * f;
+        s.nu = positions_for(base.nu, 1 / f), s.nv = positions_for(base.nv, 1 / f);
+        points.push_back({knob, Num(s.h_mm) + " mm", s});
+      }
+    if (knob == "extent")
+      for (double f : First(values, std::vector<double>{0.5, 1, 1.5})) {
+        Setting s = base;
+        s.nu = positions_for(base.nu, f), s.nv = positions_for(base.nv, f);
+        points.push_back({knob, "x" + Num(f), s});
+      }
+    if (knob == "photo")
+      for (double f : First(values, quick ? std::vector<double>{1, 1.5, 2}
+                                          : std::vector<double>{0.5, 0.75, 1})) {
+        Setting s = base;
+        s.photo_scale = base.photo_scale * f;
+        points.push_back({knob, "x" + Num(s.photo_scale), s});
+      }
+    if (knob == "k_max")
+      for (int k : First(values, std::vector<int>{1, 2, 3})) {
+        Setting s = base;
+        s.k_max = k;
+        points.push_back({knob, std::to_string(k), s});
+      }
+    if (knob == "resolution")
+      for (double f : First(values, std::vector<double>{0.5, 1, 2})) {
+        Setting s = base;
+        s.resolution = std::max(8, int(std::lround(base.resolution * f)));
+        points.push_back({knob, std::to_string(s.resolution), s});
+      }
+    if (knob == "samples")
+      for (int n : First(values, std::vector<int>{1, 2, 4})) {
+        Setting s = base;
+        s.samples = n;
+        points.push_back({knob, std::to_string(n), s});
+      }
+    // Noise: the sensor's full well (electrons at value 1: shot noise of a photo at value x has
+    // relative sigma 1/sqrt(x full_well)), read noise 3 e-; a shorter exposure is a smaller
+    // effective full well.
+    if (knob == "noise")
+      for (double fw : First(values, std::vector<double>{20000, 2000, 200})) {
+        Setting s = base;
+        s.full_well_e = fw;
+        points.push_back({knob, "full well " + std::to_string(int(fw)) + " e-", s});
+      }
+    // Brackets on the noisy camera of the noise knob's middle value: each added stop of +2
+    // exposes 4x longer (clipped highlights are taken from the shorter ones), at the lab's cost
+    // of one more exposure per slide.
+    if (knob == "brackets")
+      for (const auto& stops :
+           First(values, std::vector<std::vector<double>>{{0}, {0, 2}, {0, 2, 4}})) {
+        Setting s = base;
+        s.full_well_e = 2000;
+        // One exposure at stop 0 is what a scene without brackets takes: the noise knob's point.
+        if (stops != std::vector<double>{0} || scene.Stops() != std::vector<double>{0})
+          s.stops = stops;
+        points.push_back(
+            {knob, std::to_string(stops.size()) + " (ev " + StopsName(stops) + ")", s});
+      }
+    // Regularisation of the fit; reconstruct's default 1e-4 is the base itself.
+    if (knob == "lambda")
+      for (double l : First(values, std::vector<double>{1e-4, 1e-2, 1})) {
+        Setting s = base;
+        s.lambda = l == 1e-4 ? -1 : l;
+        points.push_back({knob, Num(l) + (l == 1e-4 ? " (default)" : ""), s});
+      }
+  }
+  return points;
+}
+
 }  // namespace
 
 int RunStudy(int argc, char** argv) {
@@ -253,17 +325,10 @@ int RunStudy(int argc, char** argv) {
       "photos at 0.25 of the scene camera's size (x1, 1.5, 2 for the photo knob), 48 texels, 40 px "
       "renders");
   app.add_option("--knobs", o.knobs,
-                 "comma-separated subset of spacing,extent,photo,k_max,resolution,samples, or all")
+                 "comma-separated subset of spacing,extent,photo,k_max,resolution,samples,noise,"
+                 "brackets,lambda,preview, or all")
       ->capture_default_str();
-  app.add_option("--move-s", o.move_s, "lab model: stage move and settle per position, s")
-      ->check(FiniteIn(0, 1e6))
-      ->capture_default_str();
-  app.add_option("--exposure-s", o.exposure_s, "lab model: one exposure with readout, s")
-      ->check(FiniteIn(0, 1e6))
-      ->capture_default_str();
-  app.add_option("--slides", o.slides, "lab model: slides per position")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
+  AddLabModelOptions(&app, &o.lab, /*brackets_option=*/false);
   app.add_option("--photo-scale", o.photo_scale,
                  "base photo size over the scene camera's (default 1, --quick 0.25)")
       ->check(FiniteIn(0.05, 4));
@@ -279,14 +344,23 @@ int RunStudy(int argc, char** argv) {
   app.add_option("--values", o.values, "values per knob: 2 (the first two of each list) or 3")
       ->check(CLI::Range(2, 3))
       ->capture_default_str();
+  app.add_option("--preview-width", o.preview_width,
+                 "crypt image W x 3W/4 (the plane's W x W) of the preview knobs and of each "
+                 "point's OSMesa frame time (default 240, --quick 120)")
+      ->check(CLI::Range(16, 2048));
+  app.add_option("--preview-samples", o.preview_samples,
+                 "N of the exact reference the preview knobs are measured against")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   app.add_flag("--keep-photos", o.keep_photos, "keep each dataset's photos (removed by default)");
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("study", common);
   LogInfo("parameters: scene=", o.scene, " out=", o.out, " quick=", o.quick ? "yes" : "no",
-          " knobs=", o.knobs, " values=", o.values, " move_s=", o.move_s,
-          " exposure_s=", o.exposure_s, " slides=", o.slides, " photo_scale=", o.photo_scale,
-          " resolution=", o.resolution, " render_size=", o.render_px, " samples=", o.samples,
-          " keep_photos=", o.keep_photos ? "yes" : "no", " threads=", threads);
+          " knobs=", o.knobs, " values=", o.values, " lab=", o.lab.Describe(),
+          " photo_scale=", o.photo_scale, " resolution=", o.resolution,
+          " render_size=", o.render_px, " samples=", o.samples, " preview_width=", o.preview_width,
+          " preview_samples=", o.preview_samples, " keep_photos=", o.keep_photos ? "yes" : "no",
+          " threads=", threads);
 
   // Inputs first: the scene (exit 2 naming the file), the knobs, then --out.
   const SynthScene scene = LoadScene(o.scene);
@@ -301,7 +375,7 @@ int RunStudy(int argc, char** argv) {
       if (std::find(kKnobs.begin(), kKnobs.end(), k) == kKnobs.end())
         throw BadInput(
             "--knobs: expected a comma-separated subset of spacing, extent, photo, "
-            "k_max, resolution, samples, got \"" +
+            "k_max, resolution, samples, noise, brackets, lambda, preview, got \"" +
             k + "\"");
       knobs.push_back(k);
     }
@@ -319,9 +393,9 @@ int RunStudy(int argc, char** argv) {
   // --out must agree, or it would resume another study's rows and datasets.
   const nlohmann::json identity = {{"schema_version", 1},
                                    {"scene", base_scene},
-                                   {"move_s", o.move_s},
-                                   {"exposure_s", o.exposure_s},
-                                   {"slides", o.slides}};
+                                   {"move_s", o.lab.move_s},
+                                   {"exposure_s", o.lab.exposure_s},
+                                   {"slides", o.lab.slides}};
   const std::string identity_path = out + "/study.json";
   if (fs::exists(identity_path)) {
     if (JsonDocument::Load(identity_path).raw() != identity)
@@ -332,6 +406,9 @@ int RunStudy(int argc, char** argv) {
     WriteJsonAtomically(identity_path, identity);
   }
 
+  const int preview_w = o.preview_width > 0 ? o.preview_width : (o.quick ? 120 : 240);
+  const int preview_h = std::max(1, preview_w * 3 / 4);
+  const std::string preview_size = std::to_string(preview_w) + "x" + std::to_string(preview_h);
   Setting base;
   base.h_mm = scene.grid.spacing_mm;
   base.nu = scene.grid.nu, base.nv = scene.grid.nv;
@@ -341,56 +418,7 @@ int RunStudy(int argc, char** argv) {
   base.samples = o.samples;
   base.render_px = o.render_px > 0 ? o.render_px : (o.quick ? 40 : 96);
 
-  // The points: (knob, value label, setting). Spacing keeps the grid's extent (the positions
-  // cover the same part of S); extent keeps h and scales the grid's span.
-  struct Point {
-    std::string knob, value;
-    Setting setting;
-  };
-  std::vector<Point> points;
-  const auto positions_for = [](int n0, double span_factor) {
-    return std::max(1, int(std::lround((n0 - 1) * span_factor)) + 1);
-  };
-  for (const std::string& knob : knobs) {
-    if (knob == "spacing")
-      for (double f : First(o.values, std::vector<double>{2, 1, 0.5})) {
-        Setting s = base;
-        s.h_mm = base.h_mm * f;
-        s.nu = positions_for(base.nu, 1 / f), s.nv = positions_for(base.nv, 1 / f);
-        points.push_back({knob, Num(s.h_mm) + " mm", s});
-      }
-    if (knob == "extent")
-      for (double f : First(o.values, std::vector<double>{0.5, 1, 1.5})) {
-        Setting s = base;
-        s.nu = positions_for(base.nu, f), s.nv = positions_for(base.nv, f);
-        points.push_back({knob, "x" + Num(f), s});
-      }
-    if (knob == "photo")
-      for (double f : First(o.values, o.quick ? std::vector<double>{1, 1.5, 2}
-                                              : std::vector<double>{0.5, 0.75, 1})) {
-        Setting s = base;
-        s.photo_scale = base.photo_scale * f;
-        points.push_back({knob, "x" + Num(s.photo_scale), s});
-      }
-    if (knob == "k_max")
-      for (int k : First(o.values, std::vector<int>{1, 2, 3})) {
-        Setting s = base;
-        s.k_max = k;
-        points.push_back({knob, std::to_string(k), s});
-      }
-    if (knob == "resolution")
-      for (double f : First(o.values, std::vector<double>{0.5, 1, 2})) {
-        Setting s = base;
-        s.resolution = std::max(8, int(std::lround(base.resolution * f)));
-        points.push_back({knob, std::to_string(s.resolution), s});
-      }
-    if (knob == "samples")
-      for (int n : First(o.values, std::vector<int>{1, 2, 4})) {
-        Setting s = base;
-        s.samples = n;
-        points.push_back({knob, std::to_string(n), s});
-      }
-  }
+  const std::vector<Point> points = SweepPoints(knobs, base, o.values, o.quick, scene);
 
   const std::string csv = out + "/study.csv";
   std::vector<StudyRow> rows = fs::exists(csv) ? ReadStudyCsv(csv) : std::vector<StudyRow>{};
@@ -400,13 +428,15 @@ int RunStudy(int argc, char** argv) {
       Num(base.photo_scale) + " x the scene camera's, K " + std::to_string(base.k_max) + ", " +
       std::to_string(base.resolution) + " texels, N " + std::to_string(base.samples) +
       ", receiver plane " + std::to_string(base.render_px) + " px. Lab model: positions x (" +
-      Num(o.move_s) + " s move + " + std::to_string(o.slides) + " slides x brackets x " +
-      Num(o.exposure_s) +
+      Num(o.lab.move_s) + " s move + " + std::to_string(o.lab.slides) + " slides x brackets x " +
+      Num(o.lab.exposure_s) +
       " s). Screen calibration: `lumislab-calibrate screen` (the board "
       "photo). Photos through the scene's effects as given (the default scene has none: "
-      "noise-free). Total time = lab model + "
-      "reconstruct + reference render (three planes); acquire (sim) is the synthetic capture's "
-      "own time, not counted.\n";
+      "noise-free; the noise and brackets knobs add `sensor_noise` and `brackets` effects). "
+      "Total time = lab model + reconstruct + reference render (three planes); acquire (sim) is "
+      "the synthetic capture's own time, not counted; preview = the median OSMesa frame of the "
+      "crypt (" +
+      preview_size + ") with the point's slab.\n";
   const auto write_outputs = [&] {
     std::string text = StudyCsvHeader() + "\n";
     for (const StudyRow& r : rows) text += StudyCsvLine(r) + "\n";
@@ -416,7 +446,6 @@ int RunStudy(int argc, char** argv) {
   // SIGINT / SIGTERM: the stage in hand is told to stop, the study stops after it (exit 1);
   // study.csv holds the points completed before, and the same command continues.
   const StopSignalScope stop_scope;
-  const int brackets = int(scene.Stops().size());
   int skipped = 0;
   for (size_t p = 0; p < points.size(); ++p) {
     const Point& point = points[p];
@@ -437,7 +466,8 @@ int RunStudy(int argc, char** argv) {
       row = *same;  // the same setting under another knob (the base): measured once
     } else {
       const Setting& s = point.setting;
-      const StageTimes times = RunChain(base_scene, s, out + "/work", threads, o.keep_photos);
+      const StageTimes times =
+          RunChain(base_scene, s, out + "/work", threads, o.keep_photos, preview_size);
       row.key = key;
       row.h_mm = s.h_mm, row.nu = s.nu, row.nv = s.nv;
       row.photo_w = int(std::lround(scene.camera.width * s.photo_scale));
@@ -445,9 +475,13 @@ int RunStudy(int argc, char** argv) {
       row.k_max = s.k_max, row.slab_res = s.resolution, row.samples = s.samples;
       row.render_px = s.render_px;
       row.acquire_s = times.acquire_s, row.calibrate_s = times.calibrate_s;
-      row.reconstruct_s = times.reconstruct_s;
+      row.reconstruct_s = times.reconstruct_s, row.preview_ms = times.preview_ms;
+      row.full_well_e = s.full_well_e, row.lambda = s.lambda;
+      LabModel lab = o.lab;
+      lab.brackets = s.stops.empty() ? int(scene.Stops().size()) : int(s.stops.size());
+      row.brackets = lab.brackets;
       Measure(scene, s, out + "/work/" + DatasetName(s) + "/ds", threads, &row);
-      row.lab_s = row.positions() * (o.move_s + o.slides * brackets * o.exposure_s);
+      row.lab_s = lab.Seconds(row.positions());
       row.total_s = row.lab_s + row.reconstruct_s + row.render_s;
     }
     row.knob = point.knob, row.value = point.value;
@@ -460,10 +494,37 @@ int RunStudy(int argc, char** argv) {
   }
   if (skipped > 0) LogInfo(skipped, " point(s) already in ", csv, ", skipped");
 
-  WriteTextAtomically(out + "/report.md", StudyReport(rows, kKnobs, header_note));
+  // The preview's own knobs on the base dataset's slab (measured once it exists).
+  std::vector<PreviewRow> preview_rows;
+  const std::string preview_csv = out + "/preview.csv";
+  if (fs::exists(preview_csv)) preview_rows = ReadPreviewCsv(preview_csv);
+  if (std::find(knobs.begin(), knobs.end(), "preview") != knobs.end()) {
+    PreviewSweepOptions po;
+    const std::string base_dir = out + "/work/" + DatasetName(base);
+    if (!fs::exists(base_dir + "/times.json"))
+      RunChain(base_scene, base, out + "/work", threads, o.keep_photos, preview_size);
+    po.slab = base_dir + "/ds/slab";
+    po.work = out + "/work/preview";
+    po.width = preview_w, po.height = preview_h;
+    po.reference_samples = o.preview_samples;
+    po.threads = threads;
+    po.samples = First(o.values, po.samples);
+    po.shadow_sizes = First(o.values, po.shadow_sizes);
+    RunPreviewSweep(po, &preview_rows, [&] {
+      std::string text = PreviewCsvHeader() + "\n";
+      for (const PreviewRow& r : preview_rows) text += PreviewCsvLine(r) + "\n";
+      WriteTextAtomically(preview_csv, text);
+    });
+  }
+
+  std::string report = StudyReport(rows, kKnobs, header_note);
+  if (!preview_rows.empty())
+    report += "\n## The preview's own knobs (base slab, against the exact reference at N = " +
+              std::to_string(o.preview_samples) + ")\n\n" + PreviewReport(preview_rows);
+  WriteTextAtomically(out + "/report.md", report);
   WriteTextAtomically(out + "/study_d.svg", StudySvg(rows, kKnobs, 0));
   WriteTextAtomically(out + "/study_4d.svg", StudySvg(rows, kKnobs, 2));
-  std::cout << ParetoTables(rows) << out << "/report.md\n";
+  std::cout << ParetoTables(rows) << TargetTable(rows) << out << "/report.md\n";
   return 0;
 }
 

@@ -4,6 +4,7 @@
 // irradiance of the exact reference against the analytic image at D = d, 2d, 4d, with the times.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,11 @@ struct StudyRow {
   // reaches them through the slab), -1 when none is; and the analytic flux's share there.
   double err_covered[3] = {0, 0, 0};
   double covered[3] = {0, 0, 0};
+  double full_well_e = 0;  // sensor_noise's full well (0: the scene's effects as given)
+  int brackets = 1;        // exposures per slide (the lab model's brackets)
+  double lambda = -1;      // reconstruct --lambda (-1: its default, 1e-4)
   double lab_s = 0, acquire_s = 0, calibrate_s = 0, reconstruct_s = 0, render_s = 0, total_s = 0;
+  double preview_ms = 0;  // median OSMesa frame of the crypt with this slab (not in total_s)
   int positions() const { return nu * nv; }
 };
 
@@ -30,6 +35,13 @@ struct StudyRow {
 std::string StudyCsvHeader();
 std::string StudyCsvLine(const StudyRow& row);
 std::vector<StudyRow> ReadStudyCsv(const std::string& path);
+// The fields of one CSV line (no quoting: the study's values hold no comma).
+std::vector<std::string> SplitCsvLine(const std::string& line);
+// The data lines of a CSV the study wrote (study.csv, preview.csv): the first line must be
+// `header`, each other line `fields` fields that `parse` accepts (it throws std::exception on a
+// field that is not a number); otherwise bad input naming the file and line.
+void ReadCsvLines(const std::string& path, const std::string& header, size_t fields,
+                  const std::function<void(const std::vector<std::string>&)>& parse);
 
 // Indices of the rows on the Pareto front of (total_s, err[d_index]): no other row is at least
 // as fast and at least as accurate and better in one; one row per key; sorted by time.
@@ -40,6 +52,9 @@ std::vector<size_t> ParetoFront(const std::vector<StudyRow>& rows, int d_index);
 std::string StudyReport(const std::vector<StudyRow>& rows,
                         const std::vector<std::string>& knob_order, const std::string& header);
 std::string ParetoTables(const std::vector<StudyRow>& rows);
+// For targets 5 %, 2 %, 1 %, 0.5 % at D = d and 4d, the measured row of least total time within
+// each (or "none measured"), with its lab, reconstruct, render and preview times.
+std::string TargetTable(const std::vector<StudyRow>& rows);
 // Error at D = d_index against total time, log axes, one curve per knob, the front marked.
 std::string StudySvg(const std::vector<StudyRow>& rows, const std::vector<std::string>& knob_order,
                      int d_index);

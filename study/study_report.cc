@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -30,7 +31,20 @@ std::string Seconds(double s) {
   return Fixed(s, "%.3g s");
 }
 
-std::vector<std::string> Split(const std::string& line) {
+// What sets a row apart from the base, in words (the table's "setting" column).
+std::string Setting(const StudyRow& r) {
+  std::ostringstream s;
+  s << "h " << Num6(r.h_mm) << " mm, " << r.nu << "x" << r.nv << ", " << r.photo_w << "x"
+    << r.photo_h << " px, K " << r.k_max << ", " << r.slab_res << " texels, N " << r.samples;
+  if (r.full_well_e > 0) s << ", full well " << Num6(r.full_well_e) << " e-";
+  if (r.brackets > 1) s << ", " << r.brackets << " brackets";
+  if (r.lambda >= 0) s << ", lambda " << Num6(r.lambda);
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<std::string> SplitCsvLine(const std::string& line) {
   std::vector<std::string> out;
   std::string field;
   std::istringstream in(line);
@@ -39,71 +53,74 @@ std::vector<std::string> Split(const std::string& line) {
   return out;
 }
 
-// What sets a row apart from the base, in words (the table's "setting" column).
-std::string Setting(const StudyRow& r) {
-  std::ostringstream s;
-  s << "h " << Num6(r.h_mm) << " mm, " << r.nu << "x" << r.nv << ", " << r.photo_w << "x"
-    << r.photo_h << " px, K " << r.k_max << ", " << r.slab_res << " texels, N " << r.samples;
-  return s.str();
-}
-
-}  // namespace
-
 std::string StudyCsvHeader() {
   return "knob,value,key,h_mm,nu,nv,positions,photo_w,photo_h,k_max,slab_res,samples,render_px,"
+         "full_well_e,brackets,lambda,"
          "slab_rel_l2,err_d,flux_d,err_2d,flux_2d,err_4d,flux_4d,err_cov_d,covered_d,err_cov_2d,"
          "covered_2d,err_cov_4d,covered_4d,lab_s,acquire_s,calibrate_s,reconstruct_s,render_s,"
-         "total_s";
+         "total_s,preview_ms";
 }
 
 std::string StudyCsvLine(const StudyRow& r) {
   std::ostringstream s;
   s << r.knob << "," << r.value << "," << r.key << "," << Num6(r.h_mm) << "," << r.nu << "," << r.nv
     << "," << r.positions() << "," << r.photo_w << "," << r.photo_h << "," << r.k_max << ","
-    << r.slab_res << "," << r.samples << "," << r.render_px << "," << Num6(r.slab_rel_l2);
+    << r.slab_res << "," << r.samples << "," << r.render_px << "," << Num6(r.full_well_e) << ","
+    << r.brackets << "," << Num6(r.lambda) << "," << Num6(r.slab_rel_l2);
   for (int k = 0; k < 3; ++k) s << "," << Num6(r.err[k]) << "," << Num6(r.flux[k]);
   for (int k = 0; k < 3; ++k) s << "," << Num6(r.err_covered[k]) << "," << Num6(r.covered[k]);
   s << "," << Num6(r.lab_s) << "," << Num6(r.acquire_s) << "," << Num6(r.calibrate_s) << ","
-    << Num6(r.reconstruct_s) << "," << Num6(r.render_s) << "," << Num6(r.total_s);
+    << Num6(r.reconstruct_s) << "," << Num6(r.render_s) << "," << Num6(r.total_s) << ","
+    << Num6(r.preview_ms);
   return s.str();
 }
 
-std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
+void ReadCsvLines(const std::string& path, const std::string& header, size_t fields,
+                  const std::function<void(const std::vector<std::string>&)>& parse) {
   std::istringstream in(ReadTextFile(path));
   std::string line;
-  if (!std::getline(in, line) || line != StudyCsvHeader())
+  if (!std::getline(in, line) || line != header)
     throw BadInput(path + ": line 1: expected the header of lumislab-study's CSV, got \"" +
                    line.substr(0, 60) + "\"");
-  std::vector<StudyRow> rows;
   for (int number = 2; std::getline(in, line); ++number) {
     if (line.empty()) continue;
-    const std::vector<std::string> f = Split(line);
-    const auto bad = [&](const std::string& why) {
-      return BadInput(path + ": line " + std::to_string(number) + ": " + why);
-    };
-    if (f.size() != 32) throw bad("expected 32 fields, got " + std::to_string(f.size()));
-    StudyRow r;
+    const std::vector<std::string> f = SplitCsvLine(line);
+    const std::string where = path + ": line " + std::to_string(number) + ": ";
+    if (f.size() != fields)
+      throw BadInput(where + "expected " + std::to_string(fields) + " fields, got " +
+                     std::to_string(f.size()));
     try {
-      size_t i = 0;
-      r.knob = f[i++], r.value = f[i++], r.key = f[i++];
-      r.h_mm = std::stod(f[i++]);
-      r.nu = std::stoi(f[i++]), r.nv = std::stoi(f[i++]);
-      ++i;  // positions = nu * nv
-      r.photo_w = std::stoi(f[i++]), r.photo_h = std::stoi(f[i++]);
-      r.k_max = std::stoi(f[i++]), r.slab_res = std::stoi(f[i++]);
-      r.samples = std::stoi(f[i++]), r.render_px = std::stoi(f[i++]);
-      r.slab_rel_l2 = std::stod(f[i++]);
-      for (int k = 0; k < 3; ++k) r.err[k] = std::stod(f[i++]), r.flux[k] = std::stod(f[i++]);
-      for (int k = 0; k < 3; ++k)
-        r.err_covered[k] = std::stod(f[i++]), r.covered[k] = std::stod(f[i++]);
-      r.lab_s = std::stod(f[i++]), r.acquire_s = std::stod(f[i++]);
-      r.calibrate_s = std::stod(f[i++]), r.reconstruct_s = std::stod(f[i++]);
-      r.render_s = std::stod(f[i++]), r.total_s = std::stod(f[i++]);
+      parse(f);
     } catch (const std::exception&) {
-      throw bad("a field is not a number");
+      throw BadInput(where + "a field is not a number");
     }
-    rows.push_back(r);
   }
+}
+
+std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
+  std::vector<StudyRow> rows;
+  ReadCsvLines(path, StudyCsvHeader(), 36, [&](const std::vector<std::string>& f) {
+    StudyRow r;
+    size_t i = 0;
+    r.knob = f[i++], r.value = f[i++], r.key = f[i++];
+    r.h_mm = std::stod(f[i++]);
+    r.nu = std::stoi(f[i++]), r.nv = std::stoi(f[i++]);
+    ++i;  // positions = nu * nv
+    r.photo_w = std::stoi(f[i++]), r.photo_h = std::stoi(f[i++]);
+    r.k_max = std::stoi(f[i++]), r.slab_res = std::stoi(f[i++]);
+    r.samples = std::stoi(f[i++]), r.render_px = std::stoi(f[i++]);
+    r.full_well_e = std::stod(f[i++]), r.brackets = std::stoi(f[i++]);
+    r.lambda = std::stod(f[i++]);
+    r.slab_rel_l2 = std::stod(f[i++]);
+    for (int k = 0; k < 3; ++k) r.err[k] = std::stod(f[i++]), r.flux[k] = std::stod(f[i++]);
+    for (int k = 0; k < 3; ++k)
+      r.err_covered[k] = std::stod(f[i++]), r.covered[k] = std::stod(f[i++]);
+    r.lab_s = std::stod(f[i++]), r.acquire_s = std::stod(f[i++]);
+    r.calibrate_s = std::stod(f[i++]), r.reconstruct_s = std::stod(f[i++]);
+    r.render_s = std::stod(f[i++]), r.total_s = std::stod(f[i++]);
+    r.preview_ms = std::stod(f[i++]);
+    rows.push_back(r);
+  });
   return rows;
 }
 
@@ -128,17 +145,43 @@ std::string ParetoTables(const std::vector<StudyRow>& rows) {
   std::ostringstream s;
   for (int d : {0, 2}) {
     s << "Pareto front, relative L2 error at D = " << kDLabel[d] << " against total time:\n\n"
-      << "| error at " << kDLabel[d] << " | total | lab | reconstruct | render | knob = value | "
-      << "setting |\n|---|---|---|---|---|---|---|\n";
+      << "| error at " << kDLabel[d] << " | total | lab | reconstruct | render | preview frame | "
+      << "knob = value | setting |\n|---|---|---|---|---|---|---|---|\n";
     for (size_t i : ParetoFront(rows, d)) {
       const StudyRow& r = rows[i];
       s << "| " << Percent(r.err[d]) << " | " << Seconds(r.total_s) << " | " << Seconds(r.lab_s)
-        << " | " << Seconds(r.reconstruct_s) << " | " << Seconds(r.render_s) << " | " << r.knob
-        << " = " << r.value << " | " << Setting(r) << " |\n";
+        << " | " << Seconds(r.reconstruct_s) << " | " << Seconds(r.render_s) << " | "
+        << Fixed(r.preview_ms, "%.3g ms") << " | " << r.knob << " = " << r.value << " | "
+        << Setting(r) << " |\n";
     }
     s << "\n";
   }
   return s.str();
+}
+
+std::string TargetTable(const std::vector<StudyRow>& rows) {
+  std::ostringstream s;
+  s << "Cheapest measured setting per target (least total time with the error at D within the "
+       "target):\n\n"
+    << "| target | D | error | total | lab | reconstruct | render | preview frame | knob = value "
+       "| setting |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (int d : {0, 2})
+    for (double target : {0.05, 0.02, 0.01, 0.005}) {
+      const StudyRow* best = nullptr;
+      for (const StudyRow& r : rows)
+        if (r.err[d] <= target && (!best || r.total_s < best->total_s)) best = &r;
+      s << "| " << Percent(target) << " | " << kDLabel[d] << " | ";
+      if (!best) {
+        s << "none measured | | | | | | | |\n";
+        continue;
+      }
+      const StudyRow& r = *best;
+      s << Percent(r.err[d]) << " | " << Seconds(r.total_s) << " | " << Seconds(r.lab_s) << " | "
+        << Seconds(r.reconstruct_s) << " | " << Seconds(r.render_s) << " | "
+        << Fixed(r.preview_ms, "%.3g ms") << " | " << r.knob << " = " << r.value << " | "
+        << Setting(r) << " |\n";
+    }
+  return s.str() + "\n";
 }
 
 std::string StudyReport(const std::vector<StudyRow>& rows,
@@ -152,8 +195,8 @@ std::string StudyReport(const std::vector<StudyRow>& rows,
     s << "## Knob `" << knob << "`\n\n"
       << "| value | positions | setting | slab vs truth | err d | err 2d | err 4d | flux d | "
          "flux 4d | covered d | err d covered | err 4d covered | lab | acquire (sim) | "
-         "reconstruct | render | total |\n"
-      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "reconstruct | render | total | preview frame |\n"
+      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const StudyRow& r : rows) {
       if (r.knob != knob) continue;
       s << "| " << r.value << " | " << r.positions() << " | " << Setting(r) << " | "
@@ -162,11 +205,12 @@ std::string StudyReport(const std::vector<StudyRow>& rows,
         << Fixed(r.flux[2], "%.4f") << " | " << Percent(r.covered[0]) << " | "
         << CoveredPercent(r.err_covered[0]) << " | " << CoveredPercent(r.err_covered[2]) << " | "
         << Seconds(r.lab_s) << " | " << Seconds(r.acquire_s) << " | " << Seconds(r.reconstruct_s)
-        << " | " << Seconds(r.render_s) << " | " << Seconds(r.total_s) << " |\n";
+        << " | " << Seconds(r.render_s) << " | " << Seconds(r.total_s) << " | "
+        << Fixed(r.preview_ms, "%.3g ms") << " |\n";
     }
     s << "\n";
   }
-  s << "## Pareto fronts\n\n" << ParetoTables(rows);
+  s << "## Pareto fronts\n\n" << ParetoTables(rows) << TargetTable(rows);
   s << "Plots: `study_d.svg`, `study_4d.svg` (error against total time, log axes, one curve per "
        "knob, the front in red).\n";
   return s.str();

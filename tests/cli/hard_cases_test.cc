@@ -42,6 +42,8 @@
 // (CheckOptions::texel_error).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -51,8 +53,11 @@
 
 #include "core/basis.h"
 #include "core/dataset.h"
+#include "core/exr_io.h"
 #include "core/slab.h"
 #include "core/slab_compare.h"
+#include "core/srgbe.h"
+#include "lib/lightfield/tone_map.h"
 #include "noise_floor.h"
 #include "slab_masks.h"
 #include "test_util.h"
@@ -758,6 +763,179 @@ TEST(HardCases, RandomisedSweep) {
     ExpectStable(what, CheckSlab(r.ds));
     CleanUp(r);
   }
+}
+
+// Receivers very near the sampling plane S (D -> 0, docs/design.md §8.2): the receiver plane at
+// D = 0.2 d and 0.05 d lit by the built-in luminaire's exact slab (`--write-test-slab`: 9 x 7,
+// h = 5 mm, d = 750 mm, 300 texels), rendered four ways by lumislab-preview: the analytic image
+// straight from the emitters (the truth), the exact reference at N = 8 and N = 1 (§4.5), and
+// OpenGL (eq. 14). The view (--extent) keeps every ray from the emitters to it inside the grid's
+// covered region on S (|u| <= ((9 - 1)/2 - K) h = 15 mm, |v| <= 10 mm; the crossing
+// u = (e D + x z)/(D + z), §4.8), so what is measured is the method, not the coverage.
+//
+// Bounds, derived:
+//  * Reference (N = 8) against the analytic image: the exact model's parallax error is first
+//    order in a = z/(d + z) |1 - d/D| and bounded pointwise by 2 a sum|c_m| (§4.5; sum|c_m| =
+//    67/39 for K = 1); with the deeper emitter (z = 20 mm) a = 0.104 at 0.2 d: 36 %. Second
+//    order adds (2 a sum|c_m|)^2 / 2 at most (the next Taylor term of the same expansion), so
+//    the bound is B = 2 a S + (2 a S)^2 / 2, 42 % at 0.2 d. At 0.05 d, a = 0.49 and 2 a S = 1.7:
+//    the expansion does not converge, no bound holds, and lumislab-plan refuses the distance
+//    (exit 0 with its warning; the preview and the reference do not check D).
+//  * OpenGL against the reference at N = 1: both sum one sample per position at c_ij (eq. 14);
+//    they differ by E' = E / g interpolated bilinearly and multiplied by g at the sample
+//    (shift-invariant model, §3.4) against E interpolated: g = d^2 cos^4 over M varies by at
+//    most 4 (a_t / d)^2 ~ 1.6e-4 relative over a texel a_t = 4 mm, plus float rounding in the
+//    GPU sum: bound 10^-3 (the CPU-GL agreement test's at d, §4.5).
+//  * Every value finite and the flux of each image positive.
+TEST(HardCases, ReceiverPlaneNearTheSamplingPlane) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "accuracy run: the Release build's (the renderers' paths run under the "
+                    "sanitizers in tests/lightfield and tests/preview)";
+  const std::string dir = FreshDir("hard_near_s");
+  const std::string slab = dir + "/slab";
+  const double d = 750, z = 20, sum_c = 67.0 / 39.0;
+  struct Plane {
+    double fraction, extent_mm;
+  };
+  for (const Plane& plane : {Plane{0.2, 120}, Plane{0.05, 40}}) {
+    const double D = plane.fraction * d;
+    char common[256];
+    std::snprintf(common, sizeof common,
+                  "--slab %s --write-test-slab --scene plane --receiver-plane %.9g --extent %.9g "
+                  "--size 48x48 --threads 2",
+                  slab.c_str(), D, plane.extent_mm);
+    const auto render = [&](const std::string& name, const std::string& args) {
+      const std::string out = dir + "/" + name + ".exr";
+      const auto r =
+          RunTool("lumislab-preview", std::string(common) + " " + args + " --out " + out);
+      EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.output;
+      const ImageF image = ReadExr(out, {"R", "G", "B"});
+      double flux = 0;
+      for (float v : image.data) {
+        EXPECT_TRUE(std::isfinite(v)) << name;
+        flux += v;
+      }
+      EXPECT_GT(flux, 0) << name;
+      return image;
+    };
+    const std::string tag = "D" + std::to_string(int(std::lround(100 * plane.fraction)));
+    const ImageF analytic = render(tag + "_analytic", "--analytic default");
+    const ImageF reference = render(tag + "_ref8", "--reference --samples 8");
+    const ImageF reference1 = render(tag + "_ref1", "--reference --samples 1");
+    const ImageF opengl = render(tag + "_gl", "");
+    const double a = z / (d + z) * std::abs(1 - d / D), first = 2 * a * sum_c;
+    const double ref_error = CompareImages(reference, analytic).relative_l2;
+    const double ref1_error = CompareImages(reference1, analytic).relative_l2;
+    const double gl_error = CompareImages(opengl, reference1).relative_l2;
+    std::printf(
+        "D = %.2f d: reference N=8 vs analytic %.3g %% (first order 2aS %.3g %%), N=1 vs "
+        "analytic %.3g %%, OpenGL vs N=1 %.3g %%\n",
+        plane.fraction, 100 * ref_error, 100 * first, 100 * ref1_error, 100 * gl_error);
+    EXPECT_LE(gl_error, 1e-3) << tag;
+    if (first < 1) {
+      EXPECT_LE(ref_error, first + first * first / 2) << tag;
+    }
+  }
+  // At 0.05 d the first-order parallax 2 a sum|c_m| exceeds 1: lumislab-plan says the distance
+  // is outside what the method can do.
+  const auto plan = RunTool("lumislab-plan", "--scene default --receiver-mm 37.5 --target 5%");
+  EXPECT_EQ(plan.exit_code, 0) << plan.output;
+  EXPECT_NE(plan.output.find("too close to S"), std::string::npos) << plan.output;
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
+// sRGBE at its edges (core/srgbe.h, docs/design.md §4.3, §8.2), beyond the unit tests of
+// tests/core/srgbe_test.cc: what the preview's sRGBE accumulation does with it, emulated on the
+// CPU (each light pass decodes the running sum, adds and re-encodes).
+//  * Every word decodes to a finite value within kSrgbeMax, and re-encoding a decoded value gives
+//    the same value back (a pass that adds nothing leaves the image unchanged; no drift).
+//  * Near 0 and through the float denormals (2^-149 ... 2^-126) every triple is within
+//    max(max|x| / 127.5, 2^-136) of its input; below 2^-136 it is exactly 0, with no sign.
+//  * At the top, sums saturate at +-kSrgbeMax (no Inf, no NaN), sign kept.
+//  * NaN and +-Inf input are clamped (NaN to 0, Inf to +-kSrgbeMax), never propagated.
+//  * Accumulation: P re-encodings of the running sums S_k leave an error of at most
+//    sum_k max|S_k| / 127.5 per channel (each encode's bound, §4.3); over intensities spanning
+//    10^-30 ... 10^30 the sum of 63 positions stays within it.
+TEST(HardCases, SrgbeAtItsEdges) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // Every exponent byte with every byte in R (G and B fixed at two patterns): finite, bounded,
+  // and a fixed point of decode -> encode -> decode.
+  int words = 0;
+  for (uint32_t e = 0; e < 256; ++e)
+    for (uint32_t byte = 0; byte < 256; ++byte)
+      for (uint32_t gb : {0x0000u, 0xff7fu}) {
+        const uint32_t w = byte | gb << 8 | e << 24;
+        const auto v = DecodeSrgbe(w);
+        for (float x : v) {
+          ASSERT_TRUE(std::isfinite(x)) << std::hex << w;
+          ASSERT_LE(std::abs(x), kSrgbeMax) << std::hex << w;
+        }
+        const auto again = DecodeSrgbe(EncodeSrgbe(v[0], v[1], v[2]));
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(again[c], v[c]) << std::hex << w << " channel " << c;
+        ++words;
+      }
+  EXPECT_EQ(words, 256 * 256 * 2);
+  // Near 0: every power of two from 2^-150 to 2^-120 (through the float denormals), alone and
+  // next to a channel 2^5 times larger.
+  for (int k = -150; k <= -120; ++k) {
+    const float x = std::ldexp(1.0f, k);
+    for (const auto& in : {std::array<float, 3>{x, -x, 0}, std::array<float, 3>{x, x * 32, -x}}) {
+      const auto out = DecodeSrgbe(EncodeSrgbe(in[0], in[1], in[2]));
+      const float bound = SrgbeErrorBound(in[0], in[1], in[2]);
+      EXPECT_LE(bound, std::max(std::ldexp(1.0f, -136), 32 * x / 127.5f));
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_LE(std::abs(out[c] - in[c]), bound) << "2^" << k << " channel " << c;
+        if (out[c] != 0) EXPECT_EQ(std::signbit(out[c]), std::signbit(in[c])) << "2^" << k;
+      }
+    }
+    if (k < -136) {
+      EXPECT_EQ(EncodeSrgbe(x, -x, x), 0u) << "2^" << k;  // exactly 0, not -0
+    }
+  }
+  // The top: the largest value round-trips exactly; beyond it, and +-Inf, clamp with the sign.
+  auto top = DecodeSrgbe(EncodeSrgbe(kSrgbeMax, -kSrgbeMax, 0));
+  EXPECT_EQ(top[0], kSrgbeMax);
+  EXPECT_EQ(top[1], -kSrgbeMax);
+  for (float big : {std::nextafter(kSrgbeMax, inf), std::numeric_limits<float>::max(), inf}) {
+    top = DecodeSrgbe(EncodeSrgbe(big, -big, nan));
+    EXPECT_EQ(top[0], kSrgbeMax);
+    EXPECT_EQ(top[1], -kSrgbeMax);
+    EXPECT_EQ(top[2], 0.f);
+  }
+  // Accumulation over 63 positions, each decade of 10^-30 ... 10^30 in turn, in a shuffled
+  // order with signs (signed E_ij): within the sum of the encodes' bounds; and saturation
+  // without Inf when the sum passes kSrgbeMax.
+  std::mt19937 rng(10);
+  for (int trial = 0; trial < 200; ++trial) {
+    uint32_t acc = 0;
+    double exact[3] = {0, 0, 0}, bound[3] = {0, 0, 0};
+    std::uniform_real_distribution<double> exponent(-30, 30), sign(-0.3, 1);
+    for (int k = 0; k < 63; ++k) {
+      const double scale = std::pow(10.0, exponent(rng));
+      const auto prev = DecodeSrgbe(acc);
+      float next[3];
+      for (int c = 0; c < 3; ++c) {
+        const double x = scale * sign(rng);
+        exact[c] += x;
+        next[c] = float(double(prev[c]) + x);
+      }
+      acc = EncodeSrgbe(next[0], next[1], next[2]);
+      const double largest = std::max({std::abs(next[0]), std::abs(next[1]), std::abs(next[2])});
+      for (int c = 0; c < 3; ++c)
+        bound[c] += std::max(largest / 127.5, std::ldexp(1.0, -136)) + 1e-7 * largest;
+    }
+    const auto sum = DecodeSrgbe(acc);
+    for (int c = 0; c < 3; ++c) EXPECT_LE(std::abs(sum[c] - exact[c]), bound[c]) << trial;
+  }
+  uint32_t acc = 0;
+  for (int k = 0; k < 4; ++k) {
+    const auto prev = DecodeSrgbe(acc);
+    acc = EncodeSrgbe(prev[0] + kSrgbeMax / 2, prev[1] - kSrgbeMax / 2, prev[2]);
+  }
+  const auto saturated = DecodeSrgbe(acc);
+  EXPECT_EQ(saturated[0], kSrgbeMax);
+  EXPECT_EQ(saturated[1], -kSrgbeMax);
 }
 
 }  // namespace

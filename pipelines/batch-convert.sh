@@ -112,17 +112,15 @@ stale() {
 }
 
 # Runs the stages of one dataset in order and stops at the first failure (batch-stage.sh records
-# it in <log>/<stage>.failed). <log>/ran lists the stages run by this batch.
+# it in <log>/<stage>.failed). $ran/<name> lists the stages run by this batch.
 convert() {  # dataset threads
   local ds="$1" n logdir upstream=0 s rc
   n="$(basename "$ds")"
   logdir="$out/log/$n"
-  mkdir -p "$logdir"
-  : >"$logdir/ran"
   for s in "${stages[@]}"; do
     stale "$s" "$ds" "$upstream" || continue
     upstream=1
-    echo "$s" >>"$logdir/ran"
+    echo "$s" >>"$ran/$n"
     rc=0
     "$here/batch-stage.sh" "$s" "$ds" "$out" --threads "$2" "${stage_args[@]}" || rc=$?
     if [ $rc != 0 ]; then
@@ -130,7 +128,7 @@ convert() {  # dataset threads
       return 0
     fi
   done
-  echo "$n: done ($(paste -sd' ' "$logdir/ran" | sed 's/^$/nothing to do/'))" >&2
+  echo "$n: done ($(paste -sd' ' "$ran/$n" | sed 's/^$/nothing to do/'))" >&2
 }
 
 if [ $dry = 1 ]; then
@@ -144,6 +142,12 @@ if [ $dry = 1 ]; then
 fi
 
 mkdir -p "$out"
+# What this batch ran, per dataset (for the summary; a folder of its own, removed at the end, so
+# that a batch with nothing to do rewrites nothing but the summary).
+ran="$(mktemp -d "$out/.ran.XXXXXX")"
+tmp="$out/.summary.csv.tmp$$"
+trap 'rm -rf "$ran" "$tmp"' EXIT
+for ds in "${datasets[@]}"; do : >"$ran/$(basename "$ds")"; done
 if [ $summary_only = 0 ]; then
   parallel=$((jobs < ${#datasets[@]} ? jobs : ${#datasets[@]}))
   threads=$((jobs / parallel))
@@ -170,8 +174,6 @@ csv_field() {  # quotes a CSV field when it needs it
     *) printf '%s' "$1" ;;
   esac
 }
-tmp="$out/.summary.csv.tmp$$"
-trap 'rm -f "$tmp"' EXIT
 {
   printf 'dataset,status,positions,error_overall_pct,error_max_pct'
   for s in "${stages[@]}"; do printf ',%s_s' "$s"; done
@@ -182,8 +184,8 @@ failures=0
 for ds in "${datasets[@]}"; do
   n="$(basename "$ds")"
   logdir="$out/log/$n"
-  status=ok failure="" positions="" err="" errmax="" ran=""
-  [ $summary_only = 1 ] || [ ! -f "$logdir/ran" ] || ran="$(paste -sd' ' "$logdir/ran")"
+  status=ok failure="" positions="" err="" errmax=""
+  stages_ran="$(paste -sd' ' "$ran/$n")"
   for s in "${stages[@]}"; do
     if [ -f "$logdir/$s.failed" ]; then
       status=failed failures=$((failures + 1))
@@ -228,14 +230,13 @@ for ds in "${datasets[@]}"; do
   {
     printf '%s,%s,%s,%s,%s' "$(csv_field "$n")" "$status" "$positions" "$err" "$errmax"
     for t in "${times[@]}"; do printf ',%s' "$t"; done
-    printf ',%s,%s,%s\n' "$(csv_field "$ran")" "$(csv_field "${outs[*]:-}")" "$(csv_field "$failure")"
+    printf ',%s,%s,%s\n' "$(csv_field "$stages_ran")" "$(csv_field "${outs[*]:-}")" "$(csv_field "$failure")"
   } >>"$tmp"
   table+=("$(printf '%-20s %-10s %-9s %-8s %s' "$n" "$status" "${positions:--}" \
     "${err:--}" "$(IFS=/; echo "${times[*]}")")")
   [ -z "$failure" ] || table+=("    $failure")
 done
 mv -f "$tmp" "$out/summary.csv"
-trap - EXIT
 printf '%-20s %-10s %-9s %-8s %s\n' dataset status positions "err %" \
   "seconds ($(IFS=/; echo "${stages[*]}"))"
 printf '%s\n' "${table[@]}"

@@ -44,7 +44,7 @@ bin="${LUMISLAB_BIN:-$(cd "$(dirname "$0")/.." && pwd)/build/bin}"
 name="$(basename "$dataset")"
 dest="$out/$name"
 logdir="$out/log/$name"
-mkdir -p "$dest" "$logdir"
+mkdir -p "$logdir"
 log="$logdir/$stage.log"
 
 # run <command...>: runs a tool with its output appended to the stage's log.
@@ -69,6 +69,7 @@ reconstruct() {
 
 export_files() {
   local export="$bin/lumislab-export" slab="$dataset/slab"
+  mkdir -p "$dest"
   # A lab's IES file must name the test, the lab and the maker (§7.8); the test is the dataset.
   local ids=(--test "$name")
   [ ${#keywords[@]} -gt 0 ] || ids+=(--lab unspecified --manufacturer unspecified)
@@ -82,11 +83,13 @@ export_files() {
 }
 
 tm25() {
+  mkdir -p "$dest"
   run "$bin/lumislab-export" tm25 --slab "$dataset/slab" --out "$dest/$name.ray" --rays "$rays" \
     --name "$name" --force --threads "$threads"
 }
 
 preview() {
+  mkdir -p "$dest"
   run "$bin/lumislab-preview" --slab "$dataset/slab" --scene crypt --size "$size" \
     --out "$dest/preview.png" --threads "$threads"
 }

@@ -19,15 +19,15 @@
 # pipelines/Snakefile.
 set -euo pipefail
 usage() {
-  sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//' >&2
-  exit 2
+  sed -n '2,/^set /{ /^#/ s/^# \{0,1\}//p; }' "$0" >&2
+  exit "${1:-2}"
 }
 here="$(cd "$(dirname "$0")" && pwd)"
-out=batch-out jobs="" distance=1500 tm25=0 dry=0 summary_only=0 args=() stage_args=()
+out=batch-out jobs="" distance=1500 tm25=0 dry=0 summary_only=0 stage_args=()
 inputs=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    -h | --help) usage ;;
+    -h | --help) usage 0 ;;
     --tm25) tm25=1; shift ;;
     -n | --dry-run) dry=1; shift ;;
     --summary-only) summary_only=1; shift ;;

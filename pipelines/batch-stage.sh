@@ -21,7 +21,7 @@
 # Exit code: the failing tool's.
 set -euo pipefail
 usage() {
-  sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,/^set /{ /^#/ s/^# \{0,1\}//p; }' "$0" >&2
   exit 2
 }
 [ $# -ge 3 ] || usage
@@ -97,6 +97,7 @@ preview() {
 : >"$log"
 rm -f "$logdir/$stage.failed"
 # A failure is recorded beside the log ("<exit code>"), for the summary.
+# shellcheck disable=SC2154  # rc is set inside the trap
 trap 'rc=$?; [ $rc = 0 ] || echo $rc >"$logdir/$stage.failed"' EXIT
 start=$(date +%s.%N)
 case "$stage" in

@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# One stage of one dataset of a batch conversion: the commands that pipelines/batch-convert.sh and
+# pipelines/Snakefile both run (one implementation), with the stage's log and time.
+#
+#   pipelines/batch-stage.sh <stage> <dataset> <out> [--threads N] [--distance-mm D]
+#       [--rays N] [--preview-size WxH] [--lab L] [--manufacturer M] [--metadata meta.json]
+#
+# <stage>: calibrate | reconstruct | export | tm25 | preview. <out>: the batch's output folder.
+# The dataset's name is its folder's name. What each stage writes (docs/design.md §6.5):
+#   calibrate    <dataset>/calib/screen.json        (lumislab-calibrate screen)
+#   reconstruct  <dataset>/slab/                    (lumislab-reconstruct)
+#   export       <out>/<name>/<name>.ies, <name>.ldt, polar.png, irradiance_<D>mm.png
+#   tm25         <out>/<name>/<name>.ray            (lumislab-export tm25)
+#   preview      <out>/<name>/preview.png           (lumislab-preview, the crypt)
+# and always <out>/log/<name>/<stage>.log (the tools' output), and <stage>.time (seconds) when the
+# stage succeeds or <stage>.failed (its exit code) when it fails. A stage is run only when its outputs are missing or older than its
+# inputs (the caller decides), so it redoes them whole (--force): calibrate and the exports
+# would otherwise skip an existing output. reconstruct is the exception: it resumes a partial
+# slab (positions already there are kept) unless a position is older than dataset.json or
+# calib/screen.json, i.e. made from another calibration, and then redoes the slab (--force).
+# Exit code: the failing tool's.
+set -euo pipefail
+usage() {
+  sed -n '2,/^set /{ /^#/ s/^# \{0,1\}//p; }' "$0" >&2
+  exit 2
+}
+[ $# -ge 3 ] || usage
+stage="$1" dataset="${2%/}" out="${3%/}"
+shift 3
+threads=0 distance=1500 rays=100000 size=640x360 keywords=()
+while [ $# -gt 0 ]; do
+  [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
+  case "$1" in
+    --threads) threads="$2" ;;
+    --distance-mm) distance="$2" ;;
+    --rays) rays="$2" ;;
+    --preview-size) size="$2" ;;
+    --lab | --manufacturer | --metadata) keywords+=("$1" "$2") ;;
+    *) echo "$0: unknown argument: $1" >&2; exit 2 ;;
+  esac
+  shift 2
+done
+bin="${LUMISLAB_BIN:-$(cd "$(dirname "$0")/.." && pwd)/build/bin}"
+name="$(basename "$dataset")"
+dest="$out/$name"
+logdir="$out/log/$name"
+mkdir -p "$logdir"
+log="$logdir/$stage.log"
+
+# run <command...>: runs a tool with its output appended to the stage's log.
+run() {
+  echo "\$ $*" >>"$log"
+  "$@" >>"$log" 2>&1
+}
+
+calibrate() {
+  run "$bin/lumislab-calibrate" screen --dataset "$dataset" --force --threads "$threads"
+}
+
+reconstruct() {
+  local force=()
+  # A position older than its inputs comes from another calibration or capture: redo them all.
+  if [ -d "$dataset/slab" ] && [ -n "$(find "$dataset/slab" -maxdepth 1 -name 'pos_*.exr' \
+    \( ! -newer "$dataset/dataset.json" -o ! -newer "$dataset/calib/screen.json" \) -print -quit)" ]; then
+    force=(--force)
+  fi
+  run "$bin/lumislab-reconstruct" --dataset "$dataset" --threads "$threads" "${force[@]}"
+}
+
+export_files() {
+  local export="$bin/lumislab-export" slab="$dataset/slab"
+  mkdir -p "$dest"
+  # A lab's IES file must name the test, the lab and the maker (§7.8); the test is the dataset.
+  local ids=(--test "$name")
+  [ ${#keywords[@]} -gt 0 ] || ids+=(--lab unspecified --manufacturer unspecified)
+  run "$export" ies --slab "$slab" --out "$dest/$name.ies" --force --threads "$threads" \
+    "${ids[@]}" "${keywords[@]}"
+  run "$export" ldt --slab "$slab" --out "$dest/$name.ldt" --force --threads "$threads" \
+    "${ids[@]}" "${keywords[@]}"
+  run "$export" polar --slab "$slab" --out "$dest/polar.png" --title "$name" --threads "$threads"
+  run "$export" irradiance --slab "$slab" --distance-mm "$distance" \
+    --out "$dest/irradiance_${distance}mm.png" --threads "$threads"
+}
+
+tm25() {
+  mkdir -p "$dest"
+  run "$bin/lumislab-export" tm25 --slab "$dataset/slab" --out "$dest/$name.ray" --rays "$rays" \
+    --name "$name" --force --threads "$threads"
+}
+
+preview() {
+  mkdir -p "$dest"
+  run "$bin/lumislab-preview" --slab "$dataset/slab" --scene crypt --size "$size" \
+    --out "$dest/preview.png" --threads "$threads"
+}
+
+: >"$log"
+rm -f "$logdir/$stage.failed"
+# A failure is recorded beside the log ("<exit code>"), for the summary.
+# shellcheck disable=SC2154  # rc is set inside the trap
+trap 'rc=$?; [ $rc = 0 ] || echo $rc >"$logdir/$stage.failed"' EXIT
+start=$(date +%s.%N)
+case "$stage" in
+  calibrate) calibrate ;;
+  reconstruct) reconstruct ;;
+  export) export_files ;;
+  tm25) tm25 ;;
+  preview) preview ;;
+  *) echo "$0: unknown stage: $stage" >&2; exit 2 ;;
+esac
+end=$(date +%s.%N)
+# The time, written whole: a summary never reads half a number.
+tmp="$logdir/.$stage.time.tmp$$"
+awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f\n", b - a }' >"$tmp"
+mv -f "$tmp" "$logdir/$stage.time"

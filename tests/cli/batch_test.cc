@@ -1,0 +1,249 @@
+// pipelines/batch-convert.sh and pipelines/Snakefile on three tiny synthetic datasets, one of
+// them broken (a photo cut short): two converted, the broken one reported with its reason, exit
+// code 1; a rerun rewrites nothing; Snakemake plans the same jobs and runs them.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core/slab_compare.h"
+#include "test_util.h"
+
+namespace lumislab {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CommandResult;
+using testing::ShellQuote;
+
+// A 2 x 2 grid photographed at 400 x 300 pixels: a dataset in about half a second.
+const char* kTinyScene = R"({ "schema_version": 1,
+  "setup": { "distance_mm": 750, "grid": {"nu": 2, "nv": 2, "spacing_mm": 5},
+             "screen_mm": [1200, 1200] },
+  "luminaire": { "emitters": [
+      {"position_mm": [1.5, -2, -20], "intensity_w_sr": [1.0, 0.9, 0.8], "lobe_exponent": 8} ] },
+  "camera": {"size_px": [400, 300], "focal_px": 330, "position_mm": [0, -100, 2400],
+             "look_at_mm": [0, 0, 750]},
+  "effects": [] })";
+
+// Runs `command` through sh in `cwd` with the build's binaries; stdout and stderr together.
+CommandResult RunIn(const std::string& cwd, const std::string& command) {
+  const std::string cmd = "cd " + ShellQuote(cwd) +
+                          " && LUMISLAB_BIN=" + ShellQuote(LUMISLAB_BIN_DIR) + " " + command +
+                          " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) result.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+std::string Pipelines() { return std::string(LUMISLAB_SOURCE_DIR) + "/pipelines"; }
+std::string BatchConvert() { return ShellQuote(Pipelines() + "/batch-convert.sh"); }
+std::string Snakemake() {
+  return "snakemake -s " + ShellQuote(Pipelines() + "/Snakefile") +
+         " --config 'datasets=[data]' out=out --cores 2";
+}
+bool HaveSnakemake() { return std::system("command -v snakemake >/dev/null 2>&1") == 0; }
+
+// The summary CSV: rows by dataset, fields by the header's names.
+using Row = std::map<std::string, std::string>;
+std::vector<std::string> SplitCsvLine(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (size_t k = 0; k < line.size(); ++k) {
+    const char c = line[k];
+    if (quoted && c == '"' && k + 1 < line.size() && line[k + 1] == '"') {
+      fields.back() += '"';
+      ++k;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+std::map<std::string, Row> ReadSummary(const std::string& path) {
+  std::istringstream in(testing::ReadBinaryFile(path));
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = SplitCsvLine(line);
+  std::map<std::string, Row> rows;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> fields = SplitCsvLine(line);
+    EXPECT_EQ(fields.size(), header.size()) << line;
+    Row row;
+    for (size_t k = 0; k < header.size() && k < fields.size(); ++k) row[header[k]] = fields[k];
+    rows[row["dataset"]] = row;
+  }
+  return rows;
+}
+
+// The jobs a dry run plans, as "<stage> <dataset name>": batch-convert.sh prints them so;
+// Snakemake prints "rule <stage>:" and then "wildcards: ds=<folder>" or "name=<name>".
+std::set<std::string> Lines(const std::string& text) {
+  std::set<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) lines.insert(line);
+  return lines;
+}
+std::set<std::string> SnakemakeJobs(const std::string& dry_run) {
+  std::set<std::string> jobs;
+  std::istringstream in(dry_run);
+  std::string rule;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("rule ", 0) == 0) rule = line.substr(5, line.find(':') - 5);
+    const size_t w = line.find("wildcards: ");
+    if (w == std::string::npos || rule.empty()) continue;
+    std::string value = line.substr(line.find('=', w) + 1);
+    jobs.insert(rule + " " + fs::path(value).filename().string());
+    rule.clear();
+  }
+  return jobs;
+}
+
+class Batch : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = testing::FreshDir("batch");
+    testing::WriteFile(root_ + "/scene.json", kTinyScene);
+    for (const char* name : {"lamp_a", "lamp_b", "broken"}) {
+      const auto r =
+          testing::RunTool("lumislab-acquire", "synth --scene " + root_ + "/scene.json --out " +
+                                                   root_ + "/data/" + name);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    // A photo cut short, as a failed copy leaves it: reconstruct refuses it (exit 2).
+    fs::resize_file(root_ + "/data/broken/photos/pos_1_0_p.exr", 1000);
+  }
+  static void TearDownTestSuite() {
+    if (!::testing::Test::HasFailure()) fs::remove_all(root_);
+  }
+  static std::string root_;
+};
+std::string Batch::root_;
+
+TEST_F(Batch, ConvertsReportsTheBrokenDatasetAndResumes) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "runs the tools many times over; the Release build's (the tools' own tests "
+                    "run sanitized)";
+  // Before anything ran: four stages for each of the three datasets.
+  const CommandResult plan = RunIn(root_, BatchConvert() + " data --out out --dry-run");
+  ASSERT_EQ(plan.exit_code, 0) << plan.output;
+  EXPECT_EQ(Lines(plan.output).size(), 12u) << plan.output;
+  EXPECT_EQ(Lines(plan.output).count("reconstruct broken"), 1u) << plan.output;
+
+  const CommandResult first = RunIn(root_, BatchConvert() + " data --out out --jobs 2");
+  ASSERT_EQ(first.exit_code, 1) << first.output;
+  // The table names the failing stage and the tool's reason (the photo).
+  EXPECT_NE(first.output.find("reconstruct (exit 2)"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("pos_1_0_p.exr"), std::string::npos) << first.output;
+  auto rows = ReadSummary(root_ + "/out/summary.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  for (const char* name : {"lamp_a", "lamp_b"}) {
+    const Row& row = rows[name];
+    EXPECT_EQ(row.at("status"), "ok") << name;
+    EXPECT_EQ(row.at("positions"), "4/4") << name;
+    EXPECT_EQ(row.at("ran"), "calibrate reconstruct export preview") << name;
+    EXPECT_EQ(row.at("failure"), "") << name;
+    for (const char* stage : {"calibrate_s", "reconstruct_s", "export_s", "preview_s"})
+      EXPECT_GT(std::stod(row.at(stage)), 0) << name << " " << stage;
+    // The error the summary reports is the slab's against truth/ (core/slab_compare.h), and a
+    // noise-free capture is reconstructed within 0.5 % (EndToEnd's bound for the default scene).
+    const std::string ds = root_ + "/data/" + name;
+    const SlabComparison c = CompareSlabs(ds + "/slab", ds + "/truth");
+    EXPECT_NEAR(std::stod(row.at("error_overall_pct")), 100 * c.overall_relative_l2, 0.001);
+    EXPECT_NEAR(std::stod(row.at("error_max_pct")), 100 * c.max_relative_l2, 0.001);
+    EXPECT_LT(c.overall_relative_l2, 0.005) << name;
+    for (const std::string& file :
+         {"/" + std::string(name) + ".ies", "/" + std::string(name) + ".ldt",
+          std::string("/polar.png"), std::string("/irradiance_1500mm.png"),
+          std::string("/preview.png")}) {
+      EXPECT_TRUE(fs::is_regular_file(root_ + "/out/" + name + file)) << name << file;
+      EXPECT_NE(row.at("outputs").find(name + file), std::string::npos) << row.at("outputs");
+    }
+    // The IES file holds the slab's far field: a lab's reader finds positive flux in it.
+    const auto info = testing::RunTool(
+        "lumislab-export", "info --json " + root_ + "/out/" + name + "/" + name + ".ies");
+    EXPECT_EQ(info.exit_code, 0) << info.output;
+    EXPECT_NE(info.output.find("\"flux\""), std::string::npos) << info.output;
+  }
+  const Row& broken = rows["broken"];
+  EXPECT_EQ(broken.at("status"), "failed");
+  EXPECT_EQ(broken.at("ran"), "calibrate reconstruct");
+  EXPECT_EQ(broken.at("failure").rfind("reconstruct (exit 2): ", 0), 0u) << broken.at("failure");
+  EXPECT_NE(broken.at("failure").find("pos_1_0_p.exr"), std::string::npos);
+  EXPECT_FALSE(fs::exists(root_ + "/out/broken/preview.png"));
+  EXPECT_TRUE(fs::is_regular_file(root_ + "/out/log/broken/reconstruct.log"));
+  EXPECT_TRUE(testing::TemporaryPaths(testing::SnapshotTree(root_ + "/out")).empty());
+
+  // Only the broken dataset's stages from reconstruct on are left, and Snakemake, which decides
+  // by the same rules, plans the same jobs.
+  const CommandResult left = RunIn(root_, BatchConvert() + " data --out out -n");
+  EXPECT_EQ(Lines(left.output),
+            (std::set<std::string>{"reconstruct broken", "export broken", "preview broken"}))
+      << left.output;
+
+  // A rerun does no work for the converted datasets: their folders, outputs and logs are left
+  // byte for byte and untouched in time (SnapshotTree hashes every file; the listing below
+  // checks modification times).
+  const auto before_a = testing::SnapshotTree(root_ + "/data/lamp_a");
+  const auto before_out = testing::SnapshotTree(root_ + "/out/lamp_a");
+  const auto before_log = testing::SnapshotTree(root_ + "/out/log/lamp_b");
+  const auto time_ies = fs::last_write_time(root_ + "/out/lamp_a/lamp_a.ies");
+  const auto time_slab = fs::last_write_time(root_ + "/data/lamp_b/slab/slab.json");
+  const auto first_rows = rows;
+  const CommandResult again = RunIn(root_, BatchConvert() + " data --out out --jobs 2");
+  EXPECT_EQ(again.exit_code, 1) << again.output;
+  EXPECT_TRUE(
+      testing::DiffSnapshots(before_a, testing::SnapshotTree(root_ + "/data/lamp_a")).empty());
+  EXPECT_TRUE(
+      testing::DiffSnapshots(before_out, testing::SnapshotTree(root_ + "/out/lamp_a")).empty());
+  EXPECT_TRUE(
+      testing::DiffSnapshots(before_log, testing::SnapshotTree(root_ + "/out/log/lamp_b")).empty());
+  EXPECT_EQ(fs::last_write_time(root_ + "/out/lamp_a/lamp_a.ies"), time_ies);
+  EXPECT_EQ(fs::last_write_time(root_ + "/data/lamp_b/slab/slab.json"), time_slab);
+  rows = ReadSummary(root_ + "/out/summary.csv");
+  EXPECT_EQ(rows["lamp_a"].at("ran"), "");
+  // The summary still describes the converted datasets: the times and error of the earlier run.
+  for (const char* field : {"status", "positions", "error_overall_pct", "reconstruct_s", "outputs"})
+    EXPECT_EQ(rows["lamp_b"].at(field), first_rows.at("lamp_b").at(field)) << field;
+  EXPECT_EQ(rows["broken"].at("ran"), "reconstruct");
+  EXPECT_EQ(rows["broken"].at("status"), "failed");
+
+  if (!HaveSnakemake())
+    GTEST_SKIP() << "snakemake is not installed (Debian: apt install snakemake): the Snakefile's "
+                    "dry run and run are not checked";
+  const CommandResult dry = RunIn(root_, Snakemake() + " -n");
+  ASSERT_EQ(dry.exit_code, 0) << dry.output;
+  EXPECT_EQ(SnakemakeJobs(dry.output), Lines(left.output)) << dry.output;
+
+  // A real run: one lost output is redone (and only it, of the converted datasets); the broken
+  // dataset fails again; the summary is written at the end.
+  fs::remove(root_ + "/out/lamp_b/preview.png");
+  const auto ies_time = fs::last_write_time(root_ + "/out/lamp_b/lamp_b.ies");
+  const CommandResult run = RunIn(root_, Snakemake() + " --keep-going");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::is_regular_file(root_ + "/out/lamp_b/preview.png")) << run.output;
+  EXPECT_EQ(fs::last_write_time(root_ + "/out/lamp_b/lamp_b.ies"), ies_time);
+  EXPECT_NE(run.output.find("reconstruct (exit 2)"), std::string::npos) << run.output;
+  EXPECT_EQ(Lines(RunIn(root_, BatchConvert() + " data --out out -n").output),
+            (std::set<std::string>{"reconstruct broken", "export broken", "preview broken"}));
+}
+
+}  // namespace
+}  // namespace lumislab

@@ -37,15 +37,7 @@ CommandResult RunIn(const std::string& cwd, const std::string& command) {
   const std::string cmd = "cd " + ShellQuote(cwd) +
                           " && LUMISLAB_BIN=" + ShellQuote(LUMISLAB_BIN_DIR) + " " + command +
                           " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) result.output.append(buf.data(), n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return result;
+  return testing::RunShell(cmd);
 }
 
 std::string Pipelines() { return std::string(LUMISLAB_SOURCE_DIR) + "/pipelines"; }

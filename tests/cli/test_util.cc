@@ -21,10 +21,9 @@ namespace fs = std::filesystem;
 
 namespace lumislab::testing {
 
-CommandResult RunTool(const std::string& tool, const std::string& args) {
-  const std::string cmd = std::string(LUMISLAB_BIN_DIR) + "/" + tool + " " + args + " 2>&1";
+CommandResult RunShell(const std::string& command) {
   CommandResult result;
-  FILE* pipe = popen(cmd.c_str(), "r");
+  FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
   std::array<char, 4096> buf;
   size_t n;
@@ -32,6 +31,10 @@ CommandResult RunTool(const std::string& tool, const std::string& args) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
+}
+
+CommandResult RunTool(const std::string& tool, const std::string& args) {
+  return RunShell(std::string(LUMISLAB_BIN_DIR) + "/" + tool + " " + args + " 2>&1");
 }
 
 std::string FreshDir(const std::string& name) {
@@ -115,15 +118,7 @@ CommandResult RunToolIn(const std::string& cwd, const std::string& tool, const s
   }
   cmd << "exec timeout -k 5 " << timeout_s << " " << LUMISLAB_BIN_DIR << "/" << tool << " " << args
       << " </dev/null 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(cmd.str().c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) result.output.append(buf.data(), n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return result;
+  return RunShell(cmd.str());
 }
 
 namespace {

@@ -25,6 +25,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
+// Runs `command` through sh (popen): its stdout (redirect stderr in the command to keep it), and
+// its exit code (128 + signal when a signal ended it).
+CommandResult RunShell(const std::string& command);
 // Runs build/bin/<tool> with the given argument string (shell-quoted by the caller).
 CommandResult RunTool(const std::string& tool, const std::string& args);
 // A fresh, empty folder under the system temp folder, named after the test and the build folder.

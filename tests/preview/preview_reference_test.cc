@@ -15,18 +15,13 @@
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
 #include "preview/run_preview.h"
+#include "preview_test_util.h"
 
 namespace lumislab {
 namespace {
 
 namespace fs = std::filesystem;
 
-int RunPreviewWith(std::vector<std::string> args) {
-  args.insert(args.begin(), "lumislab-preview");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
-}
 
 // A folder of this process: ctest runs each test of this file as its own process, in parallel.
 std::string Scratch(const std::string& name) {

@@ -23,6 +23,7 @@
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
 #include "preview/run_preview.h"
+#include "preview_test_util.h"
 
 namespace lumislab {
 namespace {
@@ -240,12 +241,6 @@ TEST_F(PreviewSlabFiles, UnitAlbedoIsTheIrradianceBeforeTheMaterials) {
   EXPECT_GT(*std::max_element(images[1].data.begin(), images[1].data.end()), 0);
 }
 
-int RunPreviewWith(std::vector<std::string> args) {
-  args.insert(args.begin(), "lumislab-preview");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
-}
 
 TEST(PreviewCommandLine, SizeIsCheckedStrictly) {
   int w = 0, h = 0;

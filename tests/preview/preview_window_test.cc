@@ -16,18 +16,13 @@
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
 #include "preview/run_preview.h"
+#include "preview_test_util.h"
 
 namespace lumislab {
 namespace {
 
 namespace fs = std::filesystem;
 
-int RunPreviewWith(std::vector<std::string> args) {
-  args.insert(args.begin(), "lumislab-preview");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  return RunMain("preview", [&] { return RunPreview(int(argv.size()), argv.data()); });
-}
 
 // A small exact slab of the built-in luminaire (5x5 positions, 60^2 texels), written once into
 // a scratch folder that is removed at exit.

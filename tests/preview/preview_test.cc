@@ -294,8 +294,7 @@ TEST(PreviewCommandLine, FalseColourView) {
        {std::vector<std::string>{"--false-colour-range", "2:1"},
         {"--false-colour-range", "0:x"},
         {"--false-colour-range", "0:5", "--false-colour-scale", "log"},
-        {"--view", "false-color"},
-        {"--window"}}) {
+        {"--view", "false-color"}}) {
     std::vector<std::string> args = {
         "--slab", slab,           "--scene", "plane",
         "--view", "false-colour", "--out",   (dir / "bad.png").string()};

@@ -245,9 +245,17 @@ TEST(PreviewWindow, ScreenshotShowsThePanelAndTheHeadlessPicture) {
   ASSERT_EQ(window.cols, 640);
   ASSERT_EQ(window.rows, 480);
   ASSERT_EQ(picture.size, window.size);
-  // Right of the panel (about 420 pixels wide): the same bytes; on it: not.
+  // Right of the panel (about 420 pixels wide): the same picture; on it: not. The command line
+  // carries the pose and camera to 6 significant digits, and the crypt's default luminaire pose
+  // has ry = 90 degrees, where rx and rz trade places (gimbal lock): the pose read back differs
+  // in the last float bits, which moves a few pixels by one code.
   const cv::Rect right(470, 0, 170, 480), panel(16, 16, 300, 300);
-  EXPECT_EQ(cv::norm(window(right), picture(right), cv::NORM_INF), 0);
+  cv::Mat right_diff;
+  cv::absdiff(window(right), picture(right), right_diff);
+  double max_diff = 0;
+  cv::minMaxLoc(right_diff.reshape(1), nullptr, &max_diff);
+  EXPECT_LE(max_diff, 1);
+  EXPECT_LT(cv::countNonZero(right_diff.reshape(1)), int(right_diff.total()) / 100);
   EXPECT_GT(cv::countNonZero(picture(right).reshape(1)), 1000);  // the scene is lit there
   cv::Mat diff;
   cv::absdiff(window(panel), picture(panel), diff);

@@ -117,6 +117,10 @@ TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
 // black level (recorded in dataset.json), stray light on both slides (cancels in E+ - E-) and an
 // exposure bracket with clipped photos (merged from the unclipped exposures).
 TEST(EndToEnd, BlackLevelAmbientAndBracketsLeaveTheSlabAccurate) {
+  // An accuracy run at full size; each of its paths runs under the sanitizers in smaller tests
+  // (Reconstruct.ExposureBracketsRecoverClippedHighlights, BracketMerge.*, AmbientEffect.*,
+  // DarkEffect.*), where this one took 51 s.
+  if (testing::kSanitized) GTEST_SKIP() << "accuracy run: the Release build's";
   const std::string ds = RunPipeline(
       "e2e_cancelling",
       SceneJson(3, 3, kFrontalCamera,

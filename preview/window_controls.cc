@@ -12,7 +12,7 @@
 namespace lumislab {
 namespace {
 
-void Status(WindowState& s) {
+void StatusPanel(WindowState& s) {
   // A frame that adds no light only draws the picture and the panel; the last render is the
   // frame that did (all lights after a camera, pose or option change; new positions otherwise).
   ImGui::Text("%.1f fps (frame %.1f ms)  last render %.0f ms, %d lights",
@@ -25,7 +25,7 @@ void Status(WindowState& s) {
   DrawPositionGrid(s);
 }
 
-void Exposure(WindowState& s) {
+void ExposurePanel(WindowState& s) {
   ToneMapping& tone = s.config.tone;
   float stops = float(tone.exposure_stops);
   if (ImGui::SliderFloat("stops", &stops, -10, 10, "%+.1f")) {
@@ -54,7 +54,7 @@ void Exposure(WindowState& s) {
   }
 }
 
-void Shadows(WindowState& s) {
+void ShadowsPanel(WindowState& s) {
   PreviewConfig& c = s.config;
   s.options_changed |= ImGui::Checkbox("shadows", &c.shadows);
   ImGui::SameLine();
@@ -79,7 +79,7 @@ void Shadows(WindowState& s) {
   c.srgbe = format == 1;
 }
 
-void Luminaire(WindowState& s) {
+void LuminairePanel(WindowState& s) {
   std::vector<double>& pose = s.config.scene.pose;
   ImGui::TextDisabled("Ctrl+drag: move, Shift+drag: aim");
   s.pose_changed |= ImGui::DragScalarN("position mm", ImGuiDataType_Double, pose.data(), 3, 5.f,
@@ -88,7 +88,7 @@ void Luminaire(WindowState& s) {
                                        0.5f, nullptr, nullptr, "%.1f");
 }
 
-void Camera(WindowState& s) {
+void CameraPanel(WindowState& s) {
   if (s.setup.plane) {
     ImGui::TextDisabled("plane view: fixed orthographic camera");
     return;
@@ -111,7 +111,7 @@ void Camera(WindowState& s) {
                                          nullptr, nullptr, "%.0f");
 }
 
-void CommandLine(WindowState& s) {
+void CommandLinePanel(WindowState& s) {
   if (ImGui::Button("screenshot (P)")) s.screenshot_requested = true;
   if (!s.last_saved.empty()) {
     ImGui::SameLine();
@@ -151,13 +151,13 @@ void DrawControls(WindowState& s) {
   ImGui::SetNextWindowBgAlpha(0.8f);
   ImGui::Begin("lumislab-preview", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::PushItemWidth(200);
-  Status(s);
-  if (ImGui::CollapsingHeader("exposure", ImGuiTreeNodeFlags_DefaultOpen)) Exposure(s);
+  StatusPanel(s);
+  if (ImGui::CollapsingHeader("exposure", ImGuiTreeNodeFlags_DefaultOpen)) ExposurePanel(s);
   if (ImGui::CollapsingHeader("shadows and accumulation", ImGuiTreeNodeFlags_DefaultOpen))
-    Shadows(s);
-  if (ImGui::CollapsingHeader("luminaire", ImGuiTreeNodeFlags_DefaultOpen)) Luminaire(s);
-  if (ImGui::CollapsingHeader("camera", ImGuiTreeNodeFlags_DefaultOpen)) Camera(s);
-  CommandLine(s);
+    ShadowsPanel(s);
+  if (ImGui::CollapsingHeader("luminaire", ImGuiTreeNodeFlags_DefaultOpen)) LuminairePanel(s);
+  if (ImGui::CollapsingHeader("camera", ImGuiTreeNodeFlags_DefaultOpen)) CameraPanel(s);
+  CommandLinePanel(s);
   ImGui::PopItemWidth();
   ImGui::End();
 }

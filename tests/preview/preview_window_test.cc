@@ -23,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 // A small exact slab of the built-in luminaire (5x5 positions, 60^2 texels), written once into
 // a scratch folder that is removed at exit.
 struct ScratchFolder {
@@ -222,11 +221,22 @@ TEST(PreviewWindow, ScreenshotShowsThePanelAndTheHeadlessPicture) {
   if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is missing (Debian: xvfb)";
   const std::string shot = Scratch("window.png"), log = Scratch("window.log");
-  const std::string command = "cd " + fs::path(shot).parent_path().string() +
-                              " && xvfb-run -a -s '-screen 0 800x600x24' " LUMISLAB_BIN_DIR
-                              "/lumislab-preview --window --slab " +
-                              TestSlab() + " --scene crypt --size 640x480 --screenshot " + shot +
-                              " > " + log + " 2>&1";
+  // Under the sanitizers: no leak check for the window's process. Under Xvfb it ends with 2 x 56
+  // bytes allocated by a library that was unloaded before exit (the GL driver stack the GLFW
+  // window loads at run time; lumislab's binary stays loaded and would be named), an "<unknown
+  // module>" that no suppression in fuzz/sanitizers/lsan.supp can match. ASan's other checks stay
+  // on, and lumislab's own allocations are leak-checked through OSMesa in the other preview tests.
+  const std::string no_leak_check =
+#ifdef LUMISLAB_SANITIZED
+      "ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" ";
+#else
+      "";
+#endif
+  const std::string command =
+      "cd " + fs::path(shot).parent_path().string() + " && " + no_leak_check +
+      "xvfb-run -a -s '-screen 0 800x600x24' " LUMISLAB_BIN_DIR
+      "/lumislab-preview --window --slab " +
+      TestSlab() + " --scene crypt --size 640x480 --screenshot " + shot + " > " + log + " 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << ReadText(log);
   const std::string text = ReadText(log);
   std::smatch m;

@@ -72,20 +72,13 @@ bool Photometric(const SlabInfo& info) {
   return info.units == "lux";
 }
 
-std::string TodayUtc() {
+// The current time in UTC, through strftime's `format`.
+std::string NowUtc(const char* format) {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
   gmtime_r(&now, &tm);
   char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%d", &tm);
-  return text;
-}
-std::string NowUtcIso() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  std::strftime(text, sizeof text, format, &tm);
   return text;
 }
 
@@ -140,7 +133,7 @@ std::vector<std::pair<std::string, std::string>> ResolveKeywords(const Keywords&
     std::string value = from_file.count(keyword) ? from_file[keyword] : "";
     const auto flag = k.flags.find(keyword);
     if (flag != k.flags.end() && !flag->second.empty()) value = flag->second;
-    if (keyword == std::string("ISSUEDATE") && value.empty()) value = TodayUtc();
+    if (keyword == std::string("ISSUEDATE") && value.empty()) value = NowUtc("%Y-%m-%d");
     if (!value.empty()) out.push_back({keyword, value});
   }
   out.insert(out.end(), extra.begin(), extra.end());
@@ -294,7 +287,7 @@ int RunRays(const RayCommand& c, int threads) {
   set.luminous_flux_lm = set.photometric ? drawn.total_flux : nan;
   set.radiant_flux_w = set.photometric ? nan : drawn.total_flux;
   set.creation_method = 1;  // measured
-  set.date_time = NowUtcIso();
+  set.date_time = NowUtc("%Y-%m-%dT%H:%M:%SZ");
   set.name = c.name;
   set.manufacturer = c.manufacturer;
   set.rayfile_creator = "lumislab-export tm25";

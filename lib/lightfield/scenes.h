@@ -33,10 +33,10 @@ Mesh MakeCloister();
 Mesh MakeReceiverPlane(double plane_z_mm, double extent_mm);
 // OBJ / glTF / PLY / ... through Assimp, in a child process (lib/lightfield/scene_file.cc): the
 // flattened triangles, albedo the material's diffuse colour times its diffuse texture at each
-// corner (lib/lightfield/scene_texture.h; a missing texture is a warning). BadInput naming the file when it is not a regular file, the importer
-// refuses it, crashes on it or runs past `timeout_s` (then it is killed), or the scene has no
-// triangles, a non-finite vertex, a face naming a missing vertex or more than
-// kMaxSceneTriangles triangles; Failure when StopRequested() ends the wait.
+// corner (lib/lightfield/scene_texture.h; a missing texture is a warning). BadInput naming the file
+// when it is not a regular file, the importer refuses it, crashes on it or runs past `timeout_s`
+// (then it is killed), or the scene has no triangles, a non-finite vertex, a face naming a missing
+// vertex or more than kMaxSceneTriangles triangles; Failure when StopRequested() ends the wait.
 constexpr size_t kMaxSceneTriangles = 10'000'000;
 constexpr double kSceneImportTimeoutS = 120;
 Mesh LoadSceneFile(const std::string& path, double timeout_s = kSceneImportTimeoutS);

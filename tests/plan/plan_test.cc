@@ -9,8 +9,8 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "../cli/test_util.h"
@@ -67,7 +67,7 @@ void CheckStudy(const std::string& scene_file, const std::string& csv, int* chec
   const char* dist[] = {"d", "2d", "4d"};
   // The plan models a noise-free capture at reconstruct's default regularisation: the study's
   // noise, brackets and lambda knobs (sensor noise, lambda up to 1) measure what it leaves out.
-  const std::set<std::string> modelled = {"spacing", "extent", "photo",
+  const std::set<std::string> modelled = {"spacing", "extent",     "photo",
                                           "k_max",   "resolution", "samples"};
   for (const auto& row : ReadCsv(csv)) {
     if (!modelled.count(row.at("knob"))) continue;

@@ -22,7 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 // A folder of this process: ctest runs each test of this file as its own process, in parallel.
 std::string Scratch(const std::string& name) {
   return ::testing::TempDir() + "/preview_reference_" + std::to_string(getpid()) + "_" + name;
@@ -120,9 +119,9 @@ Agreement Compare(const ImageF& a, const ImageF& b) {
 // surfaces and light them alike. Without shadows they evaluate the same sum, up to a few 0.1 %
 // from interpolating between the 64 texels (the preview E', the reference E and its factor at
 // the point), and apart from pixels whose centre falls on a silhouette (a column's edge before
-// a wall far behind) where the rasteriser and the ray caster pick different sides. With shadows the shadow maps (512^2,
-// normal offset) differ from one occlusion ray per position in penumbra pixels, as in
-// PreviewRenderer.MatchesCpuEvaluationWithShadows (10 % over all pixels there).
+// a wall far behind) where the rasteriser and the ray caster pick different sides. With shadows the
+// shadow maps (512^2, normal offset) differ from one occlusion ray per position in penumbra pixels,
+// as in PreviewRenderer.MatchesCpuEvaluationWithShadows (10 % over all pixels there).
 TEST(PreviewReference, RoomsAgreeWithOpenGl) {
   const std::string slab = TestSlab(), out = Scratch("");
   for (const std::string scene : {"crypt", "cloister"}) {

@@ -241,7 +241,6 @@ TEST_F(PreviewSlabFiles, UnitAlbedoIsTheIrradianceBeforeTheMaterials) {
   EXPECT_GT(*std::max_element(images[1].data.begin(), images[1].data.end()), 0);
 }
 
-
 TEST(PreviewCommandLine, SizeIsCheckedStrictly) {
   int w = 0, h = 0;
   EXPECT_TRUE(ParseSize("640x480", &w, &h));

@@ -110,9 +110,39 @@ uniform bool u_unit_albedo;  // irradiance view (false colour): E before the mat
 uniform bool u_srgbe;
 uniform usampler2D u_previous;
 uniform vec2 u_grid_half;  // half extent of the filter centres: the union of all spot cones
+uniform int u_texture_filter;  // TextureFilter: 0 bilinear (hardware), 1 nearest, 2 cubic
 layout(location = 0) out vec4 o_float;
 layout(location = 1) out uint o_packed;
 )") + kLightClip + kSrgbeCode + R"(
+// E'_ij at texture coordinate uv of layer `layer`, reconstructed from the texel centres as
+// --texture-filter says: bilinear through the hardware (the paper's), the nearest texel, or
+// Catmull-Rom (4 x 4 texels, interpolating, cubic in each axis). Edges are clamped as the
+// bilinear filter's CLAMP_TO_EDGE.
+vec3 TexelClamped(ivec2 t, ivec2 size, int layer) {
+  return texelFetch(u_intensity, ivec3(clamp(t, ivec2(0), size - 1), layer), 0).rgb;
+}
+vec4 CatmullRom(float f) {
+  float f2 = f * f, f3 = f2 * f;
+  return vec4(-0.5 * f3 + f2 - 0.5 * f, 1.5 * f3 - 2.5 * f2 + 1.0, -1.5 * f3 + 2.0 * f2 + 0.5 * f,
+              0.5 * f3 - 0.5 * f2);
+}
+vec3 SampleIntensity(vec2 uv, int layer) {
+  if (u_texture_filter == 0) return texture(u_intensity, vec3(uv, float(layer))).rgb;
+  ivec2 size = textureSize(u_intensity, 0).xy;
+  vec2 p = uv * vec2(size) - 0.5;  // texel-centre coordinates
+  if (u_texture_filter == 1) return TexelClamped(ivec2(floor(p + 0.5)), size, layer);
+  ivec2 base = ivec2(floor(p));
+  vec2 f = p - vec2(base);
+  vec4 wx = CatmullRom(f.x), wy = CatmullRom(f.y);
+  vec3 sum = vec3(0.0);
+  for (int b = 0; b < 4; ++b) {
+    vec3 row = vec3(0.0);
+    for (int a = 0; a < 4; ++a) row += wx[a] * TexelClamped(base + ivec2(a - 1, b - 1), size, layer);
+    sum += wy[b] * row;
+  }
+  return sum;
+}
+
 void main() {
   vec3 x = v_lum_position;
   vec3 n = normalize(v_lum_normal);
@@ -139,7 +169,7 @@ void main() {
       visible = texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_layers[k]),
                                        0.5 * ndc.z + 0.5));
     }
-    vec3 intensity = texture(u_intensity, vec3(uv, float(u_layers[k]))).rgb;
+    vec3 intensity = SampleIntensity(uv, u_layers[k]);
     sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
   }
   vec3 radiance = sum * (u_unit_albedo ? vec3(1.0) : v_albedo) * u_radiance_scale;
@@ -436,6 +466,7 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glUniform1i(Loc(p, "u_srgbe"), options_.srgbe);
   glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
   glUniform1i(Loc(p, "u_unit_albedo"), options_.unit_albedo ? 1 : 0);
+  glUniform1i(Loc(p, "u_texture_filter"), int(options_.texture_filter));
   const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);
   glUniform2f(Loc(p, "u_grid_half"), float(corner.x()), float(corner.y()));
   // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.

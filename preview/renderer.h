@@ -20,6 +20,11 @@
 
 namespace lumislab {
 
+// How E'_ij is read between its texel centres (docs/design.md §4.6's knob): the hardware's
+// bilinear filter (the paper's, the default), the nearest texel, or Catmull-Rom cubic
+// interpolation (16 texel reads instead of one filtered read).
+enum class TextureFilter { kBilinear = 0, kNearest = 1, kCubic = 2 };
+
 struct RenderOptions {
   bool shadows = true;
   bool srgbe = false;       // sRGBE-packed accumulation instead of float
@@ -30,6 +35,7 @@ struct RenderOptions {
   // Albedo 1 everywhere: with radiance_scale 1 the image is the irradiance E arriving at each
   // surface (W/m^2), which --view false-colour maps.
   bool unit_albedo = false;
+  TextureFilter texture_filter = TextureFilter::kBilinear;
 };
 
 constexpr int kLightsPerPass = 64;

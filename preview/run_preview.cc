@@ -36,6 +36,7 @@ struct CommandLineExtras {
   bool no_auto_exposure = false;
   std::string backend;  // empty: osmesa, or window with --window
   bool window = false;
+  std::string texture_filter = TextureFilterName(TextureFilter::kBilinear);
 };
 
 void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -90,6 +91,11 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
                "also render with the other accumulation format and report the difference");
   app.add_option("--shadow-size", config.shadow_size, "shadow-map size")->capture_default_str();
   app.add_flag("--shadow-pcf", config.shadow_pcf, "2x2 filtered shadow-map lookups");
+  app.add_option("--texture-filter", extras.texture_filter,
+                 "E' between its texel centres: bilinear (the hardware's, the paper's) | nearest "
+                 "| cubic (Catmull-Rom, 16 texel reads)")
+      ->check(CLI::IsMember({"bilinear", "nearest", "cubic"}))
+      ->capture_default_str();
 }
 
 void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -178,6 +184,8 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
                      std::to_string(config.shadow_size));
   }
   config.false_colour = extras.view == "false-colour";
+  for (TextureFilter f : {TextureFilter::kBilinear, TextureFilter::kNearest, TextureFilter::kCubic})
+    if (extras.texture_filter == TextureFilterName(f)) config.texture_filter = f;
   config.false_colour_scale.log = extras.false_colour_scale == "log";
   ParseFalseColourRange(extras.false_colour_range, "--false-colour-range",
                         &config.false_colour_scale);
@@ -189,7 +197,9 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
                                       {config.bench, "--bench"},
                                       {config.srgbe, "--srgbe"},
                                       {config.report_srgbe_error, "--srgbe-error"},
-                                      {config.shadow_pcf, "--shadow-pcf"}})
+                                      {config.shadow_pcf, "--shadow-pcf"},
+                                      {config.texture_filter != TextureFilter::kBilinear,
+                                       "--texture-filter (it reads the slab bilinearly)"}})
       if (set)
         throw BadInput(std::string(mode) + " renders on the CPU: " + option + " is not for it");
     if (config.out.empty()) throw BadInput(std::string(mode) + " needs --out <file.exr|.png>");
@@ -255,6 +265,18 @@ const char* BackendName(Backend backend) {
   return "?";
 }
 
+const char* TextureFilterName(TextureFilter filter) {
+  switch (filter) {
+    case TextureFilter::kBilinear:
+      return "bilinear";
+    case TextureFilter::kNearest:
+      return "nearest";
+    case TextureFilter::kCubic:
+      return "cubic";
+  }
+  return "?";
+}
+
 SceneSetup MakePreviewSetup(const PreviewConfig& config, const SlabInfo& info) {
   SceneSetup setup = MakeSceneSetup(config.scene, info);
   if (!config.camera.empty()) SetCameraValues(config.camera, setup);
@@ -280,6 +302,7 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.srgbe = config.srgbe;
   options.shadow_size = config.shadow_size;
   options.shadow_pcf = config.shadow_pcf;
+  options.texture_filter = config.texture_filter;
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;
   options.cull_back_faces = setup.closed_room;
@@ -400,6 +423,8 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   line << arg("--shadow-size") << arg(std::to_string(config.shadow_size));
   if (config.shadow_pcf) line << arg("--shadow-pcf");
   if (config.srgbe) line << arg("--srgbe");
+  if (config.texture_filter != TextureFilter::kBilinear)
+    line << arg("--texture-filter") << arg(TextureFilterName(config.texture_filter));
   line << arg("--out") << arg(out);
   return line.str();
 }

@@ -20,6 +20,8 @@ namespace lumislab {
 // (headless on a GPU; refused when EGL offers only a software renderer) or a GLFW window.
 enum class Backend { kOsmesa, kEgl, kWindow };
 const char* BackendName(Backend backend);
+// --texture-filter's names: bilinear, nearest, cubic.
+const char* TextureFilterName(TextureFilter filter);
 
 struct PreviewConfig {
   std::string slab_dir;
@@ -39,6 +41,7 @@ struct PreviewConfig {
   bool srgbe = false;
   int shadow_size = 512;
   bool shadow_pcf = false;
+  TextureFilter texture_filter = TextureFilter::kBilinear;  // --texture-filter
   bool watch = false;
   double poll_s = 0.5;
   Backend backend = Backend::kOsmesa;  // --backend; --window is --backend window

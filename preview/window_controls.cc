@@ -77,6 +77,12 @@ void ShadowsPanel(WindowState& s) {
   ImGui::SameLine();
   s.options_changed |= ImGui::RadioButton("sRGBE", &format, 1);
   c.srgbe = format == 1;
+  const char* filters[] = {"bilinear", "nearest", "cubic"};
+  int filter = int(c.texture_filter);
+  if (ImGui::Combo("texture filter", &filter, filters, 3)) {
+    c.texture_filter = TextureFilter(filter);
+    s.options_changed = true;
+  }
 }
 
 void LuminairePanel(WindowState& s) {

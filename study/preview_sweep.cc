@@ -174,6 +174,8 @@ void RunPreviewSweep(const PreviewSweepOptions& o, std::vector<PreviewRow>* rows
       points.push_back({scene, "shadows", "off", {"--no-shadows"}, false});
     }
     points.push_back({scene, "srgbe", "on", {"--srgbe"}, false});
+    for (const char* filter : {"nearest", "cubic"})
+      points.push_back({scene, "texture_filter", filter, {"--texture-filter", filter}, false});
 
     for (const PreviewPoint& p : points) {
       const bool done = std::any_of(rows->begin(), rows->end(), [&](const PreviewRow& r) {

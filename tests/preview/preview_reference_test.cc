@@ -82,6 +82,38 @@ TEST(PreviewReference, PlaneAgreesWithOpenGlAndTheAnalyticImage) {
   EXPECT_LT(ref_vs_analytic, 2e-3);
 }
 
+// --texture-filter (the knob of docs/design.md §4.6): E' between texel centres read bilinearly
+// (the default, the same image as without the flag), from the nearest texel, or Catmull-Rom. On
+// the plane at D = d the image is sum_ij E_ij(x) read straight from the textures, so against the
+// analytic image only the reconstruction between texels differs. A coarse slab (32 texels over
+// the 1.2 m window, 37.5 mm texels) and 128 x 128 pixels make that error visible.
+TEST(PreviewReference, TextureFilterIsAKnobMeasuredAgainstTheAnalyticImage) {
+  const std::string slab = Scratch("coarse_slab"), out = Scratch("");
+  fs::remove_all(slab);
+  WriteTruthSlab(DefaultScene().luminaire, DefaultSlabInfo(9, 7, 5, 32), slab, 2);
+  auto run = [&](std::vector<std::string> extra, const std::string& name) {
+    std::vector<std::string> args = {"--slab", slab,      "--scene", "plane",
+                                     "--size", "128x128", "--out",   out + name};
+    args.insert(args.end(), extra.begin(), extra.end());
+    EXPECT_EQ(RunPreviewWith(args), 0) << name;
+    return ReadExr(out + name, {"R", "G", "B"});
+  };
+  const ImageF analytic = run({"--analytic", "default"}, "tf_analytic.exr");
+  const ImageF plain = run({}, "tf_plain.exr");
+  const ImageF bilinear = run({"--texture-filter", "bilinear"}, "tf_bilinear.exr");
+  const ImageF nearest = run({"--texture-filter", "nearest"}, "tf_nearest.exr");
+  const ImageF cubic = run({"--texture-filter", "cubic"}, "tf_cubic.exr");
+  EXPECT_EQ(plain.data, bilinear.data);
+  const double e_bilinear = RelativeL2(bilinear, analytic, 280);
+  const double e_nearest = RelativeL2(nearest, analytic, 280);
+  const double e_cubic = RelativeL2(cubic, analytic, 280);
+  std::printf("plane at d, 32 texels, vs analytic: bilinear %.4g, nearest %.4g, cubic %.4g\n",
+              e_bilinear, e_nearest, e_cubic);
+  for (double e : {e_bilinear, e_nearest, e_cubic}) EXPECT_TRUE(std::isfinite(e));
+  EXPECT_GT(e_nearest, e_bilinear);
+  EXPECT_LT(e_cubic, e_bilinear);
+}
+
 // a against b: relative L2 over every pixel, relative L2 over the pixels whose largest channel
 // differs by at most 1 % of b's brightest pixel, and the share of the others.
 struct Agreement {
@@ -163,6 +195,8 @@ TEST(PreviewReference, BadOptionsAreRefusedNamingThem) {
       {{"--samples", "3"}, "--samples"},
       {{"--reference", "--watch"}, "--watch"},
       {{"--reference", "--srgbe"}, "--srgbe"},
+      {{"--reference", "--texture-filter", "cubic"}, "--texture-filter"},
+      {{"--texture-filter", "bicubic"}, "--texture-filter"},
       {{"--analytic", "default", "--window"}, "--window"},
       {{"--analytic", "default", "--reference"}, "--analytic"},
       {{"--analytic", slab + "/missing.json"}, "missing.json"},

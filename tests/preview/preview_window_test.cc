@@ -143,6 +143,7 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   config.shadow_size = 1024;
   config.shadow_pcf = true;
   config.srgbe = true;
+  config.texture_filter = TextureFilter::kCubic;
   const std::string line = HeadlessCommandLine(config, "out.png");
   // Split like a shell: words, or '...' as one.
   std::vector<std::string> words;
@@ -172,6 +173,7 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   EXPECT_EQ(back.shadow_size, 1024);
   EXPECT_TRUE(back.shadow_pcf);
   EXPECT_TRUE(back.srgbe);
+  EXPECT_EQ(back.texture_filter, TextureFilter::kCubic);
   EXPECT_EQ(back.out, "out.png");
   EXPECT_EQ(back.backend, Backend::kOsmesa);
 }

@@ -169,9 +169,9 @@ TEST(Study, NoiseBracketsLambdaAndThePreviewsKnobs) {
   EXPECT_EQ(b2.lambda, -1);     // reconstruct's default
 
   // The preview's knobs: crypt N = 1, 2, OpenGL base, shadows 256 and 1024, PCF, no shadows,
-  // sRGBE; plane at 2d N = 1, 2, OpenGL, sRGBE.
+  // sRGBE, texture filter nearest and cubic; plane at 2d N = 1, 2, OpenGL, sRGBE, nearest, cubic.
   const std::vector<PreviewRow> preview = ReadPreviewCsv(out + "/preview.csv");
-  ASSERT_EQ(preview.size(), 12u);
+  ASSERT_EQ(preview.size(), 16u);
   std::map<std::string, PreviewRow> by;
   for (const PreviewRow& p : preview) {
     EXPECT_TRUE(std::isfinite(p.rel_l2) && std::isfinite(p.p95)) << p.knob;
@@ -187,6 +187,12 @@ TEST(Study, NoiseBracketsLambdaAndThePreviewsKnobs) {
   // inequality the error against the reference moves by at most that.
   EXPECT_LE(std::abs(by["crypt/srgbe/on"].rel_l2 - gl.rel_l2),
             std::sqrt(3.0) / 127.5 * (1 + gl.rel_l2));
+  // The reference reads the 32-texel slab bilinearly as the OpenGL base does: on the plane the
+  // nearest texel is further from it (measured against the analytic image on the plane at d:
+  // PreviewReference.TextureFilterIsAKnobMeasuredAgainstTheAnalyticImage).
+  EXPECT_GT(by["plane2d/texture_filter/nearest"].rel_l2,
+            by["plane2d/opengl/base (shadows 512; float)"].rel_l2);
+  EXPECT_GT(by["crypt/texture_filter/cubic"].frame_ms, 0);
   // The reference at N = 1 and 2 against N = 4: near, not ordered (at 48 x 36 px and 25 positions
   // N = 2 came out 0.96 %, N = 1 0.78 %; on the default scene 0.87 % and 1.2 %).
   for (const char* n : {"crypt/ref_samples/1", "crypt/ref_samples/2"}) {

@@ -140,4 +140,14 @@ double DualFilter::Peak2D() const {
   return p * p;
 }
 
+double DualFilter::SumAbs() const {
+  double sum = std::abs(coefficients_[0]);
+  for (size_t k = 1; k < coefficients_.size(); ++k) sum += 2 * std::abs(coefficients_[k]);
+  return sum;
+}
+
+double ParallaxFirstOrderBound(double z_mm, double d_mm, double D_mm, const DualFilter& filter) {
+  return 2 * z_mm / (d_mm + z_mm) * std::abs(1 - d_mm / D_mm) * filter.SumAbs();
+}
+
 }  // namespace lumislab

@@ -44,13 +44,7 @@ constexpr double kCalibratedHMax = 10;
 const double kSpacings[] = {0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7.5, 10, 12.5, 15, 20, 25, 30, 40, 50};
 const int kResolutions[] = {16, 24, 32, 48, 64, 96, 128, 150, 192, 256, 384, 512, 768, 1000};
 
-double SumAbsDual(int k_max) {
-  const DualFilter filter = DualFilter::Truncated(k_max);
-  const std::vector<double>& c = filter.coefficients();
-  double sum = std::abs(c[0]);
-  for (size_t k = 1; k < c.size(); ++k) sum += 2 * std::abs(c[k]);
-  return sum;
-}
+double SumAbsDual(int k_max) { return DualFilter::Truncated(k_max).SumAbs(); }
 
 // Largest |u| where a ray from the light to |x| <= X on the plane z = D crosses S:
 // u = e D / (D + z) + x z / (D + z), per point and axis.
@@ -180,8 +174,8 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
   // §8.2): no prediction holds, whatever the grid.
   double z_max = 0;
   for (const LightPoint& l : in.light) z_max = std::max(z_max, l.z);
-  const double first_order = 2 * z_max / (in.distance_mm + z_max) *
-                             std::abs(1 - in.distance_mm / in.D()) * SumAbsDual(s.k_max);
+  const double first_order =
+      ParallaxFirstOrderBound(z_max, in.distance_mm, in.D(), DualFilter::Truncated(s.k_max));
   if (first_order >= 1) {
     p.reachable = false;
     char buf[240];

@@ -16,6 +16,7 @@
 #include "core/log.h"
 #include "core/stop_signal.h"
 #include "lib/lightfield/light_field.h"
+#include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
 #include "preview/headless.h"
 #include "preview/reference_mode.h"
@@ -59,6 +60,9 @@ void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ex
                  "plane mode: D in mm (default: the slab's d)");
   app.add_option("--extent", config.scene.extent_mm,
                  "plane mode: side W in mm (default: window D/d)");
+  app.add_option("--luminaire-depth-mm", config.luminaire_depth_mm,
+                 "plane mode: how far behind S the deepest light sits, to check a receiver plane "
+                 "near S (default: a synthetic dataset's truth/luminaire.json beside the slab)");
 }
 
 void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -215,6 +219,10 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
       throw InputError(option, "", "0 (default) or a length in [1, 1e5] mm", std::to_string(v));
   };
   length("--receiver-plane", config.scene.receiver_plane_mm);
+  if (config.luminaire_depth_mm != -1 &&
+      !(config.luminaire_depth_mm >= 0 && config.luminaire_depth_mm <= kMaxDistanceMm))
+    throw InputError("--luminaire-depth-mm", "", "a depth in [0, 1e5] mm",
+                     std::to_string(config.luminaire_depth_mm));
   length("--extent", config.scene.extent_mm);
   for (size_t k = 0; k < config.scene.pose.size(); ++k) {
     const double v = config.scene.pose[k];
@@ -247,6 +255,7 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     LogInfo("stopped before ", config.slab_dir, "/slab.json appeared");
     return 0;
   }
+  CheckReceiverPlane(config, *info);
   if (config.reference || !config.analytic.empty()) return RunReferenceMode(config, *info);
   return config.backend == Backend::kWindow ? RunWindow(config, *info) : RunHeadless(config, *info);
 }
@@ -263,6 +272,40 @@ const char* BackendName(Backend backend) {
       return "window";
   }
   return "?";
+}
+
+double CheckReceiverPlane(const PreviewConfig& config, const SlabInfo& info) {
+  const double d = info.distance_mm;
+  const double D = config.scene.receiver_plane_mm;
+  if (config.scene.name != "plane" || D == 0 || D >= d) return -1;
+  double z = config.luminaire_depth_mm;
+  std::string source = "--luminaire-depth-mm";
+  std::filesystem::path slab = std::filesystem::absolute(config.slab_dir).lexically_normal();
+  if (slab.filename().empty()) slab = slab.parent_path();  // "dataset/slab/"
+  const std::filesystem::path truth = slab.parent_path() / "truth" / "luminaire.json";
+  if (z < 0 && std::filesystem::exists(truth)) {
+    z = 0;
+    for (const Emitter& e : LoadLuminaire(truth.string()).emitters)
+      z = std::max(z, -e.position_mm.z());
+    source = truth.string();
+  }
+  if (z < 0) {
+    LogInfo("the receiver plane at D = ", D, " mm is nearer S than d = ", d,
+            " mm: the error there grows with the luminaire's depth behind S (z |1 - d/D|); give "
+            "--luminaire-depth-mm to have it checked");
+    return -1;
+  }
+  const double bound = ParallaxFirstOrderBound(z, d, D, info.filter.Filter());
+  if (bound >= 1)
+    LogWarning("the receiver plane at D = ", D,
+               " mm is too close to S for the method: the "
+               "first-order parallax bound 2 a sum|c_m| is ",
+               bound, " (>= 1) for light ", z, " mm behind S (", source,
+               "), so no error bound holds for this image");
+  else
+    LogInfo("receiver plane at D = ", D, " mm, light up to ", z, " mm behind S (", source,
+            "): first-order parallax bound ", bound);
+  return bound;
 }
 
 const char* TextureFilterName(TextureFilter filter) {
@@ -405,6 +448,8 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   if (!config.scene.pose.empty()) line << arg("--luminaire-pose") << arg(values(config.scene.pose));
   if (config.scene.receiver_plane_mm != 0)
     line << arg("--receiver-plane") << arg(values({config.scene.receiver_plane_mm}));
+  if (config.luminaire_depth_mm >= 0)
+    line << arg("--luminaire-depth-mm") << arg(values({config.luminaire_depth_mm}));
   if (config.scene.extent_mm != 0) line << arg("--extent") << arg(values({config.scene.extent_mm}));
   if (!config.camera.empty()) line << arg("--camera") << arg(values(config.camera));
   line << arg("--size") << arg(std::to_string(config.width) + "x" + std::to_string(config.height));

@@ -26,6 +26,10 @@ const char* TextureFilterName(TextureFilter filter);
 struct PreviewConfig {
   std::string slab_dir;
   SceneRequest scene;  // name, pose, receiver plane D and extent
+  // --luminaire-depth-mm: how far behind S the deepest light sits, to check a receiver plane
+  // near S (CheckReceiverPlane); < 0: a synthetic dataset's truth/luminaire.json beside the slab,
+  // else unknown.
+  double luminaire_depth_mm = -1;
   int width = 400, height = 400;
   std::string out;   // headless output (.exr linear, .png tone-mapped)
   ToneMapping tone;  // PNG / window: exposure stops, automatic exposure, tone curve
@@ -57,6 +61,13 @@ struct PreviewConfig {
   int samples = 4;
   std::string analytic;  // default | dataset folder | scene or truth/luminaire.json file
 };
+
+// Plane mode with D < d: the parallax error of the method grows as z |1 - d/D| for light z mm
+// behind S (docs/design.md §4.5). With z known (the flag, or truth/luminaire.json of the
+// dataset holding the slab) it logs the first-order bound, and warns that no bound holds once
+// it reaches 1; without z it says that the error there depends on it. Returns the bound (-1:
+// not computed).
+double CheckReceiverPlane(const PreviewConfig& config, const SlabInfo& info);
 
 // The whole tool: command line, then the window or the headless run.
 int RunPreview(int argc, char** argv);

@@ -780,7 +780,8 @@ TEST(HardCases, RandomisedSweep) {
 //    order adds (2 a sum|c_m|)^2 / 2 at most (the next Taylor term of the same expansion), so
 //    the bound is B = 2 a S + (2 a S)^2 / 2, 42 % at 0.2 d. At 0.05 d, a = 0.49 and 2 a S = 1.7:
 //    the expansion does not converge, no bound holds, and lumislab-plan refuses the distance
-//    (exit 0 with its warning; the preview and the reference do not check D).
+//    (exit 0 with its warning); the preview and the reference warn the same way given the
+//    light's depth (--luminaire-depth-mm, or the dataset's truth/luminaire.json).
 //  * OpenGL against the reference at N = 1: both sum one sample per position at c_ij (eq. 14);
 //    they differ by E' = E / g interpolated bilinearly and multiplied by g at the sample
 //    (shift-invariant model, §3.4) against E interpolated: g = d^2 cos^4 over M varies by at
@@ -804,11 +805,13 @@ TEST(HardCases, ReceiverPlaneNearTheSamplingPlane) {
                   "--slab %s --write-test-slab --scene plane --receiver-plane %.9g --extent %.9g "
                   "--size 48x48 --threads 2",
                   slab.c_str(), D, plane.extent_mm);
+    std::string log;  // the last render's output
     const auto render = [&](const std::string& name, const std::string& args) {
       const std::string out = dir + "/" + name + ".exr";
       const auto r =
           RunTool("lumislab-preview", std::string(common) + " " + args + " --out " + out);
       EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.output;
+      log = r.output;
       const ImageF image = ReadExr(out, {"R", "G", "B"});
       double flux = 0;
       for (float v : image.data) {
@@ -822,7 +825,10 @@ TEST(HardCases, ReceiverPlaneNearTheSamplingPlane) {
     const ImageF analytic = render(tag + "_analytic", "--analytic default");
     const ImageF reference = render(tag + "_ref8", "--reference --samples 8");
     const ImageF reference1 = render(tag + "_ref1", "--reference --samples 1");
-    const ImageF opengl = render(tag + "_gl", "");
+    // The preview checks the plane against the light's depth (given: --write-test-slab's slab
+    // has no truth/ beside it) and warns where no bound holds, as lumislab-plan does.
+    const ImageF opengl = render(tag + "_gl", "--luminaire-depth-mm 20");
+    EXPECT_EQ(log.find("too close to S") != std::string::npos, plane.fraction < 0.1) << log;
     const double a = z / (d + z) * std::abs(1 - d / D), first = 2 * a * sum_c;
     const double ref_error = CompareImages(reference, analytic).relative_l2;
     const double ref1_error = CompareImages(reference1, analytic).relative_l2;
@@ -837,7 +843,7 @@ TEST(HardCases, ReceiverPlaneNearTheSamplingPlane) {
     }
   }
   // At 0.05 d the first-order parallax 2 a sum|c_m| exceeds 1: lumislab-plan says the distance
-  // is outside what the method can do.
+  // is outside what the method can do, as the preview did above.
   const auto plan = RunTool("lumislab-plan", "--scene default --receiver-mm 37.5 --target 5%");
   EXPECT_EQ(plan.exit_code, 0) << plan.output;
   EXPECT_NE(plan.output.find("too close to S"), std::string::npos) << plan.output;

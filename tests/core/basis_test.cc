@@ -113,6 +113,18 @@ TEST(DualTest, PeakIsTheMaximumMagnitude) {
   EXPECT_LT(min, -0.05);
 }
 
+// sum|c_m| and the parallax bound 2 z/(d + z) |1 - d/D| sum|c_m| built on it (design §4.5).
+TEST(DualTest, SumOfMagnitudesAndTheParallaxBound) {
+  const DualFilter f = DualFilter::FromCoefficients({1.5, -0.25});
+  EXPECT_DOUBLE_EQ(f.SumAbs(), 2.0);  // c_0 once, c_1 for +1 and -1
+  const DualFilter k1 = DualFilter::Truncated(1);
+  EXPECT_NEAR(k1.SumAbs(), 67.0 / 39.0, 1e-12);
+  // z = 20 mm behind S, d = 750: at D = 0.05 d, a = 20/770 * 19 and 2 a S = 1.70 (> 1).
+  EXPECT_NEAR(ParallaxFirstOrderBound(20, 750, 37.5, k1), 2 * 20.0 / 770 * 19 * 67 / 39, 1e-12);
+  EXPECT_DOUBLE_EQ(ParallaxFirstOrderBound(20, 750, 750, k1), 0.0);  // D = d: no parallax
+  EXPECT_DOUBLE_EQ(ParallaxFirstOrderBound(0, 750, 37.5, k1), 0.0);  // light on S
+}
+
 TEST(DualTest, FromCoefficientsRoundTrips) {
   const DualFilter f = DualFilter::Truncated(2);
   const DualFilter g = DualFilter::FromCoefficients(f.coefficients());

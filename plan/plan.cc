@@ -146,6 +146,22 @@ PlanInput PlanInputFromScene(const SynthScene& scene) {
     wz += weight * z;
     w += weight;
   }
+  // A ray source (TM-25 file): the box of its rays' origins at their deepest, and its flux at
+  // their flux-weighted depth.
+  for (const RaySource& r : scene.luminaire.ray_sources) {
+    LightPoint box;
+    double flux_z = 0;
+    for (const SourceRay& ray : *r.rays) {
+      box.ax = std::max(box.ax, std::abs(ray.origin_mm.x()));
+      box.ay = std::max(box.ay, std::abs(ray.origin_mm.y()));
+      box.z = std::max(box.z, -ray.origin_mm.z());
+      flux_z += ray.flux * -ray.origin_mm.z();
+    }
+    in.light.push_back(box);
+    const double weight = r.flux * r.rgb.sum() / 3;
+    wz += weight * flux_z / r.flux;
+    w += weight;
+  }
   in.depth_mm = w > 0 ? wz / w : in.light.front().z;
   return in;
 }

@@ -72,7 +72,13 @@ RaySource ParseRaySource(const JsonView& e, const Eigen::Vector3d& position_mm,
     if (v.Size() != 3) v.Fail("[R, G, B] in W per unit of ray flux");
   }
   const double cell = r.Has("cell_mm") ? r["cell_mm"].NumberIn(1e-3, 1e5) : default_cell_mm;
-  return RaySource::Load(file.string(), position_mm, rotation, rgb, cell);
+  try {
+    return RaySource::Load(file.string(), position_mm, rotation, rgb, cell);
+  } catch (const Error& e) {
+    // The reader names the ray file and its field; the scene file and its field lead.
+    if (e.exit_code() != int(ExitCode::kBadInput)) throw;
+    throw BadInput(r.file() + ": " + r["file"].path() + ": " + e.what());
+  }
 }
 
 // The "luminaire" block of a scene file (also the whole of truth/luminaire.json). A ray source

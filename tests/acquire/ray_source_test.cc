@@ -253,9 +253,20 @@ TEST(RaySource, BadInputNamesTheFileAndField) {
     const std::string message = error_of(emitter);
     EXPECT_NE(message.find(part), std::string::npos) << message;
   };
-  expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "none.ray"}})", "none.ray");
+  const std::string scene = dir + "/scene.json: luminaire.emitters[1].rays.file: ";
+  expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "none.ray"}})",
+         scene + dir + "/none.ray: ");
   WriteTextAtomically(dir + "/broken.ray", "TM25 but nothing else");
-  expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "broken.ray"}})", "broken.ray");
+  expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "broken.ray"}})",
+         scene + dir + "/broken.ray: ");
+  // A file cut short names the section it lacks.
+  Tm25RaySet few;
+  ray_samples::AddLambertianDisc(0, 0, -2, 3, 1e3, 10, 1, &few);
+  WriteTm25(few, dir + "/cut.ray");
+  std::string bytes = acquire_test::FileBytes(dir + "/cut.ray");
+  WriteTextAtomically(dir + "/cut.ray", bytes.substr(0, bytes.size() - 6));
+  expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "cut.ray"}})",
+         scene + dir + "/cut.ray: number of rays (4.7.1.6): the header says 10 rays");
   // Rays only away from S, or all in front of it.
   Tm25RaySet set;
   ray_samples::AddLambertianDisc(0, 0, -2, 3, 1e3, 100, 1, &set);
@@ -265,7 +276,6 @@ TEST(RaySource, BadInputNamesTheFileAndField) {
          "away.ray: rays: expected rays that cross the filter plane S from behind");
   expect(R"({"position_mm": [0, 0, 5], "rays": {"file": "away.ray", "rotation_deg": [180, 0, 0]}})",
          "got none of 100");
-  const std::string em = "small.json: luminaire.emitters[1]";
   expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "away.ray", "colour": 1}})",
          "luminaire.emitters[1].rays.colour: expected file, rotation_deg, rgb or cell_mm");
   expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "away.ray", "cell_mm": 0}})",
@@ -277,7 +287,6 @@ TEST(RaySource, BadInputNamesTheFileAndField) {
          "luminaire.emitters[1].intensity_w_sr: expected no intensity_w_sr with rays");
   expect(R"({"position_mm": [0, 0, 0], "lobe_exponent": 1, "rays": {"file": "a.ray"}})",
          "luminaire.emitters[1]: expected exactly one of lobe_exponent, distribution");
-  (void)em;
 }
 
 // truth/luminaire.json copies the ray file beside it and reads back the same source; what knows

@@ -11,10 +11,11 @@
 
 #include "../acquire/ray_samples.h"
 #include "../cli/test_util.h"
-#include "lib/photometry/tm25.h"
-#include "lib/synthetic/scene.h"
+#include "core/atomic_file.h"
 #include "core/slab.h"
 #include "lib/lightfield/far_field.h"
+#include "lib/photometry/tm25.h"
+#include "lib/synthetic/scene.h"
 #include "plan/plan.h"
 
 namespace lumislab {
@@ -78,9 +79,21 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
   "camera": {"size_px": [400, 300], "focal_px": 325, "position_mm": [0, -400, 2400],
              "look_at_mm": [0, 0, 750], "radiometric_scale_w_m2": 1.6} })");
   const std::string ds = ShellQuote(dir + "/ds");
+  // Bad input first: a missing ray file is exit 2 naming the scene's field and the file, and
+  // nothing is written.
+  std::string missing = ReadTextFile(dir + "/scene.json");
+  missing.replace(missing.find("disc.ray"), 8, "none.ray");
+  testing::WriteFile(dir + "/missing.json", missing);
+  auto r = RunTool("lumislab-acquire",
+                   "synth --scene " + ShellQuote(dir + "/missing.json") + " --out " + ds);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("missing.json: luminaire.emitters[0].rays.file: " + dir + "/none.ray"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/ds"));
   const auto start = std::chrono::steady_clock::now();
-  auto r = RunTool("lumislab-acquire", "synth --scene " + ShellQuote(dir + "/scene.json") +
-                                           " --out " + ds + " --truth-resolution 16");
+  r = RunTool("lumislab-acquire", "synth --scene " + ShellQuote(dir + "/scene.json") + " --out " +
+                                      ds + " --truth-resolution 16");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(dir + "/ds/truth/emitter_0.ray"));
   r = RunTool("lumislab-calibrate", "screen --dataset " + ds);

@@ -65,5 +65,7 @@ class RaySplat {
 
 // Default splat cell of a scene: the larger screen side / 200 (6 mm on the 1.2 m screen).
 constexpr double kRayCellsPerScreen = 200;
+// Finest splat cell a scene may ask for: the larger screen side / 4096.
+constexpr double kMaxRayCellsPerScreen = 4096;
 
 }  // namespace lumislab

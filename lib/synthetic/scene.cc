@@ -72,12 +72,18 @@ RaySource ParseRaySource(const JsonView& e, const Eigen::Vector3d& position_mm,
     if (v.Size() != 3) v.Fail("[R, G, B] in W per unit of ray flux");
   }
   const double cell = r.Has("cell_mm") ? r["cell_mm"].NumberIn(1e-3, 1e5) : default_cell_mm;
+  // At most kMaxRayCellsPerScreen cells along the screen (a map per position is that squared).
+  const double screen = default_cell_mm * kRayCellsPerScreen;
+  if (screen > 0 && cell < screen / kMaxRayCellsPerScreen)
+    r["cell_mm"].Fail("at least the larger screen side / " +
+                      std::to_string(int(kMaxRayCellsPerScreen)) + " (" +
+                      std::to_string(screen / kMaxRayCellsPerScreen) + " mm)");
   try {
     return RaySource::Load(file.string(), position_mm, rotation, rgb, cell);
-  } catch (const Error& e) {
+  } catch (const Error& error) {
     // The reader names the ray file and its field; the scene file and its field lead.
-    if (e.exit_code() != int(ExitCode::kBadInput)) throw;
-    throw BadInput(r.file() + ": " + r["file"].path() + ": " + e.what());
+    if (error.exit_code() != int(ExitCode::kBadInput)) throw;
+    throw BadInput(r.file() + ": " + r["file"].path() + ": " + error.what());
   }
 }
 

@@ -289,6 +289,8 @@ TEST(RaySource, BadInputNamesTheFileAndField) {
          "luminaire.emitters[1].rays.colour: expected file, rotation_deg, rgb or cell_mm");
   expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "away.ray", "cell_mm": 0}})",
          "luminaire.emitters[1].rays.cell_mm");
+  expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "away.ray", "cell_mm": 0.1}})",
+         "luminaire.emitters[1].rays.cell_mm: expected at least the larger screen side / 4096");
   expect(R"({"position_mm": [0, 0, 0], "rays": {"file": "away.ray", "rgb": [1, -1, 1]}})",
          "luminaire.emitters[1].rays.rgb[1]");
   expect(R"({"position_mm": [0, 0, 0], "rays": {"file": 3}})", "luminaire.emitters[1].rays.file");

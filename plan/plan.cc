@@ -12,6 +12,7 @@
 #include "core/basis.h"
 #include "core/command_line.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/log.h"
 #include "lib/synthetic/scene.h"
 
@@ -146,8 +147,9 @@ PlanInput PlanInputFromScene(const SynthScene& scene) {
     wz += weight * z;
     w += weight;
   }
-  // A ray source (TM-25 file): the box of its rays' origins at their deepest, and its flux at
-  // their flux-weighted depth.
+  // A ray source (TM-25 file): the box of its rays' origins at their deepest, and its weight at
+  // their flux-weighted depth; the weight flux / pi, a Lambertian source's axial intensity, to
+  // compare with the point emitters' I0.
   for (const RaySource& r : scene.luminaire.ray_sources) {
     LightPoint box;
     double flux_z = 0;
@@ -158,7 +160,7 @@ PlanInput PlanInputFromScene(const SynthScene& scene) {
       flux_z += ray.flux * -ray.origin_mm.z();
     }
     in.light.push_back(box);
-    const double weight = r.flux * r.rgb.sum() / 3;
+    const double weight = r.flux * r.rgb.sum() / 3 / kPi;
     wz += weight * flux_z / r.flux;
     w += weight;
   }

@@ -160,10 +160,14 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
         "  plane at %.0f mm (%.0f x %.0f mm, 12 x 12 bins): relative L2 %.4f, flux out / in "
         "%.5f; predicted: plan %.4f, rays' Monte-Carlo %.4f, together %.4f\n",
         plan_in.receiver_mm, w, h, c.rel_l2, c.flux_ratio, plan.at_D.total, c.mc, bound);
+    // The margin: the exported rays keep the light field's positive part only (SampleSlabRays,
+    // docs/design.md §5.17; 18 % of this slab's flux left out), a centre-to-edge pattern of a few
+    // per cent on these bins that the accuracy model does not include (measured 1.12 x and
+    // 1.03 x the prediction at d and 4d).
     EXPECT_LT(c.rel_l2, 1.5 * bound);
     EXPECT_NEAR(c.flux_ratio, 1, 1.5 * bound);
   }
-  if (!::testing::Test::HasFailure() && !std::getenv("KEEP")) std::filesystem::remove_all(dir);
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
 }
 
 }  // namespace

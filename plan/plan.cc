@@ -12,6 +12,7 @@
 #include "core/basis.h"
 #include "core/command_line.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/log.h"
 #include "lib/synthetic/scene.h"
 
@@ -138,6 +139,23 @@ PlanInput PlanInputFromScene(const SynthScene& scene) {
     in.light.push_back({std::abs(e.position_mm.x()), std::abs(e.position_mm.y()), z});
     const double weight = e.intensity_w_sr.sum() / 3;
     wz += weight * z;
+    w += weight;
+  }
+  // A ray source (TM-25 file): the box of its rays' origins at their deepest, and its weight at
+  // their flux-weighted depth; the weight flux / pi, a Lambertian source's axial intensity, to
+  // compare with the point emitters' I0.
+  for (const RaySource& r : scene.luminaire.ray_sources) {
+    LightPoint box;
+    double flux_z = 0;
+    for (const SourceRay& ray : *r.rays) {
+      box.ax = std::max(box.ax, std::abs(ray.origin_mm.x()));
+      box.ay = std::max(box.ay, std::abs(ray.origin_mm.y()));
+      box.z = std::max(box.z, -ray.origin_mm.z());
+      flux_z += ray.flux * -ray.origin_mm.z();
+    }
+    in.light.push_back(box);
+    const double weight = r.flux * r.rgb.sum() / 3 / kPi;
+    wz += weight * flux_z / r.flux;
     w += weight;
   }
   in.depth_mm = w > 0 ? wz / w : in.light.front().z;

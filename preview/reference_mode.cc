@@ -33,6 +33,7 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
   // Inputs first: a bad luminaire or slab is refused before the scene is built.
   const bool analytic = !config.analytic.empty();
   const Luminaire luminaire = analytic ? LoadLuminaire(config.analytic) : Luminaire{};
+  RequirePointEmitters(luminaire, config.analytic, "--analytic");
   const std::vector<ImageF> irradiance =
       analytic ? std::vector<ImageF>{} : ReadSlabIrradiance(config.slab_dir, info, config.threads);
   const ReferenceScene view(setup, config.width, config.height);

@@ -364,6 +364,8 @@ int RunStudy(int argc, char** argv) {
 
   // Inputs first: the scene (exit 2 naming the file), the knobs, then --out.
   const SynthScene scene = LoadScene(o.scene);
+  // The study measures against the analytic image of point emitters.
+  RequirePointEmitters(scene.luminaire, scene.source, "the study's analytic receiver planes");
   const nlohmann::json base_scene =
       nlohmann::json::parse(o.scene == "default" ? DefaultSceneJson() : ReadTextFile(o.scene));
   std::vector<std::string> knobs;

@@ -94,10 +94,12 @@ ImageF ResponseSceneRender(const SynthScene& scene, double exposure) {
   // The luminaire at the centre grid position without a slide: the screen's unfiltered
   // irradiance, luminaire frame (lab + c).
   const Eigen::Vector2d c = scene.grid.Centre(scene.grid.nu / 2, scene.grid.nv / 2);
+  const Eigen::Vector2d half(0.5 * scene.screen_w_mm, 0.5 * scene.screen_h_mm);
+  const PlaneLight light = PlaneLight::Open(scene.luminaire, scene.distance_mm, c - half, c + half);
   double peak = 0;
   for (size_t k = 0; k < view.pixels.size(); ++k) {
     const Eigen::Vector2d st = view.lab_mm[k] + c;
-    const Eigen::Vector3d e = scene.luminaire.PlaneIrradiance(st.x(), st.y(), scene.distance_mm);
+    const Eigen::Vector3d e = light.Irradiance(st.x(), st.y());
     for (int ch = 0; ch < 3; ++ch) photo.data[size_t(view.pixels[k]) * 3 + ch] = float(e[ch]);
     peak = std::max(peak, e.maxCoeff());
   }
@@ -141,8 +143,7 @@ void ReferenceIrradiance(const SynthScene& scene, double radiometric_scale, Eige
   const Eigen::Vector2d c = scene.grid.Centre(ref.reference_i, ref.reference_j) +
                             scene.StageOffsetMm(ref.reference_i, ref.reference_j);
   const Eigen::Vector2d st = ref.point_mm + c;
-  scene.luminaire.SlideIrradiance(filter, filter.Peak2D(), scene.grid.spacing_mm, c,
-                                  scene.distance_mm, st.x(), st.y(), plus, minus);
+  ScreenLight(scene, filter, c).Slides(st.x(), st.y(), plus, minus);
   // Ambient light is on the screen whichever slide is in: level x scale W/m^2 (at exposure 1 the
   // effect adds `level` to the normalised value).
   double ambient = 0;

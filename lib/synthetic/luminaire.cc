@@ -113,3 +113,112 @@ void Luminaire::SlideIrradiance(const DualFilter& f, double peak, double h_mm,
 }
 
 }  // namespace lumislab
+
+namespace lumislab {
+
+PlaneLight::PlaneLight(const Luminaire& luminaire, double plane_z_mm, const Eigen::Vector2d& lo_mm,
+                       const Eigen::Vector2d& hi_mm, int channels)
+    : luminaire_(&luminaire), plane_z_mm_(plane_z_mm) {
+  if (luminaire.ray_sources.empty()) return;
+  // One lattice for all ray sources: the finest cell asked for.
+  double cell = 0;
+  for (const RaySource& r : luminaire.ray_sources)
+    if (r.cell_mm > 0 && (cell == 0 || r.cell_mm < cell)) cell = r.cell_mm;
+  if (!(cell > 0))
+    throw BadInput(luminaire.ray_sources.front().file +
+                   ": rays.cell_mm: expected the splat cell (a scene file sets its default from "
+                   "the screen), got none");
+  rays_ = std::make_unique<RaySplat>(lo_mm.x(), hi_mm.x(), lo_mm.y(), hi_mm.y(), cell, channels);
+}
+
+PlaneLight PlaneLight::ThroughSlides(const Luminaire& luminaire, const DualFilter& f, double h_mm,
+                                     const Eigen::Vector2d& c_mm, double d_mm,
+                                     const Eigen::Vector2d& lo_mm, const Eigen::Vector2d& hi_mm) {
+  PlaneLight light(luminaire, d_mm, lo_mm, hi_mm, 6);
+  light.slides_ = true;
+  light.filter_ = f;
+  light.peak_ = f.Peak2D();
+  light.h_mm_ = h_mm;
+  light.c_mm_ = c_mm;
+  if (!light.rays_) return light;
+  const double support = f.SupportHalfWidth();
+  double flux[6];
+  // Each ray from its origin through S (where the slides weigh it, as SlideIrradiance weighs a
+  // point emitter's ray) onto M.
+  for (const RaySource& source : luminaire.ray_sources)
+    for (const SourceRay& ray : *source.rays) {
+      const Eigen::Vector3d& o = ray.origin_mm;
+      const Eigen::Vector3d& k = ray.direction;
+      const double to_s = -o.z() / k.z();
+      const double fu = (o.x() + k.x() * to_s - c_mm.x()) / h_mm;
+      const double fv = (o.y() + k.y() * to_s - c_mm.y()) / h_mm;
+      if (std::abs(fu) >= support || std::abs(fv) >= support) continue;
+      const double phi = f.Eval2D(fu, fv) / light.peak_;  // the slide pair's transmittance
+      if (phi == 0) continue;
+      const double to_m = (d_mm - o.z()) / k.z();
+      const Eigen::Vector3d w = (std::abs(phi) * ray.flux) * source.rgb;
+      for (int c = 0; c < 3; ++c) {
+        flux[c] = phi > 0 ? w[c] : 0;
+        flux[3 + c] = phi < 0 ? w[c] : 0;
+      }
+      light.rays_->Add(o.x() + k.x() * to_m, o.y() + k.y() * to_m, flux);
+    }
+  return light;
+}
+
+PlaneLight PlaneLight::Open(const Luminaire& luminaire, double plane_z_mm,
+                            const Eigen::Vector2d& lo_mm, const Eigen::Vector2d& hi_mm) {
+  PlaneLight light(luminaire, plane_z_mm, lo_mm, hi_mm, 3);
+  if (!light.rays_) return light;
+  double flux[3];
+  for (const RaySource& source : luminaire.ray_sources)
+    for (const SourceRay& ray : *source.rays) {
+      const double to_plane = (plane_z_mm - ray.origin_mm.z()) / ray.direction.z();
+      if (!(to_plane > 0)) continue;  // the plane is behind the ray's origin
+      for (int c = 0; c < 3; ++c) flux[c] = ray.flux * source.rgb[c];
+      light.rays_->Add(ray.origin_mm.x() + ray.direction.x() * to_plane,
+                       ray.origin_mm.y() + ray.direction.y() * to_plane, flux);
+    }
+  return light;
+}
+
+void PlaneLight::Slides(double s_mm, double t_mm, Eigen::Vector3d* plus,
+                        Eigen::Vector3d* minus) const {
+  LUMISLAB_CHECK(slides_, "PlaneLight: not through slides");
+  luminaire_->SlideIrradiance(filter_, peak_, h_mm_, c_mm_, plane_z_mm_, s_mm, t_mm, plus, minus);
+  if (!rays_) return;
+  double e[6];
+  rays_->At(s_mm, t_mm, e);
+  *plus += Eigen::Vector3d(e[0], e[1], e[2]);
+  *minus += Eigen::Vector3d(e[3], e[4], e[5]);
+}
+
+Eigen::Vector3d PlaneLight::Filtered(double s_mm, double t_mm) const {
+  LUMISLAB_CHECK(slides_, "PlaneLight: not through slides");
+  Eigen::Vector3d sum =
+      luminaire_->FilteredIrradiance(filter_, h_mm_, c_mm_, plane_z_mm_, s_mm, t_mm);
+  if (!rays_) return sum;
+  double e[6];
+  rays_->At(s_mm, t_mm, e);
+  for (int c = 0; c < 3; ++c) sum[c] += peak_ * (e[c] - e[3 + c]);
+  return sum;
+}
+
+Eigen::Vector3d PlaneLight::Irradiance(double s_mm, double t_mm) const {
+  LUMISLAB_CHECK(!slides_, "PlaneLight: through slides");
+  Eigen::Vector3d sum = luminaire_->PlaneIrradiance(s_mm, t_mm, plane_z_mm_);
+  if (!rays_) return sum;
+  double e[3];
+  rays_->At(s_mm, t_mm, e);
+  return sum + Eigen::Vector3d(e[0], e[1], e[2]);
+}
+
+void RequirePointEmitters(const Luminaire& luminaire, const std::string& source,
+                          const std::string& what) {
+  if (luminaire.ray_sources.empty()) return;
+  throw BadInput(source + ": luminaire: " + what +
+                 " needs point emitters, got a TM-25 ray source (" +
+                 luminaire.ray_sources.front().file + ")");
+}
+
+}  // namespace lumislab

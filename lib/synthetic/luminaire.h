@@ -1,6 +1,7 @@
 // The synthetic luminaire: point emitters with cos^n lobes behind the filter plane S
-// (docs/design.md §1-3). Everything here is analytic, so it doubles as the ground truth of every
-// synthetic test.
+// (docs/design.md §1-3), and TM-25 ray files as sources (lib/synthetic/ray_source.h). The point
+// emitters are analytic, so they double as the ground truth of every synthetic test; a ray
+// source's truth is its own rays through the same splat as its photos (PlaneLight).
 #pragma once
 
 #include <Eigen/Core>
@@ -10,6 +11,7 @@
 
 #include "core/basis.h"
 #include "lib/photometry/intensity_distribution.h"
+#include "lib/synthetic/ray_source.h"
 
 namespace lumislab {
 
@@ -45,7 +47,10 @@ struct Emitter {
 
 struct Luminaire {
   std::vector<Emitter> emitters;
+  std::vector<RaySource> ray_sources;  // scene emitters with "rays" (a TM-25 file)
 
+  // The three functions below are the point emitters' light at one point, analytic; a ray
+  // source's light needs its rays splatted over a region first: PlaneLight does both.
   // RGB irradiance (W/m^2) on the plane z = plane_z_mm at (x,y) (luminaire frame), no filter.
   Eigen::Vector3d PlaneIrradiance(double x_mm, double y_mm, double plane_z_mm) const;
   // Signed E_ij(s,t) on M (z = d_mm) through Phi~ centred at c (the ground truth), W/m^2.
@@ -57,6 +62,45 @@ struct Luminaire {
                        double d_mm, double s_mm, double t_mm, Eigen::Vector3d* plus,
                        Eigen::Vector3d* minus) const;
 };
+
+// The light a luminaire sends onto a plane, over a region of it (luminaire frame, mm): the point
+// emitters analytically (the Luminaire functions above), the ray sources through a RaySplat of
+// their rays built once here (cost: their rays). The photos, the truth slab and the calibration
+// captures read their light through it. The luminaire must outlive it.
+class PlaneLight {
+ public:
+  // Through the two slides of the filter centred at c (T+ and T-, docs/design.md §2.5) onto M
+  // (z = d), over [lo, hi] of M.
+  static PlaneLight ThroughSlides(const Luminaire& luminaire, const DualFilter& f, double h_mm,
+                                  const Eigen::Vector2d& c_mm, double d_mm,
+                                  const Eigen::Vector2d& lo_mm, const Eigen::Vector2d& hi_mm);
+  // Without a slide onto the plane z = plane_z over [lo, hi].
+  static PlaneLight Open(const Luminaire& luminaire, double plane_z_mm,
+                         const Eigen::Vector2d& lo_mm, const Eigen::Vector2d& hi_mm);
+
+  // Through the slides: irradiance (W/m^2) with T+ and with T- in (SlideIrradiance's).
+  void Slides(double s_mm, double t_mm, Eigen::Vector3d* plus, Eigen::Vector3d* minus) const;
+  // Through the slides: the signed E_ij = peak (E+ - E-) (FilteredIrradiance's for the point
+  // emitters; the same expression of the same splat for the rays, so photos and truth agree).
+  Eigen::Vector3d Filtered(double s_mm, double t_mm) const;
+  // Without a slide: the irradiance (W/m^2).
+  Eigen::Vector3d Irradiance(double s_mm, double t_mm) const;
+
+ private:
+  PlaneLight(const Luminaire& luminaire, double plane_z_mm, const Eigen::Vector2d& lo_mm,
+             const Eigen::Vector2d& hi_mm, int channels);
+  const Luminaire* luminaire_;
+  bool slides_ = false;
+  DualFilter filter_ = DualFilter::Truncated(1);
+  double peak_ = 1, h_mm_ = 1, plane_z_mm_ = 0;
+  Eigen::Vector2d c_mm_ = Eigen::Vector2d::Zero();
+  std::unique_ptr<RaySplat> rays_;  // null without ray sources; 6 channels (E+, E-) or 3
+};
+
+// For what knows point emitters only (analytic images, GridCovers, the study): BadInput naming
+// `source` and the first ray source's file when the luminaire has one.
+void RequirePointEmitters(const Luminaire& luminaire, const std::string& source,
+                          const std::string& what);
 
 // Unfiltered irradiance (W/m^2, per unit I0) that emitter e sends to (s,t,d), and the point
 // (u,v) where that ray crosses S (z = 0). Returns 0 when the point is not in front of e.

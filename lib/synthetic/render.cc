@@ -25,21 +25,27 @@ ScreenView ScreenView::Of(const SynthScene& scene) {
   return view;
 }
 
+PlaneLight ScreenLight(const SynthScene& scene, const DualFilter& filter,
+                       const Eigen::Vector2d& c) {
+  const Eigen::Vector2d half(0.5 * scene.screen_w_mm, 0.5 * scene.screen_h_mm);
+  return PlaneLight::ThroughSlides(scene.luminaire, filter, scene.grid.spacing_mm, c,
+                                   scene.distance_mm, c - half, c + half);
+}
+
 void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int j,
                     double radiometric_scale, ImageF* plus, ImageF* minus) {
   *plus = ImageF(view.width, view.height, 3);
   *minus = ImageF(view.width, view.height, 3);
   const DualFilter filter = scene.Filter();
-  const double peak = filter.Peak2D();
   // Where the stage put the luminaire: the nominal centre plus a listed stage_error's offset.
   const Eigen::Vector2d c = scene.grid.Centre(i, j) + scene.StageOffsetMm(i, j);
   const double gain = scene.camera.exposure / radiometric_scale;
+  const PlaneLight light = ScreenLight(scene, filter, c);
   Eigen::Vector3d e_plus, e_minus;
   for (size_t k = 0; k < view.pixels.size(); ++k) {
     // The luminaire was moved by -c: lab (x, y) is (x, y) + c in the luminaire frame.
     const Eigen::Vector2d st = view.lab_mm[k] + c;
-    scene.luminaire.SlideIrradiance(filter, peak, scene.grid.spacing_mm, c, scene.distance_mm,
-                                    st.x(), st.y(), &e_plus, &e_minus);
+    light.Slides(st.x(), st.y(), &e_plus, &e_minus);
     float* p = &plus->data[size_t(view.pixels[k]) * 3];
     float* n = &minus->data[size_t(view.pixels[k]) * 3];
     for (int ch = 0; ch < 3; ++ch) {
@@ -52,15 +58,14 @@ void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int 
 double MaxSlideIrradiance(const SynthScene& scene, const ScreenView& view, int stride,
                           int threads) {
   const DualFilter filter = scene.Filter();
-  const double peak = filter.Peak2D();
   std::vector<double> max_of(scene.grid.count(), 0.0);
   ParallelFor(scene.grid.count(), threads, [&](int q) {
     Eigen::Vector3d e_plus, e_minus;
     const Eigen::Vector2d c = scene.grid.Centre(q % scene.grid.nu, q / scene.grid.nu);
+    const PlaneLight light = ScreenLight(scene, filter, c);
     for (size_t k = 0; k < view.pixels.size(); k += stride) {
       const Eigen::Vector2d st = view.lab_mm[k] + c;
-      scene.luminaire.SlideIrradiance(filter, peak, scene.grid.spacing_mm, c, scene.distance_mm,
-                                      st.x(), st.y(), &e_plus, &e_minus);
+      light.Slides(st.x(), st.y(), &e_plus, &e_minus);
       max_of[q] = std::max({max_of[q], e_plus.maxCoeff(), e_minus.maxCoeff()});
     }
   });

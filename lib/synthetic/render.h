@@ -21,6 +21,11 @@ struct ScreenView {
   static ScreenView Of(const SynthScene& scene);
 };
 
+// The light the screen gets through the slides of the filter centred at c (luminaire frame, the
+// stage's actual position): the physical screen, lab [-W/2, W/2] x [-H/2, H/2], is that window
+// shifted by c in the luminaire frame.
+PlaneLight ScreenLight(const SynthScene& scene, const DualFilter& filter, const Eigen::Vector2d& c);
+
 // Photos of position (i, j) through T+ and T- before any effect: normalised linear RGB values
 // v = E / radiometric_scale * exposure (3 channels, RGB order), with the luminaire at the grid
 // centre plus scene.StageOffsetMm(i, j).

@@ -43,13 +43,72 @@ void ParseSetup(const JsonView& root, SynthScene* scene) {
     scene->k_max = ParseFilterTruncation(root["filter"]["k_max"]);
 }
 
-// The "luminaire" block of a scene file (also the whole of truth/luminaire.json).
-Luminaire ParseLuminaire(const JsonView& root) {
+// A rotation_deg member: three angles within 36000 degrees (R = Rz Ry Rx).
+Eigen::Vector3d RotationDeg(const JsonView& v) {
+  const std::vector<double> r = v.Numbers(3);
+  for (double x : r)
+    if (std::abs(x) > 36000) v.Fail("three angles within 36000 degrees");
+  return {r[0], r[1], r[2]};
+}
+
+// {"file": "x.ray", "rotation_deg": [rx, ry, rz], "rgb": [r, g, b], "cell_mm": c}: a TM-25 ray
+// file relative to the JSON file's folder, its origin at the emitter's position_mm, its axes
+// turned by R; rgb the W per channel per unit of a ray's flux; cell_mm the splat lattice on the
+// screen (default: the scene's larger screen side / kRayCellsPerScreen).
+RaySource ParseRaySource(const JsonView& e, const Eigen::Vector3d& position_mm,
+                         double default_cell_mm) {
+  const JsonView r = e["rays"];
+  for (const std::string& key : r.Keys())
+    if (key != "file" && key != "rotation_deg" && key != "rgb" && key != "cell_mm")
+      r[key].Fail("file, rotation_deg, rgb or cell_mm");
+  std::filesystem::path file = r["file"].String();
+  if (file.is_relative()) file = std::filesystem::path(r.file()).parent_path() / file;
+  const Eigen::Vector3d rotation =
+      r.Has("rotation_deg") ? RotationDeg(r["rotation_deg"]) : Eigen::Vector3d::Zero();
+  Eigen::Vector3d rgb = Eigen::Vector3d::Ones();
+  if (r.Has("rgb")) {
+    const JsonView v = r["rgb"];
+    for (size_t c = 0; c < 3; ++c) rgb[c] = v[c].NumberIn(0, 1e9);
+    if (v.Size() != 3) v.Fail("[R, G, B] in W per unit of ray flux");
+  }
+  const double cell = r.Has("cell_mm") ? r["cell_mm"].NumberIn(1e-3, 1e5) : default_cell_mm;
+  // At most kMaxRayCellsPerScreen cells along the screen (a map per position is that squared).
+  const double screen = default_cell_mm * kRayCellsPerScreen;
+  if (screen > 0 && cell < screen / kMaxRayCellsPerScreen)
+    r["cell_mm"].Fail("at least the larger screen side / " +
+                      std::to_string(int(kMaxRayCellsPerScreen)) + " (" +
+                      std::to_string(screen / kMaxRayCellsPerScreen) + " mm)");
+  try {
+    return RaySource::Load(file.string(), position_mm, rotation, rgb, cell);
+  } catch (const Error& error) {
+    // The reader names the ray file and its field; the scene file and its field lead.
+    if (error.exit_code() != int(ExitCode::kBadInput)) throw;
+    throw BadInput(r.file() + ": " + r["file"].path() + ": " + error.what());
+  }
+}
+
+// The "luminaire" block of a scene file (also the whole of truth/luminaire.json). A ray source
+// without cell_mm gets `default_cell_mm` (0 where no screen is known: LoadLuminaire).
+Luminaire ParseLuminaire(const JsonView& root, double default_cell_mm) {
   Luminaire luminaire;
   const JsonView emitters = root["luminaire"]["emitters"];
   if (emitters.Size() == 0) emitters.Fail("a non-empty array of emitters");
   for (size_t k = 0; k < emitters.Size(); ++k) {
     const JsonView e = emitters[k];
+    const int kinds = int(e.Has("lobe_exponent")) + int(e.Has("distribution")) + int(e.Has("rays"));
+    if (kinds != 1)
+      e.Fail(
+          "exactly one of lobe_exponent, distribution (a measured IES / EULUMDAT file) or "
+          "rays (a TM-25 ray file)");
+    if (e.Has("rays")) {
+      // The file's origin anywhere: its rays are checked one by one (RaySource::Load).
+      if (e.Has("intensity_w_sr"))
+        e["intensity_w_sr"].Fail(
+            "no intensity_w_sr with rays (the rays carry their flux; "
+            "rays.rgb weighs the channels)");
+      luminaire.ray_sources.push_back(ParseRaySource(e, Vec3(e["position_mm"]), default_cell_mm));
+      continue;
+    }
     Emitter emitter;
     emitter.position_mm = Vec3(e["position_mm"]);
     if (!(emitter.position_mm.z() < 0))
@@ -57,8 +116,6 @@ Luminaire ParseLuminaire(const JsonView& root) {
     const JsonView intensity = e["intensity_w_sr"];
     for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
     if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr");
-    if (e.Has("distribution") == e.Has("lobe_exponent"))
-      e.Fail("either lobe_exponent or distribution (a measured IES / EULUMDAT file)");
     if (e.Has("lobe_exponent")) {
       emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
     } else {
@@ -69,13 +126,8 @@ Luminaire ParseLuminaire(const JsonView& root) {
         if (key != "file" && key != "rotation_deg") d[key].Fail("file or rotation_deg");
       std::filesystem::path file = d["file"].String();
       if (file.is_relative()) file = std::filesystem::path(d.file()).parent_path() / file;
-      Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
-      if (d.Has("rotation_deg")) {
-        const std::vector<double> r = d["rotation_deg"].Numbers(3);
-        for (int a = 0; a < 3; ++a) rotation[a] = r[a];
-        for (double x : r)
-          if (std::abs(x) > 36000) d["rotation_deg"].Fail("three angles within 36000 degrees");
-      }
+      const Eigen::Vector3d rotation =
+          d.Has("rotation_deg") ? RotationDeg(d["rotation_deg"]) : Eigen::Vector3d::Zero();
       emitter.measured =
           std::make_shared<const MeasuredLobe>(MeasuredLobe::Load(file.string(), rotation));
     }
@@ -242,7 +294,8 @@ SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   SynthScene scene;
   scene.source = name;
   ParseSetup(root, &scene);
-  scene.luminaire = ParseLuminaire(root);
+  scene.luminaire =
+      ParseLuminaire(root, std::max(scene.screen_w_mm, scene.screen_h_mm) / kRayCellsPerScreen);
   ParseCamera(root, &scene);
   ParseCalibration(root, &scene);
   if (root.Has("effects")) ParseEffects(root["effects"], &scene);
@@ -273,7 +326,7 @@ Luminaire LoadLuminaire(const std::string& source) {
           : source;
   const JsonDocument doc = JsonDocument::Load(path);
   doc.CheckSchemaVersion(kSceneSchemaVersion);
-  return ParseLuminaire(doc.root());
+  return ParseLuminaire(doc.root(), 0);
 }
 
 Dataset DatasetSkeleton(const SynthScene& scene) {

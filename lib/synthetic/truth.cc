@@ -20,11 +20,15 @@ SlabPosition TruthPosition(const Luminaire& luminaire, const SlabInfo& info, int
   p.mask = ImageF(info.layout.res_x, info.layout.res_y, 1, 1.f);
   const DualFilter filter = info.filter.Filter();
   const Eigen::Vector2d c = info.grid.Centre(i, j);
+  // The texel centres lie in the window; a ray source is splatted over it (the same lattice as
+  // the photos', so its truth is what they hold).
+  const Eigen::Vector2d half(0.5 * info.layout.window_w_mm, 0.5 * info.layout.window_h_mm);
+  const PlaneLight light = PlaneLight::ThroughSlides(luminaire, filter, info.grid.spacing_mm, c,
+                                                     info.distance_mm, -half, half);
   for (int row = 0; row < info.layout.res_y; ++row)
     for (int col = 0; col < info.layout.res_x; ++col) {
       const Eigen::Vector2d st = info.layout.TexelCentre(col, row);
-      const Eigen::Vector3d e = luminaire.FilteredIrradiance(filter, info.grid.spacing_mm, c,
-                                                             info.distance_mm, st.x(), st.y());
+      const Eigen::Vector3d e = light.Filtered(st.x(), st.y());
       for (int ch = 0; ch < 3; ++ch) p.irradiance.at(col, row, ch) = float(e[ch]);
     }
   return p;
@@ -125,6 +129,20 @@ void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
       j["lobe_exponent"] = e.lobe_exponent;
     }
     emitters.push_back(j);
+  }
+  // Ray sources after the point emitters, their files copied the same way (numbered on).
+  for (size_t r = 0; r < luminaire.ray_sources.size(); ++r) {
+    const RaySource& source = luminaire.ray_sources[r];
+    std::string ext = std::filesystem::path(source.file).extension().string();
+    if (ext.empty()) ext = ".ray";
+    const std::string name = "emitter_" + std::to_string(luminaire.emitters.size() + r) + ext;
+    WriteTextAtomically((folder / name).string(), ReadTextFile(source.file));
+    emitters.push_back({{"position_mm", Vec(source.position_mm)},
+                        {"rays",
+                         {{"file", name},
+                          {"rotation_deg", Vec(source.rotation_deg)},
+                          {"rgb", Vec(source.rgb)},
+                          {"cell_mm", source.cell_mm}}}});
   }
   nlohmann::json j;
   j["schema_version"] = 1;

@@ -64,7 +64,7 @@ TEST(SceneFile, MeasuredDistributionEmitters) {
               1e-9);  // 200 cd at 30 degrees
   EXPECT_EQ(e.Shape(Eigen::Vector3d(0, 0, -1)), 0);
   EXPECT_NE(ParseError("\"lobe_exponent\": 8", measured + ", \"lobe_exponent\": 8")
-                .find("luminaire.emitters[0]: expected either lobe_exponent or distribution"),
+                .find("luminaire.emitters[0]: expected exactly one of lobe_exponent, distribution"),
             std::string::npos);
   EXPECT_NE(ParseError("\"lobe_exponent\": 8", "\"distribution\": {\"file\": \"none.ies\"}")
                 .find("none.ies: photometric file not found"),

@@ -12,6 +12,7 @@
 #include "core/json.h"
 #include "core/log.h"
 #include "core/slab.h"
+#include "export/complete_slab.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/photometry/eulumdat.h"
 #include "lib/photometry/file_info.h"
@@ -47,13 +48,7 @@ Slab LoadCompleteSlab(const std::string& path, int threads) {
   Slab slab;
   slab.dir = ResolveSlabDir(path);
   slab.info = SlabInfo::Load(slab.dir);
-  if (!slab.info.Complete())
-    throw InputError(slab.dir + "/slab.json", "present",
-                     "every position of the " + std::to_string(slab.info.grid.nu) + " x " +
-                         std::to_string(slab.info.grid.nv) +
-                         " grid (a partial slab lacks the light of the others: finish it with "
-                         "lumislab-reconstruct)",
-                     std::to_string(slab.info.present.size()) + " position(s)");
+  RequireCompleteSlab(slab.info, slab.dir);
   slab.positions = ReadSlabPositions(slab.dir, slab.info, threads);
   LogInfo("slab ", slab.dir, ": ", slab.info.grid.nu, " x ", slab.info.grid.nv, " positions, h ",
           slab.info.grid.spacing_mm, " mm, d ", slab.info.distance_mm, " mm, ",
@@ -318,7 +313,15 @@ CLI::App* AddRayCommand(CLI::App& app, RayCommand* c, CommonOptions* common) {
   cmd->add_option("--rays", c->rays, "number of rays")
       ->check(CLI::Range(int64_t(1), kMaxRays))
       ->capture_default_str();
-  cmd->add_option("--seed", c->seed, "random seed")->capture_default_str();
+  // CLI11 converts "-1" to 2^64 - 1 for an unsigned option, silently: refused by name.
+  cmd->add_option("--seed", c->seed, "random seed")
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            return s.find('-') == std::string::npos ? std::string()
+                                                    : "expected an integer >= 0, got " + s;
+          },
+          "INT >= 0"))
+      ->capture_default_str();
   cmd->add_option("--name", c->name, "name of the light source (header)");
   cmd->add_option("--manufacturer", c->manufacturer, "its manufacturer (header)");
   cmd->add_flag("--force", c->force, "rewrite the output if it exists");

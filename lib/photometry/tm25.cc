@@ -251,7 +251,7 @@ void WriteTm25(const Tm25RaySet& set, const std::string& path) {
     std::ofstream o(tmp, std::ios::binary);
     o.write(out.data(), std::streamsize(out.size()));
     o.close();
-    if (!o) throw IoError(tmp, "cannot write");
+    if (!o) throw IoError(path, "cannot write");  // the output's name, not the temporary's
   });
 }
 

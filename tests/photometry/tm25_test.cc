@@ -164,8 +164,13 @@ TEST(Tm25, HeaderSizesAreCheckedAgainstTheFileBeforeUse) {
   Set<int32_t>(&text, 84, 0x7fffffe0);
   Set<int32_t>(&columns, 80, 1024);
   for (const auto& [bytes, expected] : std::vector<std::pair<std::string, std::string>>{
-           {text, "additional text block (4.7.6): the file ends before it"},
-           {columns, "additional column name 1 (4.7.5): the file ends before it"}}) {
+           // The size needed is in the message: it was checked before anything was read.
+           {text,
+            "additional text block (4.7.6): the file ends before it (truncated: 36372 "
+            "bytes, 2147483616 needed from byte 36288)"},
+           {columns,
+            "additional column name 1 (4.7.5): the file ends before it (truncated: "
+            "36372 bytes, 512 needed from byte 36288)"}}) {
     Write(path, bytes);
     try {
       ReadTm25(path);

@@ -247,6 +247,7 @@ CLI::App* AddFarFieldCommand(CLI::App& app, const std::string& format, FarFieldC
       ->capture_default_str();
   cmd->add_option("--opening-mm", c->opening_mm,
                   "luminous opening width,length,height in mm (default: the grid's extent)")
+      ->check(FiniteIn(-1e6, 1e6))
       ->delimiter(',')
       ->expected(3);
   cmd->add_flag("--force", c->force, "rewrite the output if it exists");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -141,6 +142,12 @@ void IntensityDistribution::Check(const std::string& file) const {
                          "intensity at C " + Num(c_deg[ic], 8) + ", gamma " + Num(gamma_deg[ig], 8),
                          "a finite number >= 0", std::isfinite(v) ? Num(v, 8) : "not a number");
     }
+  // A size in feet near the largest double overflows in mm, and the writers would print "inf"
+  // (fuzz_ies; lumislab-export's --opening-mm nan,1,1 wrote "nan").
+  for (const auto& [field, v] : {std::pair<const char*, double>{"luminous width", opening.width_mm},
+                                 {"luminous length", opening.length_mm},
+                                 {"luminous height", opening.height_mm}})
+    if (!std::isfinite(v)) throw InputError(file, field, "a finite size (mm)", Num(v, 8));
   // Values near the largest double pass one by one, and their flux overflows (fuzz_ies).
   if (!std::isfinite(TotalFlux()))
     throw InputError(file, "intensity values", "values whose total flux is a finite number",

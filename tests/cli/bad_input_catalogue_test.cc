@@ -1931,6 +1931,7 @@ std::vector<Case> PhotometryCases() {
                     .Names({"--gamma-angles", "vertical angle 3"}));
     v.push_back(F(format, "samples_zero", "--samples 0").Names({"--samples"}));
     v.push_back(F(format, "opening_two_values", "--opening-mm 10,20").Names({"--opening-mm"}));
+    v.push_back(F(format, "opening_nan", "--opening-mm nan,20,0").Names({"--opening-mm"}));
   }
   v.push_back(F("ies", "no_test_keyword", "")
                   .Args("ies --slab ds --out x.ies --lab L --manufacturer M")

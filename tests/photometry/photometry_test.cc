@@ -332,6 +332,15 @@ TEST(IntensityDistribution, FuzzFindingsFluxOverflowAndCloseAngles) {
   EXPECT_NE(message.find("big.ies: intensity values: expected values whose total flux is a finite"),
             std::string::npos)
       << message;
+  // 1e308 feet of luminous width is inf mm, which FormatIes wrote as "inf".
+  std::tie(code, message) = Thrown([&] {
+    ParseIes("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 1 1 1e308 0 0\n1 1 0\n0 45 90\n0\n1 1 1\n",
+             "wide.ies");
+  });
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(message.find("wide.ies: luminous width: expected a finite size (mm), got inf"),
+            std::string::npos)
+      << message;
   std::tie(code, message) =
       Thrown([&] { ParseIes(head + "0 90 90.0000001 180\n0\n1 1 1 1\n", "close.ies"); });
   EXPECT_EQ(code, 2);

@@ -234,7 +234,7 @@ IntensityDistribution ParseEulumdat(const std::string& text, const std::string& 
     for (int g = 0; g < ng; ++g)
       d.values[c * ng + g] =
           in.Token("intensity " + std::to_string(g + 1) + " of C plane " + Num(d.c_deg[c], 6)) *
-          lamp_flux / 1000.0;
+          (lamp_flux / 1000.0);  // not (value * flux) / 1000: that overflows 1000 times sooner
   if (in.TokensLeft() > 0)
     throw BadInput(name + ": line " + std::to_string(in.TokenLine()) + ": " +
                    std::to_string(in.TokensLeft()) + " value(s) after the last intensity (the " +

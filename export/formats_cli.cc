@@ -4,9 +4,7 @@
 #include <cmath>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/error.h"
@@ -14,8 +12,10 @@
 #include "core/json.h"
 #include "core/log.h"
 #include "core/slab.h"
+#include "export/complete_slab.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/photometry/eulumdat.h"
+#include "lib/photometry/file_info.h"
 #include "lib/photometry/ies.h"
 #include "lib/photometry/intensity_distribution.h"
 #include "lib/photometry/tm25.h"
@@ -48,13 +48,7 @@ Slab LoadCompleteSlab(const std::string& path, int threads) {
   Slab slab;
   slab.dir = ResolveSlabDir(path);
   slab.info = SlabInfo::Load(slab.dir);
-  if (!slab.info.Complete())
-    throw InputError(slab.dir + "/slab.json", "present",
-                     "every position of the " + std::to_string(slab.info.grid.nu) + " x " +
-                         std::to_string(slab.info.grid.nv) +
-                         " grid (a partial slab lacks the light of the others: finish it with "
-                         "lumislab-reconstruct)",
-                     std::to_string(slab.info.present.size()) + " position(s)");
+  RequireCompleteSlab(slab.info, slab.dir);
   slab.positions = ReadSlabPositions(slab.dir, slab.info, threads);
   LogInfo("slab ", slab.dir, ": ", slab.info.grid.nu, " x ", slab.info.grid.nv, " positions, h ",
           slab.info.grid.spacing_mm, " mm, d ", slab.info.distance_mm, " mm, ",
@@ -253,6 +247,7 @@ CLI::App* AddFarFieldCommand(CLI::App& app, const std::string& format, FarFieldC
       ->capture_default_str();
   cmd->add_option("--opening-mm", c->opening_mm,
                   "luminous opening width,length,height in mm (default: the grid's extent)")
+      ->check(FiniteIn(-1e6, 1e6))
       ->delimiter(',')
       ->expected(3);
   cmd->add_flag("--force", c->force, "rewrite the output if it exists");
@@ -319,7 +314,15 @@ CLI::App* AddRayCommand(CLI::App& app, RayCommand* c, CommonOptions* common) {
   cmd->add_option("--rays", c->rays, "number of rays")
       ->check(CLI::Range(int64_t(1), kMaxRays))
       ->capture_default_str();
-  cmd->add_option("--seed", c->seed, "random seed")->capture_default_str();
+  // CLI11 converts "-1" to 2^64 - 1 for an unsigned option, silently: refused by name.
+  cmd->add_option("--seed", c->seed, "random seed")
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            return s.find('-') == std::string::npos ? std::string()
+                                                    : "expected an integer >= 0, got " + s;
+          },
+          "INT >= 0"))
+      ->capture_default_str();
   cmd->add_option("--name", c->name, "name of the light source (header)");
   cmd->add_option("--manufacturer", c->manufacturer, "its manufacturer (header)");
   cmd->add_flag("--force", c->force, "rewrite the output if it exists");
@@ -334,88 +337,8 @@ struct InfoCommand {
   bool json = false;
 };
 
-bool IsTm25(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  in.read(magic, 4);
-  return in && std::string(magic, 4) == "TM25";
-}
-
-nlohmann::json NumberOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nullptr; }
-
 int RunInfo(const InfoCommand& c) {
-  CheckInputFile(c.file, "file");
-  nlohmann::json j;
-  j["file"] = c.file;
-  if (IsTm25(c.file)) {
-    const Tm25RaySet set = ReadTm25(c.file);
-    j["format"] = "TM-25";
-    j["photometric"] = set.photometric;
-    j["flux_unit"] = set.photometric ? "lm" : "W";
-    j["flux"] = set.FluxSum();
-    j["rays"] = set.rays.size();
-    j["header_luminous_flux_lm"] = NumberOrNull(set.luminous_flux_lm);
-    j["header_radiant_flux_w"] = NumberOrNull(set.radiant_flux_w);
-    j["date_time"] = set.date_time;
-    j["name"] = set.name;
-    j["manufacturer"] = set.manufacturer;
-    j["rayfile_creator"] = set.rayfile_creator;
-  } else {
-    const IntensityDistribution d = ReadIntensityFile(c.file);
-    j["format"] = d.format;
-    j["photometric"] = d.photometric;
-    j["intensity_unit"] = d.photometric ? "cd" : "W/sr";
-    j["flux_unit"] = d.photometric ? "lm" : "W";
-    j["flux"] = d.TotalFlux();
-    j["symmetry"] = CSymmetryName(d.Symmetry());
-    j["c_planes"] = {
-        {"count", d.c_deg.size()}, {"first", d.c_deg.front()}, {"last", d.c_deg.back()}};
-    j["gamma_angles"] = {{"count", d.gamma_deg.size()},
-                         {"first", d.gamma_deg.front()},
-                         {"last", d.gamma_deg.back()}};
-    size_t peak = 0;
-    for (size_t k = 0; k < d.values.size(); ++k)
-      if (d.values[k] > d.values[peak]) peak = k;
-    j["peak"] = {{"intensity", d.values[peak]},
-                 {"c_deg", d.c_deg[peak / d.gamma_deg.size()]},
-                 {"gamma_deg", d.gamma_deg[peak % d.gamma_deg.size()]}};
-    j["opening_mm"] = {{"width", d.opening.width_mm},
-                       {"length", d.opening.length_mm},
-                       {"height", d.opening.height_mm}};
-    j["input_watts"] = d.input_watts;
-    nlohmann::json keywords = nlohmann::json::object();
-    for (const auto& [key, value] : d.keywords)
-      if (!key.empty()) keywords[key] = value;
-    j["keywords"] = keywords;
-  }
-  if (c.json) {
-    std::printf("%s\n", j.dump(2).c_str());
-    return 0;
-  }
-  std::ostringstream os;
-  os << "file: " << c.file << "\nformat: " << j["format"].get<std::string>() << "\n";
-  const std::string unit = j["flux_unit"];
-  if (j.contains("rays")) {
-    os << "rays: " << j["rays"].get<size_t>() << " ("
-       << (j["photometric"].get<bool>() ? "luminous" : "radiant") << " flux per ray)\n";
-  } else {
-    os << "symmetry: " << j["symmetry"].get<std::string>() << "\n"
-       << "C planes: " << j["c_planes"]["count"].get<size_t>() << " ("
-       << Num(j["c_planes"]["first"], 6) << " to " << Num(j["c_planes"]["last"], 6) << " deg)\n"
-       << "gamma angles: " << j["gamma_angles"]["count"].get<size_t>() << " ("
-       << Num(j["gamma_angles"]["first"], 6) << " to " << Num(j["gamma_angles"]["last"], 6)
-       << " deg)\n"
-       << "peak: " << Num(j["peak"]["intensity"], 6) << " "
-       << j["intensity_unit"].get<std::string>() << " at C " << Num(j["peak"]["c_deg"], 6)
-       << ", gamma " << Num(j["peak"]["gamma_deg"], 6) << "\n";
-    for (const auto& [key, value] : j["keywords"].items()) {
-      std::string text = value.get<std::string>();
-      std::replace(text.begin(), text.end(), '\n', ' ');
-      os << "[" << key << "] " << text.substr(0, 90) << "\n";
-    }
-  }
-  os << "flux: " << Num(j["flux"], 7) << " " << unit << "\n";
-  std::fputs(os.str().c_str(), stdout);
+  std::fputs(FormatPhotometricFileInfo(PhotometricFileInfo(c.file), c.json).c_str(), stdout);
   return 0;
 }
 

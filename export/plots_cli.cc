@@ -12,6 +12,7 @@
 #include "core/log.h"
 #include "core/slab.h"
 #include "core/stop_signal.h"
+#include "export/complete_slab.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/polar_plot.h"
@@ -58,6 +59,7 @@ int RunIrradiance(const IrradianceOptions& o, int threads) {
   request.log = o.scale == "log";
   ParseFalseColourRange(o.range, "--range", &request);
   const SlabInfo info = SlabInfo::Load(o.slab_dir);
+  RequireCompleteSlab(info, o.slab_dir);
   const std::vector<ImageF> irradiance = ReadSlabIrradiance(o.slab_dir, info, threads);
   SceneRequest scene;
   scene.name = "plane";
@@ -88,8 +90,7 @@ int RunIrradiance(const IrradianceOptions& o, int threads) {
 // The far field in the four half-planes, up to the largest gamma every one of them saw.
 PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
   const SlabInfo info = SlabInfo::Load(o.slab_dir);
-  if (info.present.empty())
-    throw InputError(o.slab_dir + "/slab.json", "present", "at least one position", "none");
+  RequireCompleteSlab(info, o.slab_dir);
   const std::vector<SlabPosition> positions = ReadSlabPositions(o.slab_dir, info, threads);
   std::vector<double> gamma;
   for (int k = 0; k * o.gamma_step_deg <= 90 + 1e-9; ++k) gamma.push_back(k * o.gamma_step_deg);

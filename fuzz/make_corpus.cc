@@ -8,6 +8,7 @@
 // stripped). Rerun it when a file format changes.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -19,6 +20,9 @@
 #include "core/slab.h"
 #include "lib/photo/photo_io.h"
 #include "lib/photo/radiometric_calibration.h"
+#include "lib/photometry/eulumdat.h"
+#include "lib/photometry/ies.h"
+#include "lib/photometry/tm25.h"
 #include "lib/synthetic/scene.h"
 
 namespace fs = std::filesystem;
@@ -292,6 +296,179 @@ void RadiometricCalibrations(const std::string& scratch) {
       "\"reading_p\": 1200, \"reading_n\": 0}\n");
 }
 
+// --- the lighting industry's files (lib/photometry): small grids, a few rays
+
+// A lobe of 100 cd * cos(gamma)^2 (0 beyond 90 degrees), brighter towards C 0, on the grid.
+IntensityDistribution SmallDistribution(std::vector<double> c, std::vector<double> gamma) {
+  IntensityDistribution d;
+  d.c_deg = std::move(c);
+  d.gamma_deg = std::move(gamma);
+  for (double ci : d.c_deg)
+    for (double g : d.gamma_deg) {
+      const double cg = std::cos(g * M_PI / 180);
+      d.values.push_back(cg > 0 ? 100 * cg * cg * (1.2 + 0.2 * std::cos(ci * M_PI / 180)) : 0);
+    }
+  d.opening = {-60, -60, 0};
+  d.input_watts = 8.5;
+  d.keywords = {{"TEST", "fuzz seed"},
+                {"TESTLAB", "lumislab"},
+                {"ISSUEDATE", "2026-12-02"},
+                {"MANUFAC", "lumislab"},
+                {"LUMCAT", "L-1"},
+                {"LUMINAIRE", "a small lobe"},
+                {"MORE_TEXT", "line one\nline two"}};
+  return d;
+}
+
+// A 1995 file with TILT=INCLUDE, a ballast-lamp factor and numbers split over lines (the reader
+// takes every edition; the writer writes only 2019).
+const char* kIes1995Tilt = R"(IESNA:LM-63-1995
+[TEST] 1995 seed
+[MANUFAC] lumislab
+[MORE] continued
+TILT=INCLUDE
+1
+3
+0 45 90
+1.0 0.9 0.7
+2 1000 0.5 3 2 1 1 0.3 0.3 0.05
+1.0 0.95 12
+0 45 90
+0 90
+100 80 10
+120,90,5
+)";
+
+// A 1986 file: free text lines before TILT=NONE, feet, one C plane.
+const char* kIes1986 = R"(a luminaire of 1986
+measured long ago
+TILT=NONE
+1 500 1 3 1 1 1 0 0 0
+1 1 10
+0 60 90
+0
+200 50 0
+)";
+
+// EULUMDAT with decimal commas, two lamp sets and several numbers on a line (Isym 1).
+const char* kLdtCommas = R"(lumislab
+1
+1
+1
+0
+3
+45
+seed
+commas
+L-2
+commas.ldt
+2026
+100
+0
+50
+80
+0
+0
+0
+0
+0
+100
+85,5
+1,0
+0
+2
+1
+LED
+1200,5
+3000K
+80
+15,5
+1
+LED
+600
+4000K
+90
+7
+0,5 0,5 0,5 0,5 0,5 0,5 0,5 0,5 0,5 0,5
+0
+0 45 90
+300,5 120 0
+)";
+
+void Photometry(const std::string& scratch) {
+  // IES: the writer's form of each symmetry, a radiometric one, and the older editions
+  // (the real files of tests/data/ies/ are copied into fuzz/corpus/fuzz_ies/ by hand).
+  const std::vector<double> gamma = {0, 30, 60, 90, 135, 180};
+  Put("fuzz_ies", "written_axial.ies", FormatIes(SmallDistribution({0}, gamma), {}, "seed"));
+  Put("fuzz_ies", "written_quadrant.ies",
+      FormatIes(SmallDistribution({0, 45, 90}, {0, 45, 90}), {}, "seed"));
+  IntensityDistribution radiometric = SmallDistribution({0, 90, 180, 270, 360}, gamma);
+  radiometric.photometric = false;
+  Put("fuzz_ies", "written_radiometric.ies", FormatIes(radiometric, {}, "seed"));
+  Put("fuzz_ies", "edition_1995_tilt_include.ies", kIes1995Tilt);
+  Put("fuzz_ies", "edition_1986.ies", kIes1986);
+  // EULUMDAT: Isym 1, 2, 3, 4 and 0, and a hand-written one.
+  const std::vector<std::pair<std::string, std::vector<double>>> planes = {
+      {"isym1_axial", {0}},
+      {"isym2_c0_c180", {0, 90, 180}},
+      {"isym3_c90_c270", {90, 180, 270}},
+      {"isym4_quadrant", {0, 45, 90}},
+      {"isym0_none", {0, 90, 180, 270}}};
+  for (const auto& [name, c] : planes)
+    Put("fuzz_eulumdat", name + ".ldt",
+        FormatEulumdat(SmallDistribution(c, {0, 45, 90, 180}), name + ".ldt"));
+  Put("fuzz_eulumdat", "commas_two_lamp_sets.ldt", kLdtCommas);
+  // TM-25: three rays with luminous flux, two with radiant flux and unknown header totals, and
+  // the latter with every optional part (spectral table, extra column, text block) patched in.
+  Tm25RaySet set;
+  set.luminous_flux_lm = 3;
+  set.radiant_flux_w = std::nan("");
+  set.date_time = "2026-12-02T06:00:00Z";
+  set.name = "seed";
+  set.manufacturer = "lumislab";
+  set.rays = {
+      {0, 0, 0, 0, 0, 1, 1}, {1.5f, -2, 0, 0.6f, 0, 0.8f, 1.5f}, {-3, 4, 0, 0, -0.6f, 0.8f, 0.5f}};
+  WriteTm25(set, scratch + "/rays.ray");
+  Take(scratch + "/rays.ray", "fuzz_tm25", "luminous_3_rays.ray");
+  set.photometric = false;
+  set.luminous_flux_lm = std::nan("");
+  set.radiant_flux_w = 0.02;
+  set.rays.resize(2);
+  WriteTm25(set, scratch + "/rays.ray");
+  const std::string radiant = ReadTextFile(scratch + "/rays.ray");
+  Take(scratch + "/rays.ray", "fuzz_tm25", "radiant_2_rays.ray");
+  // Offsets of the header fields (docs/design.md §5.17): 76 spectral tables, 80 additional
+  // items, 84 text block bytes, 256 the flags (radiant, wavelength, luminous, Stokes,
+  // tristimulus, spectrum index from 264), 36288 the end of the fixed header.
+  std::string all = radiant.substr(0, kTm25FixedHeaderBytes);
+  auto put_int = [&](size_t at, int32_t v) { std::memcpy(&all[at], &v, 4); };
+  auto append = [&](const void* p, size_t n) { all.append(static_cast<const char*>(p), n); };
+  put_int(76, 1);                                                   // one spectral table
+  put_int(80, 1);                                                   // one additional ray item
+  put_int(84, 32);                                                  // a 32-byte text block
+  for (size_t at : {264, 268, 272, 276, 280, 284}) put_int(at, 1);  // every optional column
+  const int32_t pairs = 3;
+  const float table[6] = {450, 0.2f, 550, 1, 650, 0.4f};
+  append(&pairs, 4);
+  append(table, sizeof table);
+  all.append(32 - (4 + sizeof table) % 32, '\0');  // the tables padded to 32 bytes
+  std::string column(512, '\0');
+  column.replace(0, 5, "extra");
+  all += column;
+  all += std::string("a text block of 32 bytes........", 32);
+  // position 3, direction 3, radiant, wavelength, luminous, Stokes 3, tristimulus 2, spectrum
+  // index, the extra item: 16 values per ray.
+  const float rays[2][16] = {{0, 0, 0, 0, 0, 1, 0.01f, 550, 6.8f, 1, 0, 0, 0.3f, 0.3f, 0, 7},
+                             {1, 2, 0, 0, 0.6f, 0.8f, 0.01f, 600, 5.0f, 1, 0, 0, 0.4f, 0.3f, 0, 8}};
+  append(rays, sizeof rays);
+  Put("fuzz_tm25", "every_optional_part.ray", all);
+  // info: one file of each format (the detection is what it adds).
+  Put("fuzz_photometry_info", "edition_1986.ies", kIes1986);
+  Put("fuzz_photometry_info", "isym4_quadrant.ldt",
+      FormatEulumdat(SmallDistribution({0, 45, 90}, {0, 45, 90, 180}), "seed.ldt"));
+  Put("fuzz_photometry_info", "radiant_2_rays.ray", radiant);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -310,6 +487,7 @@ int main(int argc, char** argv) {
     Photos();
     SlabPositions(scratch);
     RadiometricCalibrations(scratch);
+    Photometry(scratch);
     fs::remove_all(scratch);
     return 0;
   });

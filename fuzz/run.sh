@@ -31,6 +31,9 @@ dict_of() {
     fuzz_slab_position) echo fuzz/dict/exr.dict ;;
     fuzz_mesh_ply) echo fuzz/dict/ply.dict ;;
     fuzz_mesh_obj) echo fuzz/dict/obj.dict ;;
+    fuzz_ies) echo fuzz/dict/ies.dict ;;
+    fuzz_eulumdat) echo fuzz/dict/eulumdat.dict ;;
+    fuzz_tm25 | fuzz_photometry_info) echo fuzz/dict/tm25.dict ;;
   esac
 }
 

@@ -234,7 +234,7 @@ IntensityDistribution ParseEulumdat(const std::string& text, const std::string& 
     for (int g = 0; g < ng; ++g)
       d.values[c * ng + g] =
           in.Token("intensity " + std::to_string(g + 1) + " of C plane " + Num(d.c_deg[c], 6)) *
-          lamp_flux / 1000.0;
+          (lamp_flux / 1000.0);  // not (value * flux) / 1000: that overflows 1000 times sooner
   if (in.TokensLeft() > 0)
     throw BadInput(name + ": line " + std::to_string(in.TokenLine()) + ": " +
                    std::to_string(in.TokensLeft()) + " value(s) after the last intensity (the " +
@@ -280,9 +280,18 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
       ityp = 0;
       break;
   }
-  std::vector<double> full =
-      symmetry == CSymmetry::kAxial ? d.c_deg : FullCircle(d.c_deg, symmetry);
-  std::vector<double> stored = d.c_deg;
+  // The ends of the C range within the angle tolerance of a symmetry plane (a multiple of 90
+  // degrees) are on it: their mirror images are themselves, where FullCircle would add a second
+  // plane a hair away that the reader counts too, and C -1e-7 is 0, not 359.9999999 (both
+  // found by fuzz_eulumdat: files the reader refused).
+  std::vector<double> planes = d.c_deg;
+  if (symmetry != CSymmetry::kAxial)
+    for (double* end : {&planes.front(), &planes.back()}) {
+      const double plane = 90 * std::round(*end / 90);
+      if (std::abs(*end - plane) <= 1e-6) *end = plane;
+    }
+  std::vector<double> full = symmetry == CSymmetry::kAxial ? planes : FullCircle(planes, symmetry);
+  std::vector<double> stored = planes;
   if (symmetry == CSymmetry::kNone && std::abs(stored.back() - 360) < 1e-6) stored.pop_back();
   auto field = [](const std::string& s) { return s.substr(0, 78); };
   auto keyword_or = [&](const char* key, const std::string& fallback) {
@@ -317,8 +326,9 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
      << Num(flux, 10) << "\n-\n-\n"
      << Num(d.input_watts, 8) << "\n";
   for (int k = 0; k < 10; ++k) os << "0\n";
-  for (double c : full) os << Num(c, 8) << "\n";
-  for (double g : d.gamma_deg) os << Num(g, 8) << "\n";
+  // Angles with 15 digits: what was read is written back (Check wants them 1e-6 deg apart).
+  for (double c : full) os << Num(c, 15) << "\n";
+  for (double g : d.gamma_deg) os << Num(g, 15) << "\n";
   for (size_t c = 0; c < stored.size(); ++c)
     for (size_t g = 0; g < d.gamma_deg.size(); ++g)
       os << Num(d.At(c, g) * 1000.0 / flux, 8) << "\n";

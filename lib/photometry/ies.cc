@@ -278,8 +278,9 @@ std::string FormatIes(const IntensityDistribution& d, const IesWriteOptions& opt
      << Num(d.opening.width_mm / 1000, 6) << " " << Num(d.opening.length_mm / 1000, 6) << " "
      << Num(d.opening.height_mm / 1000, 6) << "\n";
   os << "1 " << options.file_generation_type << " " << Num(d.input_watts, 6) << "\n";
-  WriteNumbers(os, d.gamma_deg, 8);
-  WriteNumbers(os, d.c_deg, 8);
+  // Angles with 15 digits: what was read is written back (Check wants them 1e-6 deg apart).
+  WriteNumbers(os, d.gamma_deg, 15);
+  WriteNumbers(os, d.c_deg, 15);
   for (size_t ic = 0; ic < d.c_deg.size(); ++ic)
     WriteNumbers(os,
                  std::vector<double>(d.values.begin() + ic * d.gamma_deg.size(),

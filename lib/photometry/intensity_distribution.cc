@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -68,7 +69,10 @@ std::vector<double> CWeights(const std::vector<double>& c, CSymmetry symmetry) {
   return w;
 }
 
-std::string Deg(double v) { return Num(v, 8) + " deg"; }
+std::string Deg(double v) { return Num(v, 15) + " deg"; }
+// Angles closer than kAngleTolerance are one angle to Near() and would divide by ~0 in Locate:
+// each must exceed the one before by more (the writers print 15 digits, which keeps them apart).
+std::string Apart() { return " by over " + Num(kAngleTolerance, 3) + " deg)"; }
 
 }  // namespace
 
@@ -111,18 +115,19 @@ void IntensityDistribution::Check(const std::string& file) const {
         gamma_deg[k] > 180 + kAngleTolerance)
       throw InputError(file, "vertical angle " + std::to_string(k + 1), "a number in [0, 180]",
                        Num(gamma_deg[k], 8));
-    if (k > 0 && !(gamma_deg[k] > gamma_deg[k - 1]))
+    if (k > 0 && !(gamma_deg[k] > gamma_deg[k - 1] + kAngleTolerance))
       throw InputError(file, "vertical angle " + std::to_string(k + 1),
-                       "more than the one before (" + Deg(gamma_deg[k - 1]) + ")",
-                       Num(gamma_deg[k], 8));
+                       "more than the one before (" + Deg(gamma_deg[k - 1]) + Apart(),
+                       Num(gamma_deg[k], 15));
   }
   for (size_t k = 0; k < c_deg.size(); ++k) {
     if (!std::isfinite(c_deg[k]))
       throw InputError(file, "horizontal angle " + std::to_string(k + 1), "a finite number",
                        Num(c_deg[k], 8));
-    if (k > 0 && !(c_deg[k] > c_deg[k - 1]))
+    if (k > 0 && !(c_deg[k] > c_deg[k - 1] + kAngleTolerance))
       throw InputError(file, "horizontal angle " + std::to_string(k + 1),
-                       "more than the one before (" + Deg(c_deg[k - 1]) + ")", Num(c_deg[k], 8));
+                       "more than the one before (" + Deg(c_deg[k - 1]) + Apart(),
+                       Num(c_deg[k], 15));
   }
   if (c_deg.size() > 1 && Symmetry() == CSymmetry::kNone &&
       !(Near(c_deg.front(), 0) && c_deg.back() > 180 && c_deg.back() <= 360 + kAngleTolerance))
@@ -137,6 +142,17 @@ void IntensityDistribution::Check(const std::string& file) const {
                          "intensity at C " + Num(c_deg[ic], 8) + ", gamma " + Num(gamma_deg[ig], 8),
                          "a finite number >= 0", std::isfinite(v) ? Num(v, 8) : "not a number");
     }
+  // A size in feet near the largest double overflows in mm, and the writers would print "inf"
+  // (fuzz_ies; lumislab-export's --opening-mm nan,1,1 wrote "nan").
+  for (const auto& [field, v] : {std::pair<const char*, double>{"luminous width", opening.width_mm},
+                                 {"luminous length", opening.length_mm},
+                                 {"luminous height", opening.height_mm}})
+    if (!std::isfinite(v)) throw InputError(file, field, "a finite size (mm)", Num(v, 8));
+  // Values near the largest double pass one by one, and their flux overflows (fuzz_ies).
+  if (!std::isfinite(TotalFlux()))
+    throw InputError(file, "intensity values", "values whose total flux is a finite number",
+                     "values so large that it overflows (largest " +
+                         Num(*std::max_element(values.begin(), values.end()), 8) + ")");
 }
 
 double IntensityDistribution::Intensity(double c_in, double gamma) const {

@@ -1,4 +1,4 @@
-// The bad-input catalogue: one table of cases over the four tools, each a mutation of a small
+// The bad-input catalogue: one table of cases over the five tools, each a mutation of a small
 // valid input, the command that must refuse it, and what the refusal must look like
 // (docs/design.md §7): exit code 2, one error line naming the file and the field, no crash, no
 // hang, and nothing under the case folder changed (every file's bytes hashed before and after;
@@ -57,6 +57,7 @@ using testing::SnapshotTree;
 using testing::TreeSnapshot;
 using testing::WriteBinaryFile;
 
+const char kSceneFileName[] = "scene.json";
 constexpr long kMemoryLimitKb = 2L << 20;  // ulimit -v: 2 GiB for every case
 constexpr double kTimeoutS = 20;           // per tool run; a hang ends as exit 124
 // The sanitized build runs a quarter of the cases (testing::InSanitizerSample): the ~400 tool
@@ -266,6 +267,79 @@ std::string Garbage() {
     bytes += char(x >> 24);
   }
   return bytes;
+}
+
+// --- the lighting industry's files (docs/design.md §5.17)
+
+// tests/data/ies/7.ies (a real LM-63-2002 file: 37 gamma angles, one C plane) with `from`
+// replaced by `to` (the first occurrence; "" leaves it whole), under `file`; keep_fraction < 1
+// cuts it short.
+Mutation RealIes(const std::string& file, const std::string& from = "", const std::string& to = "",
+                 double keep_fraction = 1) {
+  return [=](const std::string& dir) {
+    std::string text = ReadBinaryFile(std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/ies/7.ies");
+    if (!from.empty()) {
+      const size_t at = text.find(from);
+      if (at == std::string::npos) throw std::runtime_error("7.ies has no \"" + from + "\"");
+      text.replace(at, from.size(), to);
+    }
+    WriteBinaryFile(dir + "/" + file, text.substr(0, size_t(text.size() * keep_fraction)));
+  };
+}
+// A small valid EULUMDAT file (Isym 1: one C plane, gamma 0, 45, 90 on lines 44-46, the
+// intensities 300, 120, 0 on lines 47-49) with the lines of `edits` (1-based) replaced.
+Mutation Ldt(const std::string& file, std::map<int, std::string> edits = {}) {
+  return [=](const std::string& dir) {
+    std::vector<std::string> lines = {
+        "lumislab", "1",   "1", "1",  "0",  "3",   "45",   "catalogue", "lamp", "L-1", "lamp.ldt",
+        "2026",     "100", "0", "50", "80", "0",   "0",    "0",         "0",    "0",   "100",
+        "85",       "1",   "0", "1",  "1",  "LED", "1200", "3000K",     "80",   "15"};
+    for (int k = 0; k < 10; ++k) lines.push_back("0.5");
+    for (const char* v : {"0", "0", "45", "90", "300", "120", "0"}) lines.push_back(v);
+    for (const auto& [line, value] : edits) lines.at(size_t(line - 1)) = value;
+    std::string text;
+    for (const auto& l : lines) text += l + "\n";
+    WriteBinaryFile(dir + "/" + file, text);
+  };
+}
+// A TM-25 ray file (little-endian, docs/design.md §5.17) whose header says `header_rays` rays of
+// luminous flux and which holds `rays` of them; `poison` >= 0 makes that ray's x NaN, `version`
+// is the file version (2013 the valid one).
+Mutation Tm25(const std::string& file, uint64_t header_rays, int rays, int poison = -1,
+              int32_t version = 2013) {
+  return [=](const std::string& dir) {
+    std::string b;
+    auto put = [&](const auto& v) { b.append(reinterpret_cast<const char*>(&v), sizeof v); };
+    b += "TM25";
+    put(version);
+    put(int32_t(1));                               // measured
+    put(float(rays));                              // luminous flux (lm)
+    put(std::numeric_limits<float>::quiet_NaN());  // radiant flux: unknown
+    put(header_rays);
+    b.append(28, '\0');                                       // date
+    for (int k = 0; k < 2; ++k) put(int32_t(0));              // ray start, spectral identifier
+    for (int k = 0; k < 3; ++k) put(float(0));                // wavelengths
+    for (int k = 0; k < 3; ++k) put(int32_t(0));              // tables, extra items, text block
+    b.append(168, '\0');                                      // reserved
+    for (int32_t flag : {1, 1, 0, 0, 1, 0, 0, 0}) put(flag);  // position, direction, luminous
+    b.append(9 * 1000 * 4, '\0');                             // the description block
+    for (int r = 0; r < rays; ++r) {
+      const float x = r == poison ? std::numeric_limits<float>::quiet_NaN() : float(r);
+      for (float v : {x, 0.f, 0.f, 0.f, 0.f, 1.f, 1.f}) put(v);
+    }
+    WriteBinaryFile(dir + "/" + file, b);
+  };
+}
+// Emitter 0 of scene.json gets a measured distribution {"file": file, ...extra} instead of its
+// cos^n lobe.
+Mutation SceneDistribution(const std::string& file, json extra = json::object()) {
+  return EditJson(kSceneFileName, [=](json& j) {
+    json& e = j["luminaire"]["emitters"][0];
+    e.erase("lobe_exponent");
+    json d = {{"file", file}};
+    d.update(extra);
+    e["distribution"] = d;
+  });
 }
 
 // --- images
@@ -543,6 +617,13 @@ class C {
   }
   C& Preview(const std::string& args = kPreview) {
     c_.tool = "lumislab-preview";
+    c_.args = args;
+    c_.input = Input::kSlab;
+    return *this;
+  }
+  // lumislab-export (args from the subcommand on), on the complete 40x40 slab.
+  C& Export(const std::string& args) {
+    c_.tool = "lumislab-export";
     c_.args = args;
     c_.input = Input::kSlab;
     return *this;
@@ -1754,10 +1835,247 @@ std::vector<Case> RadiometricCases() {
   return v;
 }
 
+// lumislab-export (docs/design.md §7.8) and the files of the lighting industry it reads and
+// writes (§5.17), and the scene's measured emitters (`distribution`, §5.10), which read the same
+// IES / EULUMDAT files. Every refusal names the file (or the option) and the field, and writes
+// nothing at --out.
+std::vector<Case> PhotometryCases() {
+  std::vector<Case> v;
+  // info on a bad file: IES, EULUMDAT (anything not IES nor TM-25) and TM-25.
+  auto I = [](const std::string& name, const std::string& file) {
+    return C("export_info_" + name).Export("info " + file + " --json");
+  };
+  v.push_back(I("missing", "nothere.ies").Names({"nothere.ies"}));
+  v.push_back(I("empty", "bad.ies").Do(WriteText("bad.ies", "")).Names({"bad.ies"}));
+  v.push_back(I("is_a_folder", "bad.ies").Do(MakeFolder("bad.ies")).Names({"bad.ies"}));
+  v.push_back(
+      I("binary_garbage", "bad.ies").Do(WriteText("bad.ies", Garbage())).Names({"bad.ies"}));
+  v.push_back(I("ies_truncated", "bad.ies")
+                  .Do(RealIes("bad.ies", "", "", 0.8))
+                  .Names({"bad.ies", "vertical x 1 horizontal angles need"}));
+  v.push_back(I("ies_cut_before_tilt", "bad.ies")
+                  .Do(RealIes("bad.ies", "", "", 0.3))
+                  .Names({"bad.ies", "TILT="}));
+  v.push_back(I("ies_nan_candela", "bad.ies")
+                  .Do(RealIes("bad.ies", " 102 90", " nan 90"))
+                  .Names({"bad.ies", "candela value 21 of horizontal angle 1"}));
+  v.push_back(I("ies_huge_candela", "bad.ies")
+                  .Do(RealIes("bad.ies", " 102 90", " 1e999 90"))
+                  .Names({"bad.ies", "candela value 21"}));
+  v.push_back(I("ies_negative_candela", "bad.ies")
+                  .Do(RealIes("bad.ies", " 102 90", " -102 90"))
+                  .Names({"bad.ies", "intensity at C 0, gamma 50"}));
+  v.push_back(I("ies_counts_huge", "bad.ies")
+                  .Do(RealIes("bad.ies", "24 -1 1 37 1", "24 -1 1 100000 100000"))
+                  .Names({"bad.ies", "100000 vertical x 100000 horizontal"}));
+  v.push_back(I("ies_counts_over_limit", "bad.ies")
+                  .Do(RealIes("bad.ies", "24 -1 1 37 1", "24 -1 1 1e12 1"))
+                  .Names({"bad.ies", "number of vertical angles"}));
+  v.push_back(I("ies_angles_out_of_order", "bad.ies")
+                  .Do(RealIes("bad.ies", "0 2.5 5 7.5", "0 5 2.5 7.5"))
+                  .Names({"bad.ies", "vertical angle 3"}));
+  v.push_back(I("ies_tilt_file", "bad.ies")
+                  .Do(RealIes("bad.ies", "TILT=NONE", "TILT=lamp.tlt"))
+                  .Names({"bad.ies", "TILT=lamp.tlt"}));
+  v.push_back(I("ies_type_b", "bad.ies")
+                  .Do(RealIes("bad.ies", "37 1 1 1 -0.45", "37 1 2 1 -0.45"))
+                  .Names({"bad.ies", "photometric type B"}));
+  v.push_back(I("ldt_isym_9", "bad.ldt").Do(Ldt("bad.ldt", {{3, "9"}})).Names({"bad.ldt", "Isym"}));
+  v.push_back(
+      I("ldt_lamp_flux_zero", "bad.ldt").Do(Ldt("bad.ldt", {{29, "0"}})).Names({"bad.ldt", "26c"}));
+  v.push_back(I("ldt_nan_intensity", "bad.ldt")
+                  .Do(Ldt("bad.ldt", {{48, "nan"}}))
+                  .Names({"bad.ldt", "intensity 2 of C plane 0"}));
+  v.push_back(I("ldt_truncated", "bad.ldt")
+                  .Do(Ldt("bad.ldt"))
+                  .Do(Truncate("bad.ldt", 0.9))
+                  .Names({"bad.ldt", "truncated"}));
+  v.push_back(I("tm25_ray_count_too_high", "bad.ray")
+                  .Do(Tm25("bad.ray", 5, 3))
+                  .Names({"bad.ray", "number of rays", "the header says 5 rays"}));
+  v.push_back(I("tm25_ray_count_huge", "bad.ray")
+                  .Do(Tm25("bad.ray", uint64_t(1) << 62, 3))
+                  .Names({"bad.ray", "number of rays"}));
+  v.push_back(I("tm25_partial_ray", "bad.ray")
+                  .Do(Tm25("bad.ray", 3, 3))
+                  .Do(Truncate("bad.ray", 0.9995))
+                  .Names({"bad.ray", "number of rays", "a partial one"}));
+  v.push_back(I("tm25_nan_ray", "bad.ray")
+                  .Do(Tm25("bad.ray", 3, 3, 1))
+                  .Names({"bad.ray", "ray 1, value 1", "finite"}));
+  v.push_back(I("tm25_version", "bad.ray")
+                  .Do(Tm25("bad.ray", 3, 3, -1, 2014))
+                  .Names({"bad.ray", "version"}));
+  v.push_back(I("tm25_header_only", "bad.ray")
+                  .Do(Tm25("bad.ray", 3, 3))
+                  .Do(Truncate("bad.ray", 0.5))
+                  .Names({"bad.ray", "truncated"}));
+  // ies / ldt / tm25 from the slab: bad flags, a bad slab, an output that cannot be written.
+  const std::string keywords = " --test T1 --lab L --manufacturer M";
+  auto F = [&](const std::string& format, const std::string& name, const std::string& flags) {
+    const std::string out = "x." + format;
+    return C("export_" + format + "_" + name)
+        .Export(format + " --slab ds --out " + out + (format == "ies" ? keywords : "") + " " +
+                flags)
+        .MustNotExist(out);
+  };
+  for (const std::string format : {"ies", "ldt"}) {
+    v.push_back(F(format, "c_step_negative", "--c-step -5").Names({"--c-step"}));
+    v.push_back(F(format, "c_step_zero", "--c-step 0").Names({"--c-step"}));
+    v.push_back(F(format, "c_step_not_dividing", "--c-step 7").Names({"--c-step", "divides"}));
+    v.push_back(F(format, "c_step_nan", "--c-step nan").Names({"--c-step"}));
+    v.push_back(F(format, "gamma_step_above_90", "--gamma-step 100").Names({"--gamma-step"}));
+    v.push_back(F(format, "c_angles_decreasing", "--c-angles 0,90,45")
+                    .Names({"--c-angles", "horizontal angle 3"}));
+    v.push_back(F(format, "gamma_angles_above_180", "--gamma-angles 0,90,200")
+                    .Names({"--gamma-angles", "vertical angle 3"}));
+    v.push_back(F(format, "samples_zero", "--samples 0").Names({"--samples"}));
+    v.push_back(F(format, "opening_two_values", "--opening-mm 10,20").Names({"--opening-mm"}));
+    v.push_back(F(format, "opening_nan", "--opening-mm nan,20,0").Names({"--opening-mm"}));
+  }
+  v.push_back(F("ies", "no_test_keyword", "")
+                  .Args("ies --slab ds --out x.ies --lab L --manufacturer M")
+                  .Names({"x.ies", "[TEST]"}));
+  v.push_back(
+      F("ies", "metadata_missing", "--metadata meta.json").Names({"meta.json", "not found"}));
+  v.push_back(F("ies", "metadata_not_json", "--metadata meta.json")
+                  .Do(WriteText("meta.json", "{\"test\": "))
+                  .Names({"meta.json", "not valid JSON"}));
+  v.push_back(F("ies", "metadata_unknown_member", "--metadata meta.json")
+                  .Do(WriteText("meta.json", "{\"schema_version\": 1, \"colour\": \"red\"}"))
+                  .Names({"meta.json", "colour"}));
+  v.push_back(
+      F("ies", "metadata_keyword_lower_case", "--metadata meta.json")
+          .Do(WriteText("meta.json", "{\"schema_version\": 1, \"keywords\": {\"bad\": \"x\"}}"))
+          .Names({"meta.json", "keywords.bad"}));
+  v.push_back(F("ies", "slab_missing", "")
+                  .Args("ies --slab nowhere --out x.ies" + keywords)
+                  .Names({"nowhere", "no slab.json"}));
+  v.push_back(F("ies", "slab_partial", "")
+                  .Do(SetJson(kSlabJson, "/present", {{0, 0}}))
+                  .Names({kSlabJson, "present"}));
+  v.push_back(
+      F("ldt", "slab_exr_nan", "")
+          .Do(ExrPoison("ds/slab/pos_1_0.exr", "R", std::numeric_limits<float>::quiet_NaN()))
+          .Names({"ds/slab/pos_1_0.exr"}));
+  v.push_back(C("export_ies_out_folder_missing")
+                  .Export("ies --slab ds --out nodir/x.ies" + keywords)
+                  .Exit(3)
+                  .Names({"nodir/x.ies", "cannot"}));
+  v.push_back(C("export_ldt_out_is_a_folder")
+                  .Export("ldt --slab ds --out x.ldt --force")
+                  .Do(MakeFolder("x.ldt"))
+                  .Exit(3)
+                  .Names({"x.ldt", "cannot"}));
+  auto T = [](const std::string& name, const std::string& flags) {
+    return C("export_tm25_" + name)
+        .Export("tm25 --slab ds --out x.ray " + flags)
+        .MustNotExist("x.ray");
+  };
+  v.push_back(T("rays_zero", "--rays 0").Names({"--rays"}));
+  v.push_back(T("rays_negative", "--rays -10").Names({"--rays"}));
+  v.push_back(T("rays_above_limit", "--rays 1000000000").Names({"--rays"}));
+  v.push_back(T("rays_text", "--rays many").Names({"--rays"}));
+  v.push_back(T("seed_negative", "--seed -1").Names({"--seed", "expected an integer >= 0"}));
+  v.push_back(T("slab_partial", "")
+                  .Do(SetJson(kSlabJson, "/present", {{0, 0}}))
+                  .Names({kSlabJson, "present"}));
+  v.push_back(C("export_tm25_out_folder_missing")
+                  .Export("tm25 --slab ds --out nodir/x.ray --rays 10")
+                  .Exit(3)
+                  .Names({"nodir/x.ray", "cannot"}));
+  // irradiance and polar (§4.9).
+  auto P = [](const std::string& cmd, const std::string& name, const std::string& flags,
+              const std::string& out) {
+    return C("export_" + cmd + "_" + name)
+        .Export(cmd + " --slab ds/slab --out " + out + " " + flags)
+        .MustNotExist(out);
+  };
+  v.push_back(
+      P("irradiance", "distance_zero", "--distance-mm 0", "i.png").Names({"--distance-mm"}));
+  v.push_back(
+      P("irradiance", "distance_nan", "--distance-mm nan", "i.png").Names({"--distance-mm"}));
+  v.push_back(P("irradiance", "extent_negative", "--distance-mm 1000 --extent-mm -5", "i.png")
+                  .Names({"--extent-mm"}));
+  v.push_back(
+      P("irradiance", "size_huge", "--distance-mm 1000 --size 100000", "i.png").Names({"--size"}));
+  v.push_back(
+      P("irradiance", "range_bad", "--distance-mm 1000 --range 5,1", "i.png").Names({"--range"}));
+  v.push_back(P("irradiance", "range_reversed", "--distance-mm 1000 --range 5:1", "i.png")
+                  .Names({"--range"}));
+  v.push_back(P("irradiance", "out_bmp", "--distance-mm 1000", "i.bmp").Names({"i.bmp", "--out"}));
+  v.push_back(P("polar", "gamma_step_zero", "--gamma-step 0", "p.svg").Names({"--gamma-step"}));
+  v.push_back(P("polar", "size_10", "--size 10", "p.svg").Names({"--size"}));
+  v.push_back(P("polar", "out_txt", "", "p.txt").Names({"p.txt", "--out"}));
+  v.push_back(P("polar", "slab_partial", "", "p.svg")
+                  .Do(SetJson(kSlabJson, "/present", {{0, 0}}))
+                  .Names({kSlabJson, "present"}));
+  v.push_back(P("irradiance", "slab_partial", "--distance-mm 1000", "i.png")
+                  .Do(SetJson(kSlabJson, "/present", {{0, 0}, {1, 1}}))
+                  .Names({kSlabJson, "present"}));
+  v.push_back(C("export_irradiance_out_folder_missing")
+                  .Export("irradiance --slab ds/slab --distance-mm 1000 --out nodir/i.png")
+                  .Exit(3)
+                  .Names({"nodir/i.png", "cannot"}));
+  v.push_back(C("cli_export_unknown_subcommand").Export("pdf --slab ds").Names({"pdf"}));
+  v.push_back(C("cli_export_unknown_option").Export("info x.ies --bogus").Names({"--bogus"}));
+  v.push_back(C("cli_export_no_subcommand").Export("").Names({"subcommand"}));
+  // The scene's measured emitters: the same readers behind lumislab-acquire synth.
+  auto S = [](const std::string& name) { return C("scene_distribution_" + name).Synth(); };
+  v.push_back(S("missing_file").Do(SceneDistribution("nothere.ies")).Names({"nothere.ies"}));
+  v.push_back(S("truncated_ies")
+                  .Do(SceneDistribution("lamp.ies"))
+                  .Do(RealIes("lamp.ies", "", "", 0.8))
+                  .Names({"lamp.ies", "vertical x 1 horizontal angles need"}));
+  v.push_back(S("nan_candela")
+                  .Do(SceneDistribution("lamp.ies"))
+                  .Do(RealIes("lamp.ies", " 102 90", " nan 90"))
+                  .Names({"lamp.ies", "candela value 21"}));
+  v.push_back(S("all_zero")
+                  .Do(SceneDistribution("lamp.ldt"))
+                  .Do(Ldt("lamp.ldt", {{47, "0"}, {48, "0"}}))
+                  .Names({"lamp.ldt", "no light"}));
+  v.push_back(S("ldt_isym_9")
+                  .Do(SceneDistribution("lamp.ldt"))
+                  .Do(Ldt("lamp.ldt", {{3, "9"}}))
+                  .Names({"lamp.ldt", "Isym"}));
+  v.push_back(S("tm25_file")
+                  .Do(SceneDistribution("lamp.ray"))
+                  .Do(Tm25("lamp.ray", 3, 3))
+                  .Names({"lamp.ray"}));
+  v.push_back(S("is_a_folder")
+                  .Do(SceneDistribution("lamp.ies"))
+                  .Do(MakeFolder("lamp.ies"))
+                  .Names({"lamp.ies"}));
+  v.push_back(S("and_lobe")
+                  .Do(SceneDistribution("lamp.ies"))
+                  .Do(RealIes("lamp.ies"))
+                  .Do(SetJson(kSceneFile, "/luminaire/emitters/0/lobe_exponent", 4))
+                  .Names({kSceneFile, "luminaire.emitters[0]"}));
+  v.push_back(S("rotation_huge")
+                  .Do(SceneDistribution("lamp.ies", {{"rotation_deg", {0, 1e9, 0}}}))
+                  .Do(RealIes("lamp.ies"))
+                  .Names({kSceneFile, "rotation_deg"}));
+  v.push_back(S("rotation_two_values")
+                  .Do(SceneDistribution("lamp.ies", {{"rotation_deg", {0, 90}}}))
+                  .Do(RealIes("lamp.ies"))
+                  .Names({kSceneFile, "rotation_deg"}));
+  v.push_back(S("unknown_member")
+                  .Do(SceneDistribution("lamp.ies", {{"scale", 2}}))
+                  .Do(RealIes("lamp.ies"))
+                  .Names({kSceneFile, "distribution.scale"}));
+  v.push_back(S("file_not_a_string")
+                  .Do(SetJson(kSceneFile, "/luminaire/emitters/0/distribution", {{"file", 7}}))
+                  .Do(EraseJson(kSceneFile, "/luminaire/emitters/0/lobe_exponent"))
+                  .Names({kSceneFile, "distribution.file"}));
+  return v;
+}
+
 std::vector<Case> AllCases() {
   std::vector<Case> all;
-  for (auto part : {DatasetCases(), ScreenCalibrationCases(), PhotoCases(), SceneCases(),
-                    CommandLineCases(), SlabCases(), MoreCases(), RadiometricCases()})
+  for (auto part :
+       {DatasetCases(), ScreenCalibrationCases(), PhotoCases(), SceneCases(), CommandLineCases(),
+        SlabCases(), MoreCases(), RadiometricCases(), PhotometryCases()})
     all.insert(all.end(), part.begin(), part.end());
   return all;
 }
@@ -1854,15 +2172,15 @@ TEST_P(Catalogue, Refuses) {
                                 << r.output;
 }
 
-// The table covers the four tools, each with cases of its own; prints the counts.
-TEST(CatalogueTable, CoversTheFourTools) {
+// The table covers the five tools, each with cases of its own; prints the counts.
+TEST(CatalogueTable, CoversTheFiveTools) {
   std::map<std::string, int> by_tool;
   const std::vector<Case> all = AllCases();
   for (const Case& c : all) ++by_tool[c.tool];
   for (const auto& [tool, n] : by_tool) std::printf("%s: %d cases\n", tool.c_str(), n);
   EXPECT_GE(all.size(), 100u);
-  for (const char* tool :
-       {"lumislab-acquire", "lumislab-calibrate", "lumislab-reconstruct", "lumislab-preview"})
+  for (const char* tool : {"lumislab-acquire", "lumislab-calibrate", "lumislab-reconstruct",
+                           "lumislab-preview", "lumislab-export"})
     EXPECT_GE(by_tool[tool], 10) << tool;
 }
 

@@ -6,11 +6,13 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "lib/photometry/eulumdat.h"
+#include "lib/photometry/file_info.h"
 #include "lib/photometry/ies.h"
 #include "lib/photometry/intensity_distribution.h"
 
@@ -315,6 +317,78 @@ TEST(Ies, MutatedFilesAreReadOrRefused) {
       }
     }
   }
+}
+
+// Found by fuzz/fuzz_ies's invariants (the inputs are in fuzz/corpus/fuzz_ies/regression_*):
+// values near the largest double, each finite, whose total flux overflows to inf (lumislab-export
+// info printed "flux: inf" and a scene emitter's lobe would have been inf / inf), and angles
+// closer than the writers printed (8 digits: 179.000002 and 179.000004 both "179"), which
+// FormatIes wrote into a file ParseIes refused.
+TEST(IntensityDistribution, FuzzFindingsFluxOverflowAndCloseAngles) {
+  const std::string head = "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 4 1 1 2 0 0 0\n1 1 0\n";
+  auto [code, message] =
+      Thrown([&] { ParseIes(head + "0 45 90 180\n0\n1e308 1e308 1e308 0\n", "big.ies"); });
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(message.find("big.ies: intensity values: expected values whose total flux is a finite"),
+            std::string::npos)
+      << message;
+  // 1e308 feet of luminous width is inf mm, which FormatIes wrote as "inf".
+  std::tie(code, message) = Thrown([&] {
+    ParseIes("IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 1 1 1e308 0 0\n1 1 0\n0 45 90\n0\n1 1 1\n",
+             "wide.ies");
+  });
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(message.find("wide.ies: luminous width: expected a finite size (mm), got inf"),
+            std::string::npos)
+      << message;
+  std::tie(code, message) =
+      Thrown([&] { ParseIes(head + "0 90 90.0000001 180\n0\n1 1 1 1\n", "close.ies"); });
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(message.find("close.ies: vertical angle 3: expected more than the one before (90 deg "
+                         "by over 1e-06 deg), got 90.0000001"),
+            std::string::npos)
+      << message;
+  // 2e-6 degrees apart: read, and written back with the same angles by both writers.
+  IntensityDistribution d = ParseIes(head + "0 179.000002 179.000004 180\n0\n4 3 2 1\n", "a.ies");
+  for (const char* key : kIesRequiredKeywords) d.keywords.push_back({key, "x"});
+  ExpectSameDistribution(d, ParseIes(FormatIes(d, {}, "b.ies"), "b.ies"), "IES");
+  ExpectSameDistribution(d, ParseEulumdat(FormatEulumdat(d, "b.ldt"), "b.ldt"), "EULUMDAT");
+  EXPECT_NEAR(ParseIes(FormatIes(d, {}, "b.ies"), "b.ies").gamma_deg[2], 179.000004, 1e-12);
+}
+
+// Found by fuzz/fuzz_eulumdat's round trip (inputs in fuzz/corpus/fuzz_eulumdat/regression_*): a
+// grid whose end plane lies within the 1e-6 degree tolerance of a symmetry plane but not on it
+// got its mirror image written as a second plane a hair away (the reader then counted one plane
+// too many and refused the file), and a first plane at -5e-7 was written as 359.9999995.
+TEST(Eulumdat, FuzzFindingsEndPlanesNearASymmetryPlane) {
+  for (const std::vector<double>& c :
+       std::vector<std::vector<double>>{{0, 45, 89.9999991},
+                                        {-9e-7, 45, 90.0000009},
+                                        {90.0000009, 180, 269.9999991},
+                                        {0, 90, 179.9999991},
+                                        {-5e-7, 90, 180, 270}}) {
+    const IntensityDistribution d = Analytic(c, [](double c_deg) { return 1 + c_deg / 360; });
+    const IntensityDistribution back = ParseEulumdat(FormatEulumdat(d, "q.ldt"), "q.ldt");
+    ExpectSameDistribution(d, back,
+                           "C " + std::to_string(c.front()) + " to " + std::to_string(c.back()));
+  }
+}
+
+// lumislab-export info --json on a file whose text is not UTF-8 (an ISO-8859-1 maker's name, as
+// European IES files have): nlohmann's dump threw type_error 316, exit 1 ("failure") for a good
+// file. The description replaces the bytes (U+FFFD) and keeps the rest (found by reading
+// export/formats_cli.cc for fuzz_photometry_info, which checks that the JSON parses back).
+TEST(FileInfo, TextThatIsNotUtf8IsReplacedInTheJson) {
+  const std::string path = ::testing::TempDir() + "/latin1.ies";
+  WriteTextAtomically(path, Replace(ReadText(DataPath("7.ies")), "[MANUFAC]RAB LIGHTING",
+                                    "[MANUFAC]Lichttechnik M\xfcller"));
+  const nlohmann::json info = PhotometricFileInfo(path);
+  const nlohmann::json back = nlohmann::json::parse(FormatPhotometricFileInfo(info, true));
+  EXPECT_EQ(back["format"], "IES LM-63-2002");
+  EXPECT_EQ(back["keywords"]["MANUFAC"], "Lichttechnik M\xef\xbf\xbdller, INC.");
+  EXPECT_NEAR(back["flux"].get<double>(), 531.98, 0.005 * 531.98);
+  EXPECT_NE(FormatPhotometricFileInfo(info, false).find("[MANUFAC] Lichttechnik M\xfcller"),
+            std::string::npos);
 }
 
 }  // namespace

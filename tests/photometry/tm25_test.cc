@@ -151,5 +151,36 @@ TEST(Tm25, BadInputNamesTheFileAndTheField) {
   }
 }
 
+// Found by fuzz/fuzz_tm25 (fuzz/corpus/fuzz_tm25/regression_text_block_2gib.ray): a header that
+// says its text block (4.7.1.15) holds 2^31 - 32 bytes made the reader allocate a 2 GiB buffer
+// before finding the file short. Now every size from the header is checked against the file
+// first: exit 2 naming the field, and no allocation (this test runs under ASan's allocation
+// limit in the sanitized build too). The same for 1024 additional column names.
+TEST(Tm25, HeaderSizesAreCheckedAgainstTheFileBeforeUse) {
+  const std::string path = TempPath("sizes.ray");
+  WriteTm25(RandomRays(3, true), path);
+  const std::string good = Bytes(path);
+  std::string text = good, columns = good;
+  Set<int32_t>(&text, 84, 0x7fffffe0);
+  Set<int32_t>(&columns, 80, 1024);
+  for (const auto& [bytes, expected] : std::vector<std::pair<std::string, std::string>>{
+           // The size needed is in the message: it was checked before anything was read.
+           {text,
+            "additional text block (4.7.6): the file ends before it (truncated: 36372 "
+            "bytes, 2147483616 needed from byte 36288)"},
+           {columns,
+            "additional column name 1 (4.7.5): the file ends before it (truncated: "
+            "36372 bytes, 512 needed from byte 36288)"}}) {
+    Write(path, bytes);
+    try {
+      ReadTm25(path);
+      ADD_FAILURE() << expected << ": read";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.exit_code(), 2) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path + ": " + expected), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace lumislab

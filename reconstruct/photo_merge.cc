@@ -231,7 +231,7 @@ struct Exposure {
         for (int c = 0; c < codes.pixels.channels(); ++c) {
           const int i = v * codes.pixels.channels() + c;
           if (photo.fractional_codes)
-            codes.pixels.ptr<float>(0)[i] = float(v);
+            codes.pixels.ptr<uint16_t>(0)[i] = uint16_t(v * kFractionalCodeOne);
           else
             codes.pixels.ptr<uint8_t>(0)[i] = uint8_t(v);
         }
@@ -342,15 +342,9 @@ void ReadCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict u
 // A JPEG's fractional codes (RGB order) through the same tables, read linearly between codes;
 // NaN (clipped) when the next whole code up is, as LinearReader has it:
 void ReadFractionalCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
-  const float* __restrict row = e.source->pixels.ptr<float>(y) + 3 * x0;
+  const uint16_t* __restrict row = e.source->pixels.ptr<uint16_t>(y) + 3 * x0;
   for (int x = 0; x < pixels; ++x, row += 3, uk += 3)
-    for (int c = 0; c < 3; ++c) {
-      const float code = row[c];
-      const int k = int(code);
-      const float f = code - float(k);
-      const float* t = e.code_u.data() + c * 256 + k;
-      uk[c] = f > 0 ? t[0] + f * (t[1] - t[0]) : t[0];  // k < 255 whenever f > 0
-    }
+    for (int c = 0; c < 3; ++c) uk[c] = ReadBetweenCodes(e.code_u.data() + c * 256, row[c]);
 }
 
 // Any other photo (calib/'s dark map, hot pixels or flat field), pixel by pixel:

@@ -22,7 +22,9 @@ double BrightestCodes(const std::vector<DecodedPhoto>& photos) {
   double brightest = -1;
   for (const auto& p : photos) {
     const int depth = p.photo.pixels.depth();
-    if ((depth != CV_8U && depth != CV_16U) || p.photo.transfer != Transfer::kLinear) return -1;
+    if ((depth != CV_8U && depth != CV_16U) || p.photo.fractional_codes ||
+        p.photo.transfer != Transfer::kLinear)
+      return -1;
     double lo = 0, hi = 0;
     cv::minMaxLoc(p.photo.pixels.reshape(1), &lo, &hi);
     brightest = std::max(brightest, hi - p.photo.spec.black_level * p.photo.CodeMax());

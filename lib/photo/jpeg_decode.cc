@@ -127,21 +127,24 @@ cv::Mat DecodeJpegFractional(const std::string& path) {
   info.out_color_space = JCS_YCbCr;  // libjpeg's inverse DCT and upsampling, no conversion
   jpeg_start_decompress(&info);
   const int w = int(info.output_width), h = int(info.output_height);
-  out.create(h, w, CV_32FC3);
+  out = NewPhotoImage(h, w, CV_16UC3);
   row.resize(size_t(w) * 3);
+  // Code x 256, rounded: the fixed point of Photo::fractional_codes.
+  const float one = float(kFractionalCodeOne), top = 255.f * one;
+  auto fixed = [&](float code) {
+    return uint16_t(std::min(top, std::max(0.f, code * one)) + 0.5f);
+  };
   while (info.output_scanline < info.output_height) {
     JSAMPLE* rows[1] = {row.data()};
     const int y = int(info.output_scanline);
     jpeg_read_scanlines(&info, rows, 1);
-    float* rgb = out.ptr<float>(y);
+    uint16_t* rgb = out.ptr<uint16_t>(y);
     // JFIF's conversion (ITU-R BT.601 full range), which libjpeg's integer tables round.
     for (int x = 0; x < w; ++x) {
       const float luma = row[3 * x], cb = row[3 * x + 1] - 128.f, cr = row[3 * x + 2] - 128.f;
-      const float r = luma + 1.402f * cr, g = luma - 0.34413629f * cb - 0.71413629f * cr,
-                  b = luma + 1.772f * cb;
-      rgb[3 * x] = std::min(255.f, std::max(0.f, r));
-      rgb[3 * x + 1] = std::min(255.f, std::max(0.f, g));
-      rgb[3 * x + 2] = std::min(255.f, std::max(0.f, b));
+      rgb[3 * x] = fixed(luma + 1.402f * cr);
+      rgb[3 * x + 1] = fixed(luma - 0.34413629f * cb - 0.71413629f * cr);
+      rgb[3 * x + 2] = fixed(luma + 1.772f * cb);
     }
   }
   jpeg_finish_decompress(&info);

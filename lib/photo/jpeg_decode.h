@@ -13,11 +13,11 @@
 namespace lumislab {
 
 // Decodes a baseline or progressive JPEG whose components are YCbCr (JFIF, or EXIF without an
-// Adobe transform) into CV_32FC3 in RGB order holding codes in [0, 255] with their fractions, in
-// the orientation its EXIF Orientation tag gives (as OpenCV's imread shows it). Returns an empty
-// Mat for a JPEG of any other colour space (grayscale, CMYK, RGB): those store codes directly and
-// go through OpenCV. A corrupt or truncated file, or one larger than kMaxPhotoPixels, is BadInput
-// naming the file.
+// Adobe transform) into CV_16UC3 in RGB order holding codes in [0, 255] with their fractions
+// (Photo::fractional_codes: code x kFractionalCodeOne, rounded to 1/256 code), in the orientation
+// its EXIF Orientation tag gives (as OpenCV's imread shows it). Returns an empty Mat for a JPEG of
+// any other colour space (grayscale, CMYK, RGB): those store codes directly and go through OpenCV.
+// A corrupt or truncated file, or one larger than kMaxPhotoPixels, is BadInput naming the file.
 cv::Mat DecodeJpegFractional(const std::string& path);
 
 }  // namespace lumislab

@@ -1,7 +1,10 @@
 #include "lib/photo/photo_io.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +28,52 @@ double LinearToSrgb(double v) {
   v = std::clamp(v, 0.0, 1.0);
   return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
 }
+
+// cv::Mat's standard allocator (OpenCV's StdMatAllocator), except that a buffer of 4 MB or more
+// is aligned to 2 MB and marked for transparent huge pages. Buffers are freed with std::free.
+class HugePageAllocator : public cv::MatAllocator {
+ public:
+  cv::UMatData* allocate(int dims, const int* sizes, int type, void* data0, size_t* step,
+                         cv::AccessFlag, cv::UMatUsageFlags) const override {
+    size_t total = CV_ELEM_SIZE(type);
+    for (int i = dims - 1; i >= 0; --i) {
+      if (step) {
+        if (data0 && step[i] != cv::Mat::AUTO_STEP) {
+          CV_Assert(total <= step[i]);
+          total = step[i];
+        } else {
+          step[i] = total;
+        }
+      }
+      total *= size_t(sizes[i]);
+    }
+    void* data = data0;
+    if (!data) {
+      constexpr size_t kHuge = size_t(2) << 20;
+      const bool huge = total >= 2 * kHuge;
+      if (posix_memalign(&data, huge ? kHuge : 64, std::max<size_t>(total, 1)) != 0)
+        throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+      // Advice only: where the kernel has no THP the pages stay 4 kB.
+      if (huge) madvise(data, total / kHuge * kHuge, MADV_HUGEPAGE);
+#endif
+    }
+    auto* u = new cv::UMatData(this);
+    u->data = u->origdata = static_cast<uchar*>(data);
+    u->size = total;
+    if (data0) u->flags |= cv::UMatData::USER_ALLOCATED;
+    return u;
+  }
+  bool allocate(cv::UMatData* u, cv::AccessFlag, cv::UMatUsageFlags) const override {
+    return u != nullptr;
+  }
+  void deallocate(cv::UMatData* u) const override {
+    if (!u) return;
+    CV_Assert(u->urefcount == 0 && u->refcount == 0);
+    if (!(u->flags & cv::UMatData::USER_ALLOCATED)) std::free(u->origdata);
+    delete u;
+  }
+};
 
 cv::Mat DecodeWithOpenCv(const std::string& path) {
   cv::Mat pixels;
@@ -226,6 +275,17 @@ double Photo::SaturationCode() const {
   return std::ceil(spec.saturation_level * CodeMax() - 1e-9);
 }
 
+cv::Mat NewPhotoImage(int rows, int cols, int type) {
+  static HugePageAllocator allocator;  // never destroyed before the images it allocated
+  cv::Mat image;
+  image.allocator = &allocator;
+  image.create(rows, cols, type);
+  // Later create() calls on this Mat (or its copies) would keep the allocator: only the
+  // buffer is ours.
+  image.allocator = nullptr;
+  return image;
+}
+
 Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
   spec.Check(path);
   Photo photo;
@@ -316,11 +376,9 @@ void LinearReader::Read(int y, int x, float rgb[3], bool clipped[3]) const {
     if (photo_.fractional_codes) {
       // Between two codes the curve is read linearly; the code counts as clipped when the next
       // whole code up does (the merge's code tables have the same rule).
-      const float code = m.ptr<float>(y)[size_t(x) * channels_ + offsets[c]];
-      const int k = int(code);
-      const float f = code - float(k);
-      v = curve8_[c][k] + f * (curve8_[c][k + 1] - curve8_[c][k]);
-      clipped[c] = !(curve8_[c][k + (f > 0)] < saturation_);
+      const uint16_t code = m.ptr<uint16_t>(y)[size_t(x) * channels_ + offsets[c]];
+      v = ReadBetweenCodes(curve8_[c], code);
+      clipped[c] = !(curve8_[c][CodeAtOrAbove(code)] < saturation_);
     } else if (m.depth() == CV_32F) {
       v = m.ptr<float>(y)[size_t(x) * channels_ + offsets[c]];
     } else if (m.depth() == CV_16U) {
@@ -379,7 +437,7 @@ cv::Mat Codes8(const Photo& photo) {
   LUMISLAB_CHECK(photo.EightBitCodes(), "Codes8: a photo of 8-bit codes");
   if (!photo.fractional_codes) return photo.pixels;
   cv::Mat codes;
-  photo.pixels.convertTo(codes, CV_8U);  // rounds to the nearest code
+  photo.pixels.convertTo(codes, CV_8U, 1.0 / kFractionalCodeOne);  // the nearest code
   return codes;
 }
 

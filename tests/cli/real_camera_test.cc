@@ -247,6 +247,11 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
     const double lo = std::max(0.0, s - 1e-5), hi = std::min(1.0, s + 1e-5);
     return (hi - lo) / 255 / (response.Curve(hi) - response.Curve(lo));
   };
+  // The JPEG coding at the effect's quality (tests/cli/noise_floor.h, JpegCodingModel): what
+  // the quantiser, the roundings of Y, Cb, Cr and the 4:2:0 chroma leave of the photos' noise
+  // and add to it.
+  sensor.jpeg_quality = 95;
+  sensor.code_of = [response](double s) { return 255 * response.Curve(std::clamp(s, 0.0, 1.0)); };
   // The decoder takes a linear value >= 0.95 as clipped: the codes from the first whose value
   // through the curve reaches it, i.e. sensor values from halfway below that code.
   int first_clipped = 0;
@@ -254,18 +259,20 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   sensor.saturation = response.Inverse((first_clipped - 0.5) / 255);
   const testing::NoiseFloor floor = CompareWithNoiseFloor("ds_noisy", noisy, sensor);
   // Issue 8 asks for 1 % per position and 1.5x the noise floor. Measured: 0.77 % overall,
-  // 0.90 % worst position (2,2), 1.62x the floor of 0.47 % (docs/design.md §5.16). The curve
-  // that calibrate response recovers is within 0.4 % RMS of the true one and gives what the true
-  // curve gives; the decoder keeps the fractions of JPEG's YCbCr -> RGB conversion (0.87 % /
-  // 1.02 % when it rounded them). What is left above the floor is JPEG's coding, which the floor
-  // leaves out (quality 100, 4:4:4: 0.72 % / 0.88 % even with the rounded conversion).
-  // The issue's 1 % per position; 0.85 % overall and 1.8x the floor so that a regression shows.
+  // 0.90 % worst position (2,2); the floor with JPEG's coding 0.79 % (0.74 - 0.97 % per
+  // position): ratio 0.97 (0.91 - 1.07 per position). Without the coding in the floor (sensor
+  // noise and one rounding of the curve's output) it was 0.47 %, ratio 1.62 (docs/design.md
+  // §5.16). The recovered curve gives what the true curve gives; the decoder keeps the
+  // fractions of JPEG's YCbCr -> RGB conversion (0.87 % / 1.02 % when it rounded them).
+  // The issue's 1 % per position; 0.85 % overall so that a regression shows.
   for (const auto& p : noisy.positions)
     EXPECT_LE(p.relative_l2, 0.01) << "position " << p.i << "," << p.j;
   EXPECT_LE(noisy.overall_relative_l2, 0.0085);
-  EXPECT_LE(noisy.overall_relative_l2, 1.8 * floor.overall);
-  // The noise is there: not below its floor.
-  EXPECT_GE(noisy.overall_relative_l2, floor.overall);
+  EXPECT_LE(noisy.overall_relative_l2, 1.5 * floor.overall);
+  // The floor is a prediction, not a bound (the quantiser removes some of the noise, and the
+  // coding model is good to about 15 % on a known picture: tests/cli/jpeg_coding_noise_test.cc):
+  // the error is not below it by more than the model's tolerance there.
+  EXPECT_GE(noisy.overall_relative_l2, floor.overall / 1.25);
 }
 
 // The same lab with a RAW camera: 14-bit RGGB DNG mosaics (linear; no response step), with

@@ -90,6 +90,20 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
                "also render with the other accumulation format and report the difference");
   app.add_option("--shadow-size", config.shadow_size, "shadow-map size")->capture_default_str();
   app.add_flag("--shadow-pcf", config.shadow_pcf, "2x2 filtered shadow-map lookups");
+  app.add_option("--shadow-share", config.shadow_share,
+                 "share one shadow map among g x g neighbouring positions, g the largest whose "
+                 "shadow edges move by at most this many shadow texels (0: off)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--merge-group", config.merge_group,
+                 "merge blocks of N x N positions into one light for distant receivers (1: off)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  app.add_option("--merge-error", config.merge_error,
+                 "--merge-group: error bound of a merged light, relative to its block's peak "
+                 "(sets the depth beyond which it is used)")
+      ->check(CLI::Range(1e-6, 100.0))
+      ->capture_default_str();
 }
 
 void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -189,7 +203,9 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
                                       {config.bench, "--bench"},
                                       {config.srgbe, "--srgbe"},
                                       {config.report_srgbe_error, "--srgbe-error"},
-                                      {config.shadow_pcf, "--shadow-pcf"}})
+                                      {config.shadow_pcf, "--shadow-pcf"},
+                                      {config.shadow_share > 0, "--shadow-share"},
+                                      {config.merge_group > 1, "--merge-group"}})
       if (set)
         throw BadInput(std::string(mode) + " renders on the CPU: " + option + " is not for it");
     if (config.out.empty()) throw BadInput(std::string(mode) + " needs --out <file.exr|.png>");
@@ -280,6 +296,9 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.srgbe = config.srgbe;
   options.shadow_size = config.shadow_size;
   options.shadow_pcf = config.shadow_pcf;
+  options.shadow_share_texels = config.shadow_share;
+  options.merge_group = config.merge_group;
+  options.merge_error = config.merge_error;
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;
   options.cull_back_faces = setup.closed_room;
@@ -399,6 +418,10 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   if (!config.shadows) line << arg("--no-shadows");
   line << arg("--shadow-size") << arg(std::to_string(config.shadow_size));
   if (config.shadow_pcf) line << arg("--shadow-pcf");
+  if (config.shadow_share > 0) line << arg("--shadow-share") << arg(values({config.shadow_share}));
+  if (config.merge_group > 1)
+    line << arg("--merge-group") << arg(std::to_string(config.merge_group)) << arg("--merge-error")
+         << arg(values({config.merge_error}));
   if (config.srgbe) line << arg("--srgbe");
   line << arg("--out") << arg(out);
   return line.str();

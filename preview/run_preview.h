@@ -39,6 +39,12 @@ struct PreviewConfig {
   bool srgbe = false;
   int shadow_size = 512;
   bool shadow_pcf = false;
+  // Faster frames (RenderOptions): shadow-map sharing (largest edge shift in shadow texels, 0:
+  // off), merged lights (block side, 1: off) and their error bound. Off by default: on the
+  // default rooms neither stays within 1 % of the full per-position render (docs/design.md §4.2).
+  double shadow_share = 0;
+  int merge_group = 1;
+  double merge_error = 0.01;
   bool watch = false;
   double poll_s = 0.5;
   Backend backend = Backend::kOsmesa;  // --backend; --window is --backend window

@@ -281,7 +281,9 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
     return f;
   };
   gl_->scene_program = Link(kSceneVertex, light_fragment(kLightsPerPass, false));
-  gl_->fast_program = Link(kSceneVertex, light_fragment(kFastLightsPerPass, true));
+  // The shortcuts' program is linked when first used (its uniform arrays are larger: a driver
+  // that refuses it then fails only the shortcuts, not the full render).
+  fast_fragment_ = light_fragment(kFastLightsPerPass, true);
   gl_->depth_program = Link(kSceneVertex, kEmptyFragment);
   gl_->shadow_program = Link(kShadowVertex, kEmptyFragment);
   gl_->display_program = Link(kQuadVertex, kDisplayFragment);
@@ -639,9 +641,7 @@ void Renderer::MergedTexture(int group) {
     double peak = 0;
     for (int y = 0; y < ry; ++y)
       for (int x = 0; x < rx; ++x) peak = std::max(peak, double(std::abs(merged.at(x, y, ch))));
-    if (peak > 0)
-      z = std::max(z,
-                   radius * (info_.distance_mm * gradient[ch] / peak + 5) / options_.merge_error);
+    if (peak > 0) z = std::max(z, radius * (info_.distance_mm * gradient[ch] / peak + 5));
   }
   const int layer = grid.count() + group;
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
@@ -701,7 +701,7 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
         e.span_begin = int(near_only.size());  // the members follow at this index
         e.span_count = int(members.size());
         far_only.push_back(e);
-        z_far = std::max(z_far, merged_z_[group]);
+        z_far = std::max(z_far, merged_z_[group] / options_.merge_error);
         for (int l : members) {
           near_only.push_back(entry(l));
           merged[l] = true;
@@ -791,6 +791,7 @@ void Renderer::LightPass(const std::vector<int>& lights) {
 
 void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
                              double z_far) {
+  if (!gl_->fast_program) gl_->fast_program = Link(kSceneVertex, fast_fragment_);
   const GLuint p = gl_->fast_program;
   SetCommonUniforms(p, true);
   float centres[2 * kFastLightsPerPass], shadow_centres[2 * kFastLightsPerPass];

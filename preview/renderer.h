@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -131,7 +132,8 @@ class Renderer {
   std::vector<Eigen::Vector2d> shadow_centre_;
   bool groups_valid_ = false;
   std::vector<bool> merged_valid_;
-  std::vector<double> merged_z_;
+  std::vector<double> merged_z_;  // z_G times the error bound (mm)
+  std::string fast_fragment_;
   int merged_group_size_ = 0;
   ShortcutState state_;
   Gl* gl_;

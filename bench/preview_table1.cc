@@ -62,8 +62,8 @@ int Run(int argc, char** argv) {
   std::string csv = "preview_table1.csv";
   bool quick = false, profile = false;
   RenderOptions fast;  // the shortcuts' settings of the "on" columns (defaults: the tool's)
-  fast.shadow_share_texels = 1;
-  fast.merge_group = 3;
+  fast.shadow_share_texels = 0;
+  fast.merge_group = 0;  // auto, as lumislab-preview: 2 without shadows, off with them
   fast.merge_error = 0.05;
   CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/design.md §8)"};
   app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
@@ -75,7 +75,8 @@ int Run(int argc, char** argv) {
   app.add_option("--shadow-share", fast.shadow_share_texels,
                  "on columns: shadow-map sharing, largest edge shift in shadow texels (0: off)")
       ->capture_default_str();
-  app.add_option("--merge-group", fast.merge_group, "on columns: merged block side (1: off)")
+  app.add_option("--merge-group", fast.merge_group,
+                 "on columns: merged block side (1: off; 0: auto, 2 without shadows)")
       ->capture_default_str();
   app.add_option("--merge-error", fast.merge_error, "on columns: merged lights' error bound")
       ->capture_default_str();
@@ -128,7 +129,7 @@ int Run(int argc, char** argv) {
         options.time_phases = profile;
         RenderOptions options_on = options;
         options_on.shadow_share_texels = fast.shadow_share_texels;
-        options_on.merge_group = fast.merge_group;
+        options_on.merge_group = fast.merge_group > 0 ? fast.merge_group : (shadows ? 1 : 2);
         options_on.merge_error = fast.merge_error;
         Renderer off(slab.info, size, size, options), on(slab.info, size, size, options_on);
         for (Renderer* r : {&off, &on}) {

@@ -96,8 +96,9 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   app.add_option("--merge-group", config.merge_group,
-                 "merge blocks of N x N positions into one light for distant receivers (1: off)")
-      ->check(CLI::Range(1, 16))
+                 "merge blocks of N x N positions into one light for distant receivers (1: off; "
+                 "0: auto, 2 without shadows, off with them)")
+      ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--merge-error", config.merge_error,
                  "--merge-group: error bound of a merged light, relative to its block's peak "
@@ -290,6 +291,11 @@ void SetCameraValues(const std::vector<double>& values, SceneSetup& setup) {
   setup.camera_target = Eigen::Vector3d(values[3], values[4], values[5]);
 }
 
+int MergeGroup(const PreviewConfig& config) {
+  if (config.merge_group > 0) return config.merge_group;
+  return config.shadows ? 1 : 2;
+}
+
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
   RenderOptions options;
   options.shadows = config.shadows;
@@ -297,7 +303,7 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.shadow_size = config.shadow_size;
   options.shadow_pcf = config.shadow_pcf;
   options.shadow_share_texels = config.shadow_share;
-  options.merge_group = config.merge_group;
+  options.merge_group = MergeGroup(config);
   options.merge_error = config.merge_error;
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;
@@ -419,9 +425,9 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   line << arg("--shadow-size") << arg(std::to_string(config.shadow_size));
   if (config.shadow_pcf) line << arg("--shadow-pcf");
   if (config.shadow_share > 0) line << arg("--shadow-share") << arg(values({config.shadow_share}));
-  if (config.merge_group > 1)
-    line << arg("--merge-group") << arg(std::to_string(config.merge_group)) << arg("--merge-error")
-         << arg(values({config.merge_error}));
+  if (config.merge_group != 0)
+    line << arg("--merge-group") << arg(std::to_string(config.merge_group));
+  if (config.merge_error != 0.05) line << arg("--merge-error") << arg(values({config.merge_error}));
   if (config.srgbe) line << arg("--srgbe");
   line << arg("--out") << arg(out);
   return line.str();

@@ -76,7 +76,8 @@ void ShadowsPanel(WindowState& s) {
     c.shadow_share = share;
     s.options_changed = true;
   }
-  s.options_changed |= ImGui::SliderInt("merge block", &c.merge_group, 1, 4);
+  s.options_changed |=
+      ImGui::SliderInt("merge block", &c.merge_group, 0, 4, c.merge_group == 0 ? "auto" : "%d");
   float merge_error = float(c.merge_error);
   if (ImGui::SliderFloat("merge error", &merge_error, 0.001f, 1.0f, "%.3f",
                          ImGuiSliderFlags_Logarithmic)) {

@@ -261,6 +261,22 @@ TEST_F(PreviewSlabFiles, ShortcutsStayWithinTheirBoundsAndOffIsTheFullRender) {
     EXPECT_LE(RelativeDifference(r->Read(), flat_reference), bound);
   }
   EXPECT_NEAR(z_times_bound[0], z_times_bound[1], 1e-9 * z_times_bound[0]);
+  // The command line's default without shadows (MergeGroup: 2 x 2, bound 0.05) is within 1 %.
+  PreviewConfig config;
+  config.shadows = false;
+  const SceneSetup setup = MakeSceneSetup("crypt", info_);
+  const RenderOptions defaults = MakeRenderOptions(config, setup);
+  EXPECT_EQ(defaults.merge_group, 2);
+  auto r = MakeRenderer(defaults);
+  Upload(*r, ScanSlabPositions(dir_.string(), info_));
+  r->Render();
+  EXPECT_GT(r->shortcuts().merged_lights, 0);
+  const double error = RelativeDifference(r->Read(), flat_reference);
+  std::printf("merged lights at the default bound: z_G %.0f mm, %.3g relative L2\n",
+              r->shortcuts().z_merge, error);
+  EXPECT_LE(error, 0.01);
+  config.shadows = true;
+  EXPECT_EQ(MakeRenderOptions(config, setup).merge_group, 1);
 }
 
 TEST_F(PreviewSlabFiles, SrgbeAccumulationStaysCloseToFloat) {

@@ -13,6 +13,7 @@
 #include "core/log.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
+#include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
@@ -59,13 +60,26 @@ void UploadAll(const Slab& slab, Renderer& r) {
 int Run(int argc, char** argv) {
   int frames = 7, size = 400, shadow_size = 512;
   std::string csv = "preview_table1.csv";
-  bool quick = false;
+  bool quick = false, profile = false;
+  RenderOptions fast;  // the shortcuts' settings of the "on" columns (defaults: the tool's)
+  fast.shadow_share_texels = 0;
+  fast.merge_group = 0;  // auto, as lumislab-preview: 2 without shadows, off with them
+  fast.merge_error = 0.05;
   CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/design.md §8)"};
   app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
   app.add_option("--size", size, "image side")->capture_default_str();
   app.add_option("--shadow-size", shadow_size, "shadow-map side")->capture_default_str();
   app.add_option("--csv", csv, "CSV output")->capture_default_str();
   app.add_flag("--quick", quick, "only crypt 5x5 and cloister 9x7 with shadows, no live");
+  app.add_flag("--profile", profile, "time the phases of each frame (glFinish between them)");
+  app.add_option("--shadow-share", fast.shadow_share_texels,
+                 "on columns: shadow-map sharing, largest edge shift in shadow texels (0: off)")
+      ->capture_default_str();
+  app.add_option("--merge-group", fast.merge_group,
+                 "on columns: merged block side (1: off; 0: auto, 2 without shadows)")
+      ->capture_default_str();
+  app.add_option("--merge-error", fast.merge_error, "on columns: merged lights' error bound")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -83,11 +97,17 @@ int Run(int argc, char** argv) {
   const Paper paper[] = {
       {5, 5, 2.7, 3.2, 1.3, 1.6}, {7, 7, 1.5, 1.7, 0.7, 0.85}, {9, 7, 1.2, 1.4, 0.55, 0.7}};
   std::ofstream out(csv);
-  out << "scene,triangles,grid,shadows,fps_cached,fps_full,paper_fps,ratio_cached,ratio_full\n";
-  std::printf("%-9s %5s %-5s %-7s %10s %10s %8s %8s %8s\n", "scene", "tris", "grid", "shadows",
-              "fps(cache)", "fps(full)", "paper", "ratio", "ratio");
-  std::printf("%-9s %5s %-5s %-7s %10s %10s %8s %8s %8s\n", "", "", "", "", "", "", "", "cache",
-              "full");
+  std::printf("shortcuts on: --shadow-share %g --merge-group %d --merge-error %g\n",
+              fast.shadow_share_texels, fast.merge_group, fast.merge_error);
+  out << "scene,triangles,grid,shadows,paper_fps,fps_cached_off,fps_full_off,fps_cached_on,"
+         "fps_full_on,ratio_cached_off,ratio_full_off,ratio_cached_on,ratio_full_on,"
+         "rel_l2_on_vs_off,shadow_group,shadow_shift_texels,merged_lights,z_merge_mm\n";
+  std::printf("%-9s %5s %-5s %-4s %6s %13s %13s | %11s %11s | %8s %3s %6s %3s %7s\n", "", "", "",
+              "", "", "--- off ---", "--- on ----", "ratio off", "ratio on", "on vs", "sha",
+              "shift", "mrg", "z merge");
+  std::printf("%-9s %5s %-5s %-4s %6s %6s %6s %6s %6s | %5s %5s %5s %5s | %8s %3s %6s %3s %7s\n",
+              "scene", "tris", "grid", "shad", "paper", "camera", "full", "camera", "full", "cam",
+              "full", "cam", "full", "off L2", "g", "texel", "n", "mm");
   for (const std::string scene : {"crypt", "cloister"}) {
     SceneRequest request;
     request.name = scene;
@@ -100,43 +120,86 @@ int Run(int argc, char** argv) {
       }
       for (bool shadows : {true, false}) {
         if (quick && !shadows) continue;
+        // Two renderers: "off" is the full per-position render, "on" has the shortcuts. Their
+        // frames alternate, so both see the same load on a shared machine.
         RenderOptions options;
         options.shadows = shadows;
         options.shadow_size = shadow_size;
         options.cull_back_faces = setup.closed_room;
-        Renderer r(slab.info, size, size, options);
-        r.SetScene(setup.mesh);
-        r.SetPose(setup.pose);
-        UploadAll(slab, r);
-        r.SetCamera(OrbitCamera(setup, 1.0));
-        r.Render();  // warm-up: shaders, shadow maps
-        std::vector<double> cached, full;
+        options.time_phases = profile;
+        RenderOptions options_on = options;
+        options_on.shadow_share_texels = fast.shadow_share_texels;
+        options_on.merge_group = fast.merge_group > 0 ? fast.merge_group : (shadows ? 1 : 2);
+        options_on.merge_error = fast.merge_error;
+        Renderer off(slab.info, size, size, options), on(slab.info, size, size, options_on);
+        for (Renderer* r : {&off, &on}) {
+          r->SetScene(setup.mesh);
+          r->SetPose(setup.pose);
+          UploadAll(slab, *r);
+          r->SetCamera(OrbitCamera(setup, 1.0));
+          r->Render();  // warm-up: shaders, shadow maps
+        }
+        const ImageDifference error = CompareImages(on.Read(), off.Read());
+        struct Times {
+          std::vector<double> cached, full, c_light, f_shadow, f_light;
+        } times[2];
         SceneSetup moving = setup;
         for (int f = 0; f < frames; ++f) {
-          moving.camera_yaw_deg += 2;
-          r.SetCamera(OrbitCamera(moving, 1.0));
-          auto start = Clock::now();
-          r.Render();
-          cached.push_back(Seconds(start));
-          moving.camera_yaw_deg += 2;
-          r.SetCamera(OrbitCamera(moving, 1.0));
-          r.SetPose(setup.pose);  // invalidates every shadow map, as a pose change does
-          start = Clock::now();
-          r.Render();
-          full.push_back(Seconds(start));
+          for (int k = 0; k < 2; ++k) {
+            Renderer& r = k == 0 ? off : on;
+            // Each frame a new view, 2 degrees on; the same views for both renderers.
+            const double step = 2.0 * (2 * f + 1);
+            moving.camera_yaw_deg = setup.camera_yaw_deg + step;
+            r.SetCamera(OrbitCamera(moving, 1.0));
+            auto start = Clock::now();
+            r.Render();
+            times[k].cached.push_back(Seconds(start));
+            times[k].c_light.push_back(r.phase_times().light_ms);
+            moving.camera_yaw_deg = setup.camera_yaw_deg + step + 2;
+            r.SetCamera(OrbitCamera(moving, 1.0));
+            r.SetPose(setup.pose);  // invalidates every shadow map, as a pose change does
+            start = Clock::now();
+            r.Render();
+            times[k].full.push_back(Seconds(start));
+            times[k].f_shadow.push_back(r.phase_times().shadow_ms);
+            times[k].f_light.push_back(r.phase_times().light_ms);
+          }
         }
-        const double fps_cached = 1 / Median(cached), fps_full = 1 / Median(full);
+        if (profile) {
+          std::printf("  on: depth range of the maps %.0f .. %.0f mm\n", on.shortcuts().z_min,
+                      on.shortcuts().z_max);
+          for (int k = 0; k < 2; ++k) {
+            std::printf(
+                "  %s phases (ms): camera move: light %.1f; full: shadow maps %.1f "
+                "light %.1f\n",
+                k ? "on " : "off", Median(times[k].c_light), Median(times[k].f_shadow),
+                Median(times[k].f_light));
+          }
+        }
+        const ShortcutState& state = on.shortcuts();
         const double paper_fps = scene == "crypt" ? (shadows ? p.crypt : p.crypt_ns)
                                                   : (shadows ? p.cloister : p.cloister_ns);
+        double fps[2][2];
+        for (int k = 0; k < 2; ++k) {
+          fps[k][0] = 1 / Median(times[k].cached);
+          fps[k][1] = 1 / Median(times[k].full);
+        }
         char grid[16];
         std::snprintf(grid, sizeof(grid), "%dx%d", p.nu, p.nv);
-        std::printf("%-9s %5zu %-5s %-7s %10.2f %10.2f %8.2f %8.1f %8.1f\n", scene.c_str(),
-                    setup.mesh.triangles(), grid, shadows ? "yes" : "no", fps_cached, fps_full,
-                    paper_fps, fps_cached / paper_fps, fps_full / paper_fps);
+        std::printf(
+            "%-9s %5zu %-5s %-4s %6.2f %6.2f %6.2f %6.2f %6.2f | %5.1f %5.1f %5.1f %5.1f | "
+            "%8.2e %3d %6.2f %3d %7.0f\n",
+            scene.c_str(), setup.mesh.triangles(), grid, shadows ? "yes" : "no", paper_fps,
+            fps[0][0], fps[0][1], fps[1][0], fps[1][1], fps[0][0] / paper_fps,
+            fps[0][1] / paper_fps, fps[1][0] / paper_fps, fps[1][1] / paper_fps, error.relative_l2,
+            state.shadow_group, state.shadow_shift, state.merged_lights, state.z_merge);
         std::fflush(stdout);
         out << scene << ',' << setup.mesh.triangles() << ',' << grid << ','
-            << (shadows ? "yes" : "no") << ',' << fps_cached << ',' << fps_full << ',' << paper_fps
-            << ',' << fps_cached / paper_fps << ',' << fps_full / paper_fps << '\n';
+            << (shadows ? "yes" : "no") << ',' << paper_fps << ',' << fps[0][0] << ',' << fps[0][1]
+            << ',' << fps[1][0] << ',' << fps[1][1] << ',' << fps[0][0] / paper_fps << ','
+            << fps[0][1] / paper_fps << ',' << fps[1][0] / paper_fps << ',' << fps[1][1] / paper_fps
+            << ',' << error.relative_l2 << ',' << state.shadow_group << ',' << state.shadow_shift
+            << ',' << state.merged_lights << ',' << state.z_merge << '\n';
       }
     }
   }

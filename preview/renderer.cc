@@ -3,6 +3,9 @@
 #include <glad/gl.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/error.h"
@@ -103,6 +106,19 @@ uniform sampler2DArrayShadow u_shadow;
 uniform int u_count;
 uniform vec2 u_centres[LIGHTS_PER_PASS];
 uniform int u_layers[LIGHTS_PER_PASS];
+#if FAST
+// Shortcuts: each light's shadow map (a shared map lies in another layer and was rendered from
+// its block's centre); lights [0, u_near_end) shade receivers nearer than u_z_far, lights
+// [u_far_begin, u_count) the others (the merged lights replace their members there).
+// A merged light's visibility is the mean of its members' (entries u_shadow_span[k].x ..
+// + .y - 1; a single light: its own entry).
+uniform vec2 u_shadow_centres[LIGHTS_PER_PASS];
+uniform int u_shadow_layers[LIGHTS_PER_PASS];
+uniform ivec2 u_shadow_span[LIGHTS_PER_PASS];
+uniform int u_near_end;
+uniform int u_far_begin;
+uniform float u_z_far;
+#endif
 uniform bool u_shadows;
 uniform float u_offset_scale;  // normal offset per mm of distance (one shadow texel)
 uniform float u_radiance_scale;
@@ -152,7 +168,14 @@ void main() {
   vec2 reach = 0.5 * u_window + u_grid_half * abs(1.0 - u_d / max(x.z, 1e-6));
   bool dark = x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
   if (dark && !u_srgbe) discard;
+#if FAST
+  const bool far = x.z >= u_z_far;
+  const int first = far ? u_far_begin : 0;
+  const int last = far ? u_count : u_near_end;
+  for (int k = first; k < last; ++k) {
+#else
   for (int k = 0; k < u_count; ++k) {
+#endif
     vec3 rel = x - vec3(u_centres[k], 0.0);
     if (rel.z <= 0.0) continue;
     float delta = length(rel);
@@ -164,10 +187,22 @@ void main() {
     vec2 uv = vec2(st.x / u_window.x + 0.5, 0.5 - st.y / u_window.y);
     float visible = 1.0;
     if (u_shadows) {
+#if FAST
+      visible = 0.0;
+      const int begin = u_shadow_span[k].x, end = begin + u_shadow_span[k].y;
+      for (int m = begin; m < end; ++m) {
+        vec4 clip = LightClip(x + n * (u_offset_scale * delta), u_shadow_centres[m]);
+        vec3 ndc = clip.xyz / clip.w;
+        visible += texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_shadow_layers[m]),
+                                          0.5 * ndc.z + 0.5));
+      }
+      if (u_shadow_span[k].y > 1) visible /= float(u_shadow_span[k].y);
+#else
       vec4 clip = LightClip(x + n * (u_offset_scale * delta), u_centres[k]);
       vec3 ndc = clip.xyz / clip.w;
       visible = texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_layers[k]),
                                        0.5 * ndc.z + 0.5));
+#endif
     }
     vec3 intensity = SampleIntensity(uv, u_layers[k]);
     sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
@@ -248,7 +283,8 @@ GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(progra
 
 struct Renderer::Gl {
   GLuint vao = 0, vbo = 0, quad_vao = 0;
-  GLuint scene_program = 0, depth_program = 0, shadow_program = 0, display_program = 0;
+  GLuint scene_program = 0, fast_program = 0, depth_program = 0, shadow_program = 0,
+         display_program = 0;
   GLuint intensity = 0, shadow = 0, shadow_fbo = 0;
   GLuint colour = 0, packed[2] = {0, 0}, depth = 0, fbo[2] = {0, 0};
 };
@@ -259,10 +295,25 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   present_.assign(lights, false);
   shadow_valid_.assign(lights, false);
   accumulated_.assign(lights, false);
-  std::string light_fragment = kLightFragment;
-  light_fragment.insert(light_fragment.find('\n') + 1,
-                        "#define LIGHTS_PER_PASS " + std::to_string(kLightsPerPass) + "\n");
-  gl_->scene_program = Link(kSceneVertex, light_fragment);
+  shadow_layer_.resize(lights);
+  shadow_centre_.resize(lights);
+  for (int l = 0; l < lights; ++l) {
+    shadow_layer_[l] = l;
+    shadow_centre_[l] = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
+  }
+  intensity_.resize(lights);
+  // Merged textures follow the positions' layers: at most one per 2 x 2 block.
+  const int merge_layers = ((info_.grid.nu + 1) / 2) * ((info_.grid.nv + 1) / 2);
+  auto light_fragment = [](int per_pass, bool fast) {
+    std::string f = kLightFragment;
+    f.insert(f.find('\n') + 1, "#define LIGHTS_PER_PASS " + std::to_string(per_pass) +
+                                   "\n#define FAST " + (fast ? "1" : "0") + "\n");
+    return f;
+  };
+  gl_->scene_program = Link(kSceneVertex, light_fragment(kLightsPerPass, false));
+  // The shortcuts' program is linked when first used (its uniform arrays are larger: a driver
+  // that refuses it then fails only the shortcuts, not the full render).
+  fast_fragment_ = light_fragment(kFastLightsPerPass, true);
   gl_->depth_program = Link(kSceneVertex, kEmptyFragment);
   gl_->shadow_program = Link(kShadowVertex, kEmptyFragment);
   gl_->display_program = Link(kQuadVertex, kDisplayFragment);
@@ -273,7 +324,7 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glGenTextures(1, &gl_->intensity);
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
   glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, info_.layout.res_x, info_.layout.res_y,
-                 lights);
+                 lights + merge_layers);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -303,8 +354,8 @@ Renderer::~Renderer() {
   glDeleteBuffers(1, &gl_->vbo);
   glDeleteVertexArrays(1, &gl_->vao);
   glDeleteVertexArrays(1, &gl_->quad_vao);
-  for (GLuint p :
-       {gl_->scene_program, gl_->depth_program, gl_->shadow_program, gl_->display_program}) {
+  for (GLuint p : {gl_->scene_program, gl_->fast_program, gl_->depth_program, gl_->shadow_program,
+                   gl_->display_program}) {
     glDeleteProgram(p);
   }
   delete gl_;
@@ -366,12 +417,14 @@ void Renderer::SetScene(const Mesh& mesh) {
   }
   glBindVertexArray(0);
   shadow_valid_.assign(shadow_valid_.size(), false);
+  groups_valid_ = false;
   view_valid_ = false;
 }
 
 void Renderer::SetPose(const Eigen::Isometry3d& luminaire_to_scene) {
   pose_ = luminaire_to_scene;
   shadow_valid_.assign(shadow_valid_.size(), false);
+  groups_valid_ = false;
   view_valid_ = false;
 }
 
@@ -384,6 +437,15 @@ void Renderer::SetCamera(const Eigen::Matrix4f& view_projection) {
 void Renderer::SetOptions(const RenderOptions& options) {
   if (options.shadow_size != options_.shadow_size) {
     throw BadInput("the shadow-map size is fixed when the renderer is created");
+  }
+  if (options.merge_group < 1 || !(options.merge_error > 0) || !(options.shadow_share_texels >= 0))
+    throw BadInput("merge group must be >= 1, merge error > 0, shadow sharing >= 0 texels");
+  if (options.shadow_share_texels != options_.shadow_share_texels) {
+    shadow_valid_.assign(shadow_valid_.size(), false);
+    groups_valid_ = false;
+  }
+  if (options.merge_group != options_.merge_group) {
+    merged_valid_.clear();
   }
   options_ = options;
   view_valid_ = false;
@@ -408,6 +470,8 @@ void Renderer::SetPosition(int i, int j, const ImageF& intensity) {
                   GL_FLOAT, intensity.data.data());
   if (accumulated_[layer]) view_valid_ = false;  // replaced: the sum must be redone
   present_[layer] = true;
+  intensity_[layer] = intensity;
+  merged_valid_.clear();  // the merged textures are rebuilt from the copies when next used
 }
 
 bool Renderer::HasPosition(int i, int j) const { return present_[info_.grid.Index(i, j)]; }
@@ -420,9 +484,13 @@ int Renderer::PositionCount() const {
 
 void Renderer::RenderShadowMap(int light) {
   const int i = light % info_.grid.nu, j = light / info_.grid.nu;
-  const Eigen::Vector2d c = info_.grid.Centre(i, j);
+  RenderShadowMapAt(light, info_.grid.Centre(i, j));
+  shadow_valid_[light] = true;
+}
+
+void Renderer::RenderShadowMapAt(int layer, const Eigen::Vector2d& c) {
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->shadow_fbo);
-  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->shadow, 0, light);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->shadow, 0, layer);
   glDrawBuffer(GL_NONE);
   glViewport(0, 0, options_.shadow_size, options_.shadow_size);
   glClear(GL_DEPTH_BUFFER_BIT);
@@ -444,12 +512,260 @@ void Renderer::RenderShadowMap(int light) {
   glBindVertexArray(gl_->vao);
   glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
   glDisable(GL_POLYGON_OFFSET_FILL);
-  shadow_valid_[light] = true;
   ++shadow_renders_;
 }
 
-void Renderer::LightPass(const std::vector<int>& lights) {
-  const GLuint p = gl_->scene_program;
+// Blocks of g x g positions from the grid's corner (the last ones smaller): members of block
+// (bi, bj) are i in [bi g, min(nu, bi g + g)), likewise j.
+std::vector<int> BlockMembers(const SamplingGrid& grid, int g, int bi, int bj) {
+  std::vector<int> members;
+  for (int j = bj * g; j < std::min(grid.nv, bj * g + g); ++j)
+    for (int i = bi * g; i < std::min(grid.nu, bi * g + g); ++i)
+      members.push_back(grid.Index(i, j));
+  return members;
+}
+
+Eigen::Vector2d MeanCentre(const SamplingGrid& grid, const std::vector<int>& members,
+                           double* radius) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (int l : members) mean += grid.Centre(l % grid.nu, l / grid.nu);
+  mean /= double(members.size());
+  *radius = 0;
+  for (int l : members)
+    *radius = std::max(*radius, (grid.Centre(l % grid.nu, l / grid.nu) - mean).norm());
+  return mean;
+}
+
+// Shadow-map sharing. A block of positions shares the map rendered from its centre c̄. Seen from
+// c̄, the edge of an occluder at depth z_o (luminaire frame) cast onto a receiver at z_r lies
+// where the ray from c_k past the edge meets the receiver: |c_k - c̄| (1/z_o - 1/z_r) radians
+// away from where the shared map puts it. A shadow texel spans W/(d S) radians (the map's
+// projection: x_ndc = 2 d x / (W z)), H/(d S) vertically. So over the depth range [z_min, z_max]
+// of what the maps see, a block of half-diagonal r moves shadow edges by at most
+//     r (1/z_min - 1/z_max) d S / min(W, H)  shadow texels,
+// and g is the largest block side that keeps this within --shadow-share. The depth range is
+// read back from the map of the grid's centre position (the surfaces the lights see first:
+// occluders, and receivers at a shadow's edge, which the map also sees).
+void Renderer::ChooseShadowGroups() {
+  const SamplingGrid& grid = info_.grid;
+  const int lights = grid.count();
+  shadow_valid_.assign(lights, false);
+  int g = 1;
+  state_ = ShortcutState{};
+  if (options_.shadow_share_texels > 0) {
+    const int centre = grid.Index(grid.nu / 2, grid.nv / 2);
+    RenderShadowMapAt(centre, grid.Centre(grid.nu / 2, grid.nv / 2));
+    const int size = options_.shadow_size;
+    std::vector<float> depth(size_t(size) * size);
+    glGetTextureSubImage(gl_->shadow, 0, 0, 0, centre, size, size, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
+                         GLsizei(depth.size() * sizeof(float)), depth.data());
+    const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
+    const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
+    double z_min = kShadowFar, z_max = 0;
+    for (float w : depth) {
+      if (!(w < 1.0f)) continue;  // cleared: nothing seen through this texel
+      const double z = b / (2.0 * w - 1.0 - a);
+      z_min = std::min(z_min, z);
+      z_max = std::max(z_max, z);
+    }
+    const double texel =
+        std::min(info_.layout.window_w_mm, info_.layout.window_h_mm) / (info_.distance_mm * size);
+    const double spread = z_max > 0 ? 1 / z_min - 1 / z_max : 0;  // nothing seen: any g is exact
+    for (int t = 2; t <= std::max(grid.nu, grid.nv); ++t) {
+      const double hu = 0.5 * (std::min(t, grid.nu) - 1), hv = 0.5 * (std::min(t, grid.nv) - 1);
+      const double shift = grid.spacing_mm * std::hypot(hu, hv) * spread / texel;
+      if (shift > options_.shadow_share_texels) break;
+      g = t;
+      state_.shadow_shift = shift;
+    }
+    state_.z_min = z_min;
+    state_.z_max = z_max;
+    if (g == 1) shadow_valid_[centre] = true;  // that map is the centre position's own
+  }
+  state_.shadow_group = g;
+  state_.shadow_maps = 0;
+  for (int bj = 0; bj * g < grid.nv; ++bj) {
+    for (int bi = 0; bi * g < grid.nu; ++bi) {
+      const std::vector<int> members = BlockMembers(grid, g, bi, bj);
+      double radius = 0;
+      const Eigen::Vector2d mean = MeanCentre(grid, members, &radius);
+      // The map lies in the layer of the member nearest the centre (in an odd block, the
+      // centre position itself, whose map is then its own).
+      int rep = members[0];
+      for (int l : members) {
+        if ((grid.Centre(l % grid.nu, l / grid.nu) - mean).norm() <
+            (grid.Centre(rep % grid.nu, rep / grid.nu) - mean).norm())
+          rep = l;
+      }
+      for (int l : members) {
+        shadow_layer_[l] = rep;
+        shadow_centre_[l] = g == 1 ? grid.Centre(l % grid.nu, l / grid.nu) : mean;
+      }
+      ++state_.shadow_maps;
+    }
+  }
+  groups_valid_ = true;
+}
+
+// The merged texture of a block G (centre c̄) for distant receivers: a receiver at depth z looks
+// member k up at s_k = x d/z + c_k (1 - d/z) and the merged light at s̄ = x d/z + c̄ (1 - d/z), so
+//     M_G(s) = Σ_k E'_k(s + (c_k - c̄))
+// equals the members' sum at z = ∞ and is off by E'_k displaced by e_k = (c_k - c̄) d/z at z:
+// |error| ≤ (r d / z) Σ_k max|∇E'_k| (r the block's radius). The spot factor cosθ cosθ'/δ² of
+// c̄ instead of c_k changes by at most 5 r/δ ≤ 5 r/z of the largest term (cosθ and cosθ' by r/δ
+// and 2r/δ, 1/δ² by 2r/δ). Relative to the block's peak P = max M_G the error is at most
+//     (r / z) (d Σ_k max|∇E'_k| / P + 5),
+// so receivers at z ≥ z_G = r (d Σ_k max|∇E'_k| / P + 5) / merge_error use the merged light
+// (per channel, the largest z_G). The merged light's visibility is the mean of its members'
+// shadow-map tests (each at its own map: soft shadows stay as soft), so
+//     Σ_k V_k E'_k  ≈  (1/n Σ_k V_k) Σ_k E'_k,
+// exact where the members see the receiver alike or their E' are alike.
+void Renderer::MergedTexture(int group) {
+  const SamplingGrid& grid = info_.grid;
+  const int g = options_.merge_group, bu = (grid.nu + g - 1) / g;
+  const std::vector<int> members = BlockMembers(grid, g, group % bu, group / bu);
+  double radius = 0;
+  const Eigen::Vector2d mean = MeanCentre(grid, members, &radius);
+  const int rx = info_.layout.res_x, ry = info_.layout.res_y;
+  const double w = info_.layout.window_w_mm, h = info_.layout.window_h_mm;
+  ImageF merged(rx, ry, 3);
+  double gradient[3] = {0, 0, 0};
+  for (int l : members) {
+    const ImageF& e = intensity_[l];
+    const Eigen::Vector2d c = grid.Centre(l % grid.nu, l / grid.nu) - mean;
+    // Texel shift of E'_k: u = s/W + 1/2 (columns), v = 1/2 - t/H (rows).
+    const double du = c.x() / w * rx, dv = -c.y() / h * ry;
+    for (int y = 0; y < ry; ++y) {
+      const double qy = y + 0.5 + dv;   // in texels from the window's top edge
+      if (qy < 0 || qy > ry) continue;  // outside the window: the member gives no light
+      const double fy = std::clamp(qy - 0.5, 0.0, double(ry - 1));
+      const int y0 = std::min(int(fy), ry - 1), y1 = std::min(y0 + 1, ry - 1);
+      const double ty = fy - y0;
+      for (int x = 0; x < rx; ++x) {
+        const double qx = x + 0.5 + du;
+        if (qx < 0 || qx > rx) continue;
+        const double fx = std::clamp(qx - 0.5, 0.0, double(rx - 1));
+        const int x0 = std::min(int(fx), rx - 1), x1 = std::min(x0 + 1, rx - 1);
+        const double tx = fx - x0;
+        for (int ch = 0; ch < 3; ++ch) {
+          merged.at(x, y, ch) +=
+              float((1 - ty) * ((1 - tx) * e.at(x0, y0, ch) + tx * e.at(x1, y0, ch)) +
+                    ty * ((1 - tx) * e.at(x0, y1, ch) + tx * e.at(x1, y1, ch)));
+        }
+      }
+    }
+    // max |∇E'_k| per mm from neighbouring texels.
+    for (int ch = 0; ch < 3; ++ch) {
+      double m = 0;
+      for (int y = 0; y < ry; ++y) {
+        for (int x = 0; x < rx; ++x) {
+          if (x + 1 < rx) m = std::max(m, std::abs(e.at(x + 1, y, ch) - e.at(x, y, ch)) * rx / w);
+          if (y + 1 < ry) m = std::max(m, std::abs(e.at(x, y + 1, ch) - e.at(x, y, ch)) * ry / h);
+        }
+      }
+      gradient[ch] += m;
+    }
+  }
+  double z = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    double peak = 0;
+    for (int y = 0; y < ry; ++y)
+      for (int x = 0; x < rx; ++x) peak = std::max(peak, double(std::abs(merged.at(x, y, ch))));
+    if (peak > 0) z = std::max(z, radius * (info_.distance_mm * gradient[ch] / peak + 5));
+  }
+  const int layer = grid.count() + group;
+  glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, rx, ry, 1, GL_RGB, GL_FLOAT,
+                  merged.data.data());
+  merged_z_[group] = z;
+  merged_valid_[group] = true;
+}
+
+// The shortcuts' light passes: with merging, the blocks whose members all are added now become
+// a merged light for receivers at least z_far deep (the largest of their z_G) and their members
+// shade the nearer ones; the other positions shade all.
+void Renderer::FastPasses(const std::vector<int>& todo) {
+  const SamplingGrid& grid = info_.grid;
+  auto entry = [&](int l) {
+    LightEntry e;
+    e.centre = grid.Centre(l % grid.nu, l / grid.nu);
+    e.layer = l;
+    e.shadow_centre = shadow_centre_[l];
+    e.shadow_layer = shadow_layer_[l];
+    return e;
+  };
+  std::vector<LightEntry> near_only, both, far_only;
+  std::vector<bool> adding(grid.count(), false);
+  for (int l : todo) adding[l] = true;
+  std::vector<bool> merged(grid.count(), false);
+  double z_far = 0;
+  const int g = options_.merge_group;
+  if (g > 1) {
+    const int bu = (grid.nu + g - 1) / g, bv = (grid.nv + g - 1) / g;
+    if (int(merged_valid_.size()) != bu * bv || merged_group_size_ != g) {
+      merged_valid_.assign(bu * bv, false);
+      merged_z_.assign(bu * bv, 0);
+      merged_group_size_ = g;
+    }
+    for (int bj = 0; bj < bv; ++bj) {
+      for (int bi = 0; bi < bu; ++bi) {
+        const std::vector<int> members = BlockMembers(grid, g, bi, bj);
+        if (members.size() < 2) continue;
+        if (!std::all_of(members.begin(), members.end(), [&](int l) { return adding[l]; }))
+          continue;
+        const int group = bj * bu + bi;
+        if (!merged_valid_[group]) MergedTexture(group);
+        double radius = 0;
+        LightEntry e;
+        e.centre = MeanCentre(grid, members, &radius);
+        e.layer = grid.count() + group;
+        int nearest = members[0];
+        for (int l : members) {
+          if ((grid.Centre(l % grid.nu, l / grid.nu) - e.centre).norm() <
+              (grid.Centre(nearest % grid.nu, nearest / grid.nu) - e.centre).norm())
+            nearest = l;
+        }
+        e.shadow_centre = shadow_centre_[nearest];
+        e.shadow_layer = shadow_layer_[nearest];
+        e.span_begin = int(near_only.size());  // the members follow at this index
+        e.span_count = int(members.size());
+        far_only.push_back(e);
+        z_far = std::max(z_far, merged_z_[group] / options_.merge_error);
+        for (int l : members) {
+          near_only.push_back(entry(l));
+          merged[l] = true;
+        }
+      }
+    }
+  }
+  for (int l : todo)
+    if (!merged[l]) both.push_back(entry(l));
+  if (far_only.empty()) z_far = std::numeric_limits<double>::infinity();
+  state_.merged_lights = int(far_only.size());
+  state_.z_merge = z_far;
+  const size_t total = near_only.size() + both.size() + far_only.size();
+  if (total <= size_t(kFastLightsPerPass)) {
+    std::vector<LightEntry> entries = near_only;
+    entries.insert(entries.end(), both.begin(), both.end());
+    entries.insert(entries.end(), far_only.begin(), far_only.end());
+    FastLightPass(entries, int(near_only.size() + both.size()), int(near_only.size()), z_far);
+    return;
+  }
+  // Too many for one pass: every position on its own, in passes of kFastLightsPerPass.
+  state_.merged_lights = 0;
+  for (size_t start = 0; start < todo.size(); start += kFastLightsPerPass) {
+    const size_t end = std::min(todo.size(), start + kFastLightsPerPass);
+    std::vector<LightEntry> entries;
+    for (size_t k = start; k < end; ++k) entries.push_back(entry(todo[k]));
+    FastLightPass(entries, int(entries.size()), int(entries.size()),
+                  std::numeric_limits<double>::infinity());
+  }
+}
+
+// Everything of a light pass but the lights: target, uniforms, textures.
+void Renderer::SetCommonUniforms(unsigned program, bool /*fast*/) {
+  const GLuint p = program;
   const int target = options_.srgbe ? 1 - ping_ : 0;
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[target]);
   glViewport(0, 0, width_, height_);
@@ -484,6 +800,11 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glUniform1i(Loc(p, "u_intensity"), 0);
   glUniform1i(Loc(p, "u_shadow"), 1);
   glUniform1i(Loc(p, "u_previous"), 2);
+}
+
+void Renderer::LightPass(const std::vector<int>& lights) {
+  const GLuint p = gl_->scene_program;
+  SetCommonUniforms(p, false);
   float centres[2 * kLightsPerPass];
   int layers[kLightsPerPass];
   for (size_t k = 0; k < lights.size(); ++k) {
@@ -496,6 +817,42 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glUniform1i(Loc(p, "u_count"), int(lights.size()));
   glUniform2fv(Loc(p, "u_centres"), GLsizei(lights.size()), centres);
   glUniform1iv(Loc(p, "u_layers"), GLsizei(lights.size()), layers);
+  DrawLightPass();
+}
+
+void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
+                             double z_far) {
+  if (!gl_->fast_program) gl_->fast_program = Link(kSceneVertex, fast_fragment_);
+  const GLuint p = gl_->fast_program;
+  SetCommonUniforms(p, true);
+  float centres[2 * kFastLightsPerPass], shadow_centres[2 * kFastLightsPerPass];
+  int layers[kFastLightsPerPass], shadow_layers[kFastLightsPerPass];
+  int spans[2 * kFastLightsPerPass];
+  const GLsizei n = GLsizei(entries.size());
+  for (size_t k = 0; k < entries.size(); ++k) {
+    const LightEntry& e = entries[k];
+    centres[2 * k] = float(e.centre.x());
+    centres[2 * k + 1] = float(e.centre.y());
+    shadow_centres[2 * k] = float(e.shadow_centre.x());
+    shadow_centres[2 * k + 1] = float(e.shadow_centre.y());
+    layers[k] = e.layer;
+    shadow_layers[k] = e.shadow_layer;
+    spans[2 * k] = e.span_begin < 0 ? int(k) : e.span_begin;
+    spans[2 * k + 1] = e.span_count;
+  }
+  glUniform1i(Loc(p, "u_count"), n);
+  glUniform2fv(Loc(p, "u_centres"), n, centres);
+  glUniform1iv(Loc(p, "u_layers"), n, layers);
+  glUniform2fv(Loc(p, "u_shadow_centres"), n, shadow_centres);
+  glUniform1iv(Loc(p, "u_shadow_layers"), n, shadow_layers);
+  glUniform2iv(Loc(p, "u_shadow_span"), n, spans);
+  glUniform1i(Loc(p, "u_near_end"), near_end);
+  glUniform1i(Loc(p, "u_far_begin"), far_begin);
+  glUniform1f(Loc(p, "u_z_far"), float(std::min(z_far, 3.0e38)));
+  DrawLightPass();
+}
+
+void Renderer::DrawLightPass() {
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
   glDepthMask(GL_FALSE);
@@ -517,10 +874,21 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
-  if (options_.srgbe) ping_ = target;
+  if (options_.srgbe) ping_ = 1 - ping_;
 }
 
 int Renderer::Render() {
+  using Clock = std::chrono::steady_clock;
+  auto mark = Clock::now();
+  times_ = PhaseTimes{};
+  // Adds the time since the last mark to *ms (after glFinish) when phases are timed.
+  auto lap = [&](double* ms) {
+    if (!options_.time_phases) return;
+    glFinish();
+    const auto now = Clock::now();
+    *ms += std::chrono::duration<double, std::milli>(now - mark).count();
+    mark = now;
+  };
   if (!view_valid_) {
     // Clear both targets, then the depth pre-pass (light passes shade visible fragments only).
     for (int k = 0; k < 2; ++k) {
@@ -548,21 +916,37 @@ int Renderer::Render() {
     glDisable(GL_CULL_FACE);
     accumulated_.assign(accumulated_.size(), false);
     view_valid_ = true;
+    lap(&times_.depth_ms);
   }
   std::vector<int> todo;
   for (size_t l = 0; l < present_.size(); ++l) {
     if (present_[l] && !accumulated_[l]) todo.push_back(int(l));
   }
-  if (options_.shadows) {
+  if (options_.shadows && !todo.empty()) {
+    if (!groups_valid_) ChooseShadowGroups();
+    // Each position's map (with sharing, its block's, in the layer shadow_layer_ names).
     for (int l : todo) {
-      if (!shadow_valid_[l]) RenderShadowMap(l);
+      const int layer = shadow_layer_[l];
+      if (shadow_valid_[layer]) continue;
+      if (options_.shadow_share_texels > 0) {
+        RenderShadowMapAt(layer, shadow_centre_[l]);
+        shadow_valid_[layer] = true;
+      } else {
+        RenderShadowMap(l);
+      }
     }
+    lap(&times_.shadow_ms);
   }
-  for (size_t start = 0; start < todo.size(); start += kLightsPerPass) {
-    const size_t end = std::min(todo.size(), start + kLightsPerPass);
-    LightPass(std::vector<int>(todo.begin() + start, todo.begin() + end));
+  if (!Fast()) {
+    for (size_t start = 0; start < todo.size(); start += kLightsPerPass) {
+      const size_t end = std::min(todo.size(), start + kLightsPerPass);
+      LightPass(std::vector<int>(todo.begin() + start, todo.begin() + end));
+    }
+  } else if (!todo.empty()) {
+    FastPasses(todo);
   }
   for (int l : todo) accumulated_[l] = true;
+  lap(&times_.light_ms);
   glFinish();
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) throw Failure("GL error " + std::to_string(error) + " while rendering");

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -36,9 +37,37 @@ struct RenderOptions {
   // surface (W/m^2), which --view false-colour maps.
   bool unit_albedo = false;
   TextureFilter texture_filter = TextureFilter::kBilinear;
+  // Shortcuts (docs/design.md §4.2, "Faster frames"); both off: the full per-position render.
+  // Shadow-map sharing: neighbouring positions in blocks of g x g share one map rendered from
+  // the block's centre, g the largest whose shadow edges move by at most this many shadow texels
+  // over the depth range the maps see (0: off, every position its own map).
+  double shadow_share_texels = 0;
+  // Light merging: blocks of merge_group x merge_group positions become one light (summed E'
+  // texture, one shadow lookup) for receivers beyond the depth where the merged term's error is
+  // bounded by merge_error times the block's peak term (1: off).
+  int merge_group = 1;
+  double merge_error = 0.01;
+  // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
+  bool time_phases = false;
+};
+
+// Wall time of the phases of the last Render() (milliseconds; only with time_phases).
+struct PhaseTimes {
+  double depth_ms = 0, shadow_ms = 0, light_ms = 0;
 };
 
 constexpr int kLightsPerPass = 64;
+constexpr int kFastLightsPerPass = 128;  // the shortcuts' program (members + merged lights)
+
+// What the shortcuts chose at the last Render() (for the bench, the window and the log).
+struct ShortcutState {
+  int shadow_group = 1;         // g of the shadow-map sharing (1: none)
+  double shadow_shift = 0;      // its largest shadow-edge shift (shadow texels)
+  double z_min = 0, z_max = 0;  // depth range the maps see (mm, luminaire frame)
+  int shadow_maps = 0;          // distinct maps in use
+  int merged_lights = 0;        // merged lights in the last pass
+  double z_merge = 0;           // receivers at least this deep (mm) used the merged lights
+};
 
 class Renderer {
  public:
@@ -64,6 +93,8 @@ class Renderer {
   int Render();
   // Shadow maps rendered since construction (to show they are cached).
   int ShadowMapRenders() const { return shadow_renders_; }
+  const PhaseTimes& phase_times() const { return times_; }
+  const ShortcutState& shortcuts() const { return state_; }
   // The accumulated image (radiance or irradiance, W/m^2 [/sr]), 3 channels, row 0 on top.
   ImageF Read() const;
   // Draws the accumulation tone-mapped (exposure factor, sRGB) into framebuffer 0.
@@ -71,8 +102,22 @@ class Renderer {
 
  private:
   struct Gl;
+  struct LightEntry {
+    Eigen::Vector2d centre, shadow_centre;
+    int layer = 0, shadow_layer = 0;
+    int span_begin = -1, span_count = 1;  // merged: its members' entries (shadows averaged)
+  };
+  bool Fast() const { return options_.shadow_share_texels > 0 || options_.merge_group > 1; }
   void RenderShadowMap(int light);
+  void RenderShadowMapAt(int layer, const Eigen::Vector2d& centre);
+  void ChooseShadowGroups();
+  void MergedTexture(int group);
   void LightPass(const std::vector<int>& lights);
+  void FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
+                     double z_far);
+  void SetCommonUniforms(unsigned program, bool fast);
+  void DrawLightPass();
+  void FastPasses(const std::vector<int>& todo);
   void AllocateTargets();
 
   SlabInfo info_;
@@ -85,6 +130,18 @@ class Renderer {
   bool view_valid_ = false;
   int shadow_renders_ = 0;
   int ping_ = 0;  // sRGBE: which of the two targets holds the current sum
+  PhaseTimes times_;
+  // Shortcuts: CPU copies of E' (merged textures are built from them), per position the layer
+  // and centre of the shadow map it uses, per merge block its texture's state and depth bound.
+  std::vector<ImageF> intensity_;
+  std::vector<int> shadow_layer_;
+  std::vector<Eigen::Vector2d> shadow_centre_;
+  bool groups_valid_ = false;
+  std::vector<bool> merged_valid_;
+  std::vector<double> merged_z_;  // z_G times the error bound (mm)
+  std::string fast_fragment_;
+  int merged_group_size_ = 0;
+  ShortcutState state_;
   Gl* gl_;
 };
 

@@ -100,6 +100,21 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
                  "| cubic (Catmull-Rom, 16 texel reads)")
       ->check(CLI::IsMember({"bilinear", "nearest", "cubic"}))
       ->capture_default_str();
+  app.add_option("--shadow-share", config.shadow_share,
+                 "share one shadow map among g x g neighbouring positions, g the largest whose "
+                 "shadow edges move by at most this many shadow texels (0: off)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--merge-group", config.merge_group,
+                 "merge blocks of N x N positions into one light for distant receivers (1: off; "
+                 "0: auto, 2 without shadows, off with them)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--merge-error", config.merge_error,
+                 "--merge-group: error bound of a merged light, relative to its block's peak "
+                 "(sets the depth beyond which it is used)")
+      ->check(CLI::Range(1e-6, 100.0))
+      ->capture_default_str();
 }
 
 void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -203,7 +218,10 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
                                       {config.report_srgbe_error, "--srgbe-error"},
                                       {config.shadow_pcf, "--shadow-pcf"},
                                       {config.texture_filter != TextureFilter::kBilinear,
-                                       "--texture-filter (it reads the slab bilinearly)"}})
+                                       "--texture-filter (it reads the slab bilinearly)"},
+
+                                      {config.shadow_share > 0, "--shadow-share"},
+                                      {config.merge_group > 1, "--merge-group"}})
       if (set)
         throw BadInput(std::string(mode) + " renders on the CPU: " + option + " is not for it");
     if (config.out.empty()) throw BadInput(std::string(mode) + " needs --out <file.exr|.png>");
@@ -339,6 +357,11 @@ void SetCameraValues(const std::vector<double>& values, SceneSetup& setup) {
   setup.camera_target = Eigen::Vector3d(values[3], values[4], values[5]);
 }
 
+int MergeGroup(const PreviewConfig& config) {
+  if (config.merge_group > 0) return config.merge_group;
+  return config.shadows ? 1 : 2;
+}
+
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
   RenderOptions options;
   options.shadows = config.shadows;
@@ -346,6 +369,9 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.shadow_size = config.shadow_size;
   options.shadow_pcf = config.shadow_pcf;
   options.texture_filter = config.texture_filter;
+  options.shadow_share_texels = config.shadow_share;
+  options.merge_group = MergeGroup(config);
+  options.merge_error = config.merge_error;
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;
   options.cull_back_faces = setup.closed_room;
@@ -467,6 +493,10 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   if (!config.shadows) line << arg("--no-shadows");
   line << arg("--shadow-size") << arg(std::to_string(config.shadow_size));
   if (config.shadow_pcf) line << arg("--shadow-pcf");
+  if (config.shadow_share > 0) line << arg("--shadow-share") << arg(values({config.shadow_share}));
+  if (config.merge_group != 0)
+    line << arg("--merge-group") << arg(std::to_string(config.merge_group));
+  if (config.merge_error != 0.05) line << arg("--merge-error") << arg(values({config.merge_error}));
   if (config.srgbe) line << arg("--srgbe");
   if (config.texture_filter != TextureFilter::kBilinear)
     line << arg("--texture-filter") << arg(TextureFilterName(config.texture_filter));

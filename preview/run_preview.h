@@ -46,6 +46,13 @@ struct PreviewConfig {
   int shadow_size = 512;
   bool shadow_pcf = false;
   TextureFilter texture_filter = TextureFilter::kBilinear;  // --texture-filter
+  // Faster frames (RenderOptions): shadow-map sharing (largest edge shift in shadow texels, 0:
+  // off), merged lights (block side, 1: off; 0: auto, MergeGroup) and their error bound. On by
+  // default only where the image stays within 1 % of the full per-position render on the
+  // default rooms (docs/design.md §4.2): merging 2 x 2 without shadows; sharing never.
+  double shadow_share = 0;
+  int merge_group = 0;
+  double merge_error = 0.05;
   bool watch = false;
   double poll_s = 0.5;
   Backend backend = Backend::kOsmesa;  // --backend; --window is --backend window
@@ -88,6 +95,8 @@ void SetCameraValues(const std::vector<double>& values, SceneSetup& setup);
 
 // Renderer options from the command line, for the scene it sets up (one place for both contexts).
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);
+// --merge-group resolved: 0 (auto) is 2 without shadows, 1 (off) with them.
+int MergeGroup(const PreviewConfig& config);
 
 // slab.json of --slab; with --watch, waits for it to appear (a live reconstruct writes it with
 // its first position); nothing when a stop signal arrives first.

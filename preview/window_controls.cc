@@ -70,6 +70,20 @@ void ShadowsPanel(WindowState& s) {
   } else {
     ImGui::Text("shadow size %d", c.shadow_size);
   }
+  // Faster frames (docs/design.md §4.2): each shortcut's knob, 0 / 1 = off.
+  float share = float(c.shadow_share);
+  if (ImGui::SliderFloat("share maps (texels)", &share, 0.0f, 4.0f, "%.2f")) {
+    c.shadow_share = share;
+    s.options_changed = true;
+  }
+  s.options_changed |=
+      ImGui::SliderInt("merge block", &c.merge_group, 0, 4, c.merge_group == 0 ? "auto" : "%d");
+  float merge_error = float(c.merge_error);
+  if (ImGui::SliderFloat("merge error", &merge_error, 0.001f, 1.0f, "%.3f",
+                         ImGuiSliderFlags_Logarithmic)) {
+    c.merge_error = merge_error;
+    s.options_changed = true;
+  }
   int format = c.srgbe;
   ImGui::Text("accumulation");
   ImGui::SameLine();

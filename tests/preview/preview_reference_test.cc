@@ -160,7 +160,9 @@ TEST(PreviewReference, RoomsAgreeWithOpenGl) {
     for (const bool shadows : {false, true}) {
       std::vector<std::string> common = {"--slab", slab,    "--scene",   scene,
                                          "--size", "64x48", "--threads", "2"};
-      if (!shadows) common.push_back("--no-shadows");
+      // The full per-position render (eq. 14 itself): no merged lights, which --no-shadows
+      // would otherwise turn on (§4.2).
+      if (!shadows) common.insert(common.end(), {"--no-shadows", "--merge-group", "1"});
       auto run = [&](std::vector<std::string> extra) {
         std::vector<std::string> args = common;
         args.insert(args.end(), extra.begin(), extra.end());

@@ -142,6 +142,9 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   config.shadows = false;
   config.shadow_size = 1024;
   config.shadow_pcf = true;
+  config.shadow_share = 0.75;
+  config.merge_group = 3;
+  config.merge_error = 0.25;
   config.srgbe = true;
   config.texture_filter = TextureFilter::kCubic;
   const std::string line = HeadlessCommandLine(config, "out.png");
@@ -172,6 +175,9 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   EXPECT_FALSE(back.shadows);
   EXPECT_EQ(back.shadow_size, 1024);
   EXPECT_TRUE(back.shadow_pcf);
+  EXPECT_EQ(back.shadow_share, 0.75);
+  EXPECT_EQ(back.merge_group, 3);
+  EXPECT_EQ(back.merge_error, 0.25);
   EXPECT_TRUE(back.srgbe);
   EXPECT_EQ(back.texture_filter, TextureFilter::kCubic);
   EXPECT_EQ(back.out, "out.png");

@@ -43,8 +43,14 @@ std::vector<std::string> SplitCsvLine(const std::string& line);
 void ReadCsvLines(const std::string& path, const std::string& header, size_t fields,
                   const std::function<void(const std::vector<std::string>&)>& parse);
 
-// Indices of the rows on the Pareto front of (total_s, err[d_index]): no other row is at least
-// as fast and at least as accurate and better in one; one row per key; sorted by time.
+// Measured times scatter with the machine's load (reconstruct and render by ±25 % and more);
+// totals within this fraction of each other count as the same time, so that a point is not put
+// on the front, or named cheapest, over a more accurate one for a few hundred ms of scatter.
+constexpr double kTimeScatter = 0.05;
+
+// Indices of the rows on the Pareto front of (total_s, err[d_index]): no other row is more
+// accurate within kTimeScatter of its time (or as accurate and faster); one row per key;
+// sorted by time.
 std::vector<size_t> ParetoFront(const std::vector<StudyRow>& rows, int d_index);
 
 // report.md text (tables per knob in `knob_order`, the Pareto fronts at d and 4d) and the
@@ -53,7 +59,8 @@ std::string StudyReport(const std::vector<StudyRow>& rows,
                         const std::vector<std::string>& knob_order, const std::string& header);
 std::string ParetoTables(const std::vector<StudyRow>& rows);
 // For targets 5 %, 2 %, 1 %, 0.5 % at D = d and 4d, the measured row of least total time within
-// each (or "none measured"), with its lab, reconstruct, render and preview times.
+// each (or "none measured"; of the rows within kTimeScatter of that time the most accurate),
+// with its lab, reconstruct, render and preview times.
 std::string TargetTable(const std::vector<StudyRow>& rows);
 // Error at D = d_index against total time, log axes, one curve per knob, the front marked.
 std::string StudySvg(const std::vector<StudyRow>& rows, const std::vector<std::string>& knob_order,

@@ -125,19 +125,24 @@ std::vector<StudyRow> ReadStudyCsv(const std::string& path) {
 }
 
 std::vector<size_t> ParetoFront(const std::vector<StudyRow>& rows, int d_index) {
-  std::vector<size_t> order;
+  std::vector<size_t> unique;
   std::set<std::string> keys;
   for (size_t i = 0; i < rows.size(); ++i)
-    if (keys.insert(rows[i].key).second) order.push_back(i);
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if (keys.insert(rows[i].key).second) unique.push_back(i);
+  const auto dominates = [&](const StudyRow& a, const StudyRow& b) {
+    const double ea = a.err[d_index], eb = b.err[d_index];
+    return (ea < eb && a.total_s <= b.total_s * (1 + kTimeScatter)) ||
+           (ea == eb && a.total_s < b.total_s);
+  };
+  std::vector<size_t> front;
+  for (size_t i : unique)
+    if (std::none_of(unique.begin(), unique.end(),
+                     [&](size_t j) { return j != i && dominates(rows[j], rows[i]); }))
+      front.push_back(i);
+  std::sort(front.begin(), front.end(), [&](size_t a, size_t b) {
     if (rows[a].total_s != rows[b].total_s) return rows[a].total_s < rows[b].total_s;
     return rows[a].err[d_index] < rows[b].err[d_index];
   });
-  // Sorted by time: a row is on the front when it is more accurate than every faster one.
-  std::vector<size_t> front;
-  double best = INFINITY;
-  for (size_t i : order)
-    if (rows[i].err[d_index] < best) front.push_back(i), best = rows[i].err[d_index];
   return front;
 }
 
@@ -167,9 +172,14 @@ std::string TargetTable(const std::vector<StudyRow>& rows) {
        "| setting |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (int d : {0, 2})
     for (double target : {0.05, 0.02, 0.01, 0.005}) {
-      const StudyRow* best = nullptr;
+      const StudyRow* fastest = nullptr;
       for (const StudyRow& r : rows)
-        if (r.err[d] <= target && (!best || r.total_s < best->total_s)) best = &r;
+        if (r.err[d] <= target && (!fastest || r.total_s < fastest->total_s)) fastest = &r;
+      const StudyRow* best = fastest;  // the most accurate as fast within the scatter
+      for (const StudyRow& r : rows)
+        if (fastest && r.err[d] <= target && r.total_s <= fastest->total_s * (1 + kTimeScatter) &&
+            r.err[d] < best->err[d])
+          best = &r;
       s << "| " << Percent(target) << " | " << kDLabel[d] << " | ";
       if (!best) {
         s << "none measured | | | | | | | |\n";

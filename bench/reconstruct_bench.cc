@@ -128,6 +128,11 @@ void CameraFormats(const std::string& out_dir, int width, int height, int runs, 
                 bench::CameraFormatName(format), mb, 1e3 * r.decode, 1e3 * r.merge, 1e3 * r.total,
                 r.total / r.decode, 1e3 * r.decode_cpu, 1e3 * r.total_cpu,
                 r.total_cpu / r.decode_cpu, r.f);
+    std::printf(
+        "%-12s full's stages (wall ms): decode %.1f, map %.1f, merge %.1f, remap %.1f, "
+        "fit %.1f, write %.1f\n",
+        "", 1e3 * r.rec_decode, 1e3 * r.map, 1e3 * r.merge, 1e3 * r.remap, 1e3 * r.fit,
+        1e3 * r.write);
     std::filesystem::remove_all(dir);
     std::filesystem::remove_all(slab_dir);
   }

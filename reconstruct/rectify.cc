@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "lib/photo/photo_io.h"
 
 namespace lumislab {
 
@@ -250,7 +251,10 @@ RectifyMap BuildRectifyMap(const ScreenCalibration& calibration, const SlabLayou
 cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
   LUMISLAB_CHECK(signal.type() == CV_32FC4 || signal.type() == CV_32FC3,
                  "Rectify: expects a CV_32FC3/4 image");
-  cv::Mat samples, texels;
+  // The samples (K x K per texel: 1800 x 1800 x 4 floats, 52 MB, for the bench's 6000 x 4000
+  // photos) in huge pages (NewPhotoImage): on the development VM a fresh 4 kB page costs
+  // 15 - 50 us to first touch, ~0.2 - 0.4 s for this image in 4 kB pages (docs/design.md 8.3).
+  cv::Mat samples = NewPhotoImage(map.map_xy.rows, map.map_xy.cols, signal.type()), texels;
   cv::remap(signal, samples, map.map_xy, map.map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));
   if (map.samples_per_texel == 1 && map.sample_weight.empty()) return samples;
@@ -260,12 +264,17 @@ cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
     return texels;
   }
   // Near the screen's edge: the mean of the samples that read only the screen (BuildRectifyMap).
-  std::vector<cv::Mat> planes;
-  cv::split(samples, planes);
-  for (cv::Mat& plane : planes) plane = plane.mul(map.sample_weight);
-  cv::Mat weighted, kept;
-  cv::merge(planes, weighted);
-  cv::resize(weighted, texels, size, 0, 0, cv::INTER_AREA);
+  // Each sample's channels times its weight, in place (the same products as a per-plane
+  // multiply, without three more images of the samples' size).
+  const int channels = samples.channels();
+  for (int row = 0; row < samples.rows; ++row) {
+    float* s = samples.ptr<float>(row);
+    const float* w = map.sample_weight.ptr<float>(row);
+    for (int col = 0; col < samples.cols; ++col)
+      for (int ch = 0; ch < channels; ++ch) s[col * channels + ch] *= w[col];
+  }
+  cv::Mat kept;
+  cv::resize(samples, texels, size, 0, 0, cv::INTER_AREA);
   cv::resize(map.sample_weight, kept, size, 0, 0, cv::INTER_AREA);
   for (int row = 0; row < texels.rows; ++row) {
     float* t = texels.ptr<float>(row);

@@ -73,7 +73,8 @@ RaySplat::RaySplat(double x0_mm, double x1_mm, double y0_mm, double y1_mm, doubl
   nodes_.assign(size_t(nx_) * ny_ * channels_, 0.0);
 }
 
-void RaySplat::Add(double x_mm, double y_mm, const double* flux) {
+template <typename F>
+void RaySplat::ForEachNode(double x_mm, double y_mm, F f) const {
   const double fx = x_mm / cell_, fy = y_mm / cell_;
   if (!(std::abs(fx) < 1e15 && std::abs(fy) < 1e15)) return;
   const double kf = std::floor(fx), lf = std::floor(fy);
@@ -83,27 +84,23 @@ void RaySplat::Add(double x_mm, double y_mm, const double* flux) {
   for (int n = 0; n < 4; ++n) {
     const long kk = k + (n & 1), ll = l + (n >> 1);
     if (kk < 0 || ll < 0 || kk >= nx_ || ll >= ny_) continue;  // beyond the region's nodes
-    double* node = &nodes_[(size_t(ll) * nx_ + size_t(kk)) * channels_];
-    for (int c = 0; c < channels_; ++c) node[c] += w[n] * flux[c];
+    f((size_t(ll) * nx_ + size_t(kk)) * channels_, w[n]);
   }
+}
+
+void RaySplat::Add(double x_mm, double y_mm, const double* flux) {
+  ForEachNode(x_mm, y_mm, [&](size_t node, double w) {
+    for (int c = 0; c < channels_; ++c) nodes_[node + c] += w * flux[c];
+  });
 }
 
 void RaySplat::At(double x_mm, double y_mm, double* irradiance) const {
   for (int c = 0; c < channels_; ++c) irradiance[c] = 0;
-  const double fx = x_mm / cell_, fy = y_mm / cell_;
-  if (!(std::abs(fx) < 1e15 && std::abs(fy) < 1e15)) return;
-  const double kf = std::floor(fx), lf = std::floor(fy);
-  const long k = long(kf) - k0_, l = long(lf) - l0_;
-  const double ax = fx - kf, ay = fy - lf;
-  const double w[4] = {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay};
   // Flux per node over the cell's area (mm^2 -> m^2: 1e6).
   const double per_area = 1e6 / (cell_ * cell_);
-  for (int n = 0; n < 4; ++n) {
-    const long kk = k + (n & 1), ll = l + (n >> 1);
-    if (kk < 0 || ll < 0 || kk >= nx_ || ll >= ny_) continue;
-    const double* node = &nodes_[(size_t(ll) * nx_ + size_t(kk)) * channels_];
-    for (int c = 0; c < channels_; ++c) irradiance[c] += w[n] * per_area * node[c];
-  }
+  ForEachNode(x_mm, y_mm, [&](size_t node, double w) {
+    for (int c = 0; c < channels_; ++c) irradiance[c] += w * per_area * nodes_[node + c];
+  });
 }
 
 }  // namespace lumislab

@@ -56,6 +56,11 @@ class RaySplat {
   int channels() const { return channels_; }
 
  private:
+  // Calls f(node index into nodes_, tent weight) for the up-to-4 lattice nodes around (x, y)
+  // that lie in the region (none for a point beyond 1e15 cells). Add and At share it.
+  template <typename F>
+  void ForEachNode(double x_mm, double y_mm, F f) const;
+
   double cell_;
   int channels_;
   long k0_, l0_;  // lattice index of node (0, 0)

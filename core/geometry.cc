@@ -1,5 +1,6 @@
 #include "core/geometry.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -28,6 +29,14 @@ double ShiftInvariantError(double theta0, double relative_width) {
   double hi = std::max(a, b), lo = std::min(a, b);
   if (std::abs(s) <= half) hi = 1.0;
   return (hi - lo) / cos4(s);
+}
+
+Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees) {
+  const Eigen::Vector3d r = degrees * kPi / 180;
+  return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
 }
 
 Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q,

@@ -16,6 +16,10 @@ double ShiftInvariantGeometry(double d, const Eigen::Vector2d& c, double s, doub
 double ShiftInvariantError(double theta0, double relative_width);
 
 // Where the line from point p (luminaire frame, mm) through q crosses the plane z = z_plane.
+// The rotation Rz(z) Ry(y) Rx(x) of angles in degrees (x about X first, then y about Y, z about
+// Z, all about the fixed axes): how scene files, emitters and --luminaire-pose give orientations.
+Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees);
+
 Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q, double z_plane);
 
 }  // namespace lumislab

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/geometry.h"
 
 namespace lumislab {
 
@@ -46,12 +47,8 @@ Eigen::Matrix4f PlaneView(double plane_z_mm, double extent_mm) {
 
 Eigen::Isometry3d PoseFromValues(const std::vector<double>& v) {
   if (v.size() != 6) throw BadInput("--luminaire-pose needs x,y,z,rx,ry,rz (mm, degrees)");
-  const double k = M_PI / 180.0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = (Eigen::AngleAxisd(v[5] * k, Eigen::Vector3d::UnitZ()) *
-                   Eigen::AngleAxisd(v[4] * k, Eigen::Vector3d::UnitY()) *
-                   Eigen::AngleAxisd(v[3] * k, Eigen::Vector3d::UnitX()))
-                      .toRotationMatrix();
+  pose.linear() = RotationZyxDegrees(Eigen::Vector3d(v[3], v[4], v[5]));
   pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
   return pose;
 }

@@ -29,11 +29,7 @@ MeasuredLobe MeasuredLobe::Load(const std::string& file, const Eigen::Vector3d& 
   lobe.distribution = std::make_shared<const IntensityDistribution>(ReadIntensityFile(file));
   lobe.file = file;
   lobe.rotation_deg = rotation_deg;
-  const Eigen::Vector3d r = rotation_deg * kPi / 180;
-  lobe.luminaire_from_file = (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
-                              Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
-                              Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
-                                 .toRotationMatrix();
+  lobe.luminaire_from_file = RotationZyxDegrees(rotation_deg);
   const std::vector<double>& v = lobe.distribution->values;
   lobe.peak = *std::max_element(v.begin(), v.end());
   if (!(lobe.peak > 0)) throw BadInput(file + ": no light in the distribution (every value 0)");

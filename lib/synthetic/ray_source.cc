@@ -22,11 +22,7 @@ RaySource RaySource::Load(const std::string& file, const Eigen::Vector3d& positi
   source.cell_mm = cell_mm;
   source.photometric = set.photometric;
   source.file_rays = set.rays.size();
-  const Eigen::Vector3d r = rotation_deg * kPi / 180;
-  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
-                                    Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
-                                    Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
-                                       .toRotationMatrix();
+  const Eigen::Matrix3d rotation = RotationZyxDegrees(rotation_deg);
   auto rays = std::make_shared<std::vector<SourceRay>>();
   rays->reserve(set.rays.size());
   // A ray on S itself (z = 0, as a slab's exported rays start) passes the slide where it starts;

@@ -71,5 +71,15 @@ TEST(ShiftInvariantErrorTest, ReproducesPaperFigure3) {
   EXPECT_TRUE(std::isfinite(ShiftInvariantError(89.9 * kDeg, 0.04)));
 }
 
+// Rz Ry Rx: x about X first. Ry(90) Rx(90) takes Y to Z (Rx) and then Z to X (Ry), and X to -Z.
+TEST(GeometryTest, RotationZyxDegreesAppliesXThenYThenZ) {
+  const Eigen::Matrix3d r = RotationZyxDegrees(Eigen::Vector3d(90, 90, 0));
+  EXPECT_TRUE(r.col(1).isApprox(Eigen::Vector3d(1, 0, 0), 1e-12)) << r;
+  EXPECT_TRUE(r.col(0).isApprox(Eigen::Vector3d(0, 0, -1), 1e-12)) << r;
+  const Eigen::Matrix3d z = RotationZyxDegrees(Eigen::Vector3d(0, 0, 30));
+  const double c = std::cos(kPi / 6), s = std::sin(kPi / 6);
+  EXPECT_TRUE(z.isApprox((Eigen::Matrix3d() << c, -s, 0, s, c, 0, 0, 0, 1).finished(), 1e-12)) << z;
+}
+
 }  // namespace
 }  // namespace lumislab

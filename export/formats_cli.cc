@@ -275,7 +275,7 @@ int RunRays(const RayCommand& c, int threads) {
     return 0;
   }
   const Slab slab = LoadCompleteSlab(c.slab, threads);
-  const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed);
+  const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed, threads);
   Tm25RaySet set;
   set.photometric = Photometric(slab.info);
   const double nan = std::nan("");

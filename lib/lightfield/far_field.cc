@@ -282,7 +282,8 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
 }
 
 SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                        int64_t count, uint64_t seed, const Eigen::Vector3d& channel_weights) {
+                        int64_t count, uint64_t seed, int threads,
+                        const Eigen::Vector3d& channel_weights) {
   LUMISLAB_CHECK(int(positions.size()) == info.grid.count(), "one slab position per grid index");
   LUMISLAB_CHECK(count >= 1, "at least one ray");
   const SlabLayout& layout = info.layout;
@@ -378,16 +379,17 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
   // sum_ij E_ij dA times the bell's integral over the cell, its negative part cancelled against
   // nearby positive mass (CancelNegativeRayCells), the rays drawn from what is left: a cell by
   // its flux, (u, v) uniform in it, (s, t) uniform in the texel.
+  // Texels run in parallel, each with its own random stream (seeded by the seed and the texel),
+  // so the rays do not depend on the thread count.
   const RayCellAxis ax = MakeRayCellAxis(grid.nu, h), ay = MakeRayCellAxis(grid.nv, h);
-  std::vector<double> profile(size_t(ax.cells) * ay.cells), row_sum(size_t(ax.cells) * grid.nv);
-  std::vector<double> cell_cumulative(profile.size());
-  RayCellCancelling cancelled;
+  std::vector<RayCellCancelling> per_texel(static_cast<size_t>(texels));
   out.rays.resize(size_t(count));
-  for (int t = 0; t < texels; ++t) {
-    if (!(scale[t] > 0) || texel_flux[t] == 0) continue;
+  ParallelFor(texels, threads, [&](int t) {
+    if (!(scale[t] > 0) || texel_flux[t] == 0) return;
     // row_sum[j][a] = sum_i E_ij overlap_x(a, i); profile[b][a] = sum_j row_sum[j][a]
     // overlap_y(b, j).
-    std::fill(row_sum.begin(), row_sum.end(), 0.0);
+    std::vector<double> profile(size_t(ax.cells) * ay.cells, 0.0);
+    std::vector<double> row_sum(size_t(ax.cells) * grid.nv, 0.0);
     for (int j = 0; j < grid.nv; ++j)
       for (int i = 0; i < grid.nu; ++i) {
         const std::vector<double>& ek = e[size_t(grid.Index(i, j))];
@@ -395,7 +397,6 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
         for (int a = 0; a < ax.cells; ++a)
           row_sum[size_t(j) * ax.cells + a] += scale[t] * ek[t] * ax.Overlap(a, i);
       }
-    std::fill(profile.begin(), profile.end(), 0.0);
     for (int b = 0; b < ay.cells; ++b)
       for (int j = 0; j < grid.nv; ++j) {
         const double w = ay.Overlap(b, j);
@@ -403,25 +404,36 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
         for (int a = 0; a < ax.cells; ++a)
           profile[size_t(b) * ax.cells + a] += w * row_sum[size_t(j) * ax.cells + a];
       }
-    CancelNegativeRayCells(ax, ay, &profile, &cancelled);
-    const int rays_here = first[t + 1] - first[t];
-    if (rays_here == 0) continue;
+    CancelNegativeRayCells(ax, ay, &profile, &per_texel[size_t(t)]);
+    if (first[t + 1] == first[t]) return;
+    std::vector<double>& cell_cumulative = row_sum;  // reused
+    cell_cumulative.resize(profile.size());
     double cell_running = 0;
     for (size_t c = 0; c < profile.size(); ++c) cell_cumulative[c] = cell_running += profile[c];
+    std::seed_seq texel_seed{uint32_t(seed), uint32_t(seed >> 32), uint32_t(t)};
+    std::mt19937_64 texel_rng(texel_seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
     const Eigen::Vector2d centre = layout.TexelCentre(t % layout.res_x, t / layout.res_x);
     for (int k = first[t]; k < first[t + 1]; ++k) {
       const auto it = std::upper_bound(cell_cumulative.begin(), cell_cumulative.end(),
-                                       uniform(rng) * cell_running);
+                                       unit(texel_rng) * cell_running);
       const size_t c =
           size_t(std::min<ptrdiff_t>(it - cell_cumulative.begin(), ptrdiff_t(profile.size()) - 1));
-      const double u = ax.start_mm + (double(c % ax.cells) + uniform(rng)) * ax.width_mm;
-      const double v = ay.start_mm + (double(c / ax.cells) + uniform(rng)) * ay.width_mm;
-      const double s = centre.x() + (uniform(rng) - 0.5) * layout.TexelW();
-      const double tt = centre.y() + (uniform(rng) - 0.5) * layout.TexelH();
+      const double u = ax.start_mm + (double(c % ax.cells) + unit(texel_rng)) * ax.width_mm;
+      const double v = ay.start_mm + (double(c / ax.cells) + unit(texel_rng)) * ay.width_mm;
+      const double s = centre.x() + (unit(texel_rng) - 0.5) * layout.TexelW();
+      const double tt = centre.y() + (unit(texel_rng) - 0.5) * layout.TexelH();
       SlabRay& ray = out.rays[size_t(order[size_t(k)])];
       ray.origin_mm = {u, v, 0.0};
       ray.direction = Eigen::Vector3d(s - u, tt - v, d).normalized();
     }
+  });
+  RayCellCancelling cancelled;  // summed in texel order: the same for any thread count
+  for (const RayCellCancelling& c : per_texel) {
+    cancelled.moved += c.moved;
+    cancelled.uncentred += c.uncentred;
+    cancelled.distance += c.distance;
+    cancelled.max_mm = std::max(cancelled.max_mm, c.max_mm);
   }
   out.moved_flux = cancelled.moved;
   out.uncentred_flux = cancelled.uncentred;

@@ -75,9 +75,10 @@ struct SlabRays {
 // (the centre of its light on every plane); texels of negative net flux are first cancelled
 // against their nearest neighbours. Then each ray draws a texel by its flux, a cell of its
 // profile by its flux, (u, v) uniformly in the cell and (s, t) uniformly in the texel. Every
-// ray carries total_flux / N. Deterministic for a seed.
+// ray carries total_flux / N. Deterministic for a seed, whatever the thread count (texels run
+// on `threads` threads, each with its own random stream).
 SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                        int64_t count, uint64_t seed,
+                        int64_t count, uint64_t seed, int threads = 1,
                         const Eigen::Vector3d& channel_weights = LuminanceWeights());
 
 }  // namespace lumislab

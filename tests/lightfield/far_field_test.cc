@@ -80,7 +80,7 @@ TEST(FarField, MatchesTheAnalyticLuminaireWhereTheGridCoversIt) {
 TEST(FarField, RaysCarryTheSlabsFluxAndAngularDistribution) {
   const Fixture& f = Data();
   const int64_t count = 1000000;
-  const SlabRays rays = SampleSlabRays(f.info, f.positions, count, 7);
+  const SlabRays rays = SampleSlabRays(f.info, f.positions, count, 7, 2);
   ASSERT_EQ(rays.rays.size(), size_t(count));
   EXPECT_NEAR(rays.flux_per_ray * double(count), rays.total_flux, 1e-9 * rays.total_flux);
   // Point emitters: the bell projection of a delta has negative lobes (c_1 < 0), cancelled
@@ -132,10 +132,18 @@ TEST(FarField, RaysCarryTheSlabsFluxAndAngularDistribution) {
     const double tolerance = std::max(0.015, 3 / std::sqrt(double(std::max<int64_t>(in_band, 1))));
     EXPECT_NEAR(from_rays / from_field, 1, tolerance) << "band " << lo;
   }
-  // The same seed draws the same rays.
+  // The same seed draws the same rays, on any number of threads.
   const SlabRays again = SampleSlabRays(f.info, f.positions, 1000, 7);
+  const SlabRays threaded = SampleSlabRays(f.info, f.positions, 1000, 7, 2);
   EXPECT_EQ(again.rays[999].origin_mm,
             SampleSlabRays(f.info, f.positions, 1000, 7).rays[999].origin_mm);
+  for (size_t k = 0; k < again.rays.size(); ++k) {
+    ASSERT_EQ(again.rays[k].origin_mm, threaded.rays[k].origin_mm) << k;
+    ASSERT_EQ(again.rays[k].direction, threaded.rays[k].direction) << k;
+  }
+  EXPECT_EQ(again.moved_flux, threaded.moved_flux);
+  EXPECT_NE(again.rays[999].origin_mm,
+            SampleSlabRays(f.info, f.positions, 1000, 8).rays[999].origin_mm);
 }
 
 }  // namespace

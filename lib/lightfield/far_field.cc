@@ -285,7 +285,8 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
                         int64_t count, uint64_t seed, int threads,
                         const Eigen::Vector3d& channel_weights) {
   LUMISLAB_CHECK(int(positions.size()) == info.grid.count(), "one slab position per grid index");
-  LUMISLAB_CHECK(count >= 1, "at least one ray");
+  LUMISLAB_CHECK(count >= 1 && count <= std::numeric_limits<int32_t>::max(),
+                 "between 1 and 2^31 - 1 rays");
   const SlabLayout& layout = info.layout;
   const SamplingGrid& grid = info.grid;
   const int texels = layout.res_x * layout.res_y;
@@ -369,10 +370,11 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
     ++first[size_t(t) + 1];
   }
   for (int t = 0; t < texels; ++t) first[t + 1] += first[t];
-  std::vector<int64_t> order(static_cast<size_t>(count));
+  std::vector<int32_t> order(static_cast<size_t>(count));  // ray indices, texel by texel
   {
     std::vector<int> next(first.begin(), first.end() - 1);
-    for (int64_t k = 0; k < count; ++k) order[size_t(next[ray_texel[size_t(k)]]++)] = k;
+    for (int64_t k = 0; k < count; ++k) order[size_t(next[ray_texel[size_t(k)]]++)] = int32_t(k);
+    std::vector<int32_t>().swap(ray_texel);
   }
 
   // Each texel's profile over (u, v) on cells of h / kRayCellsPerSpacing: the signed flux

@@ -98,6 +98,41 @@ TEST(FarField, RaysCarryTheSlabsFluxAndAngularDistribution) {
     ASSERT_GT(r.direction.z(), 0);
     ASSERT_NEAR(r.direction.norm(), 1, 1e-12);
   }
+  // The rays' irradiance at d is the slab's, sum_ij E_ij (the cancelling keeps each texel's
+  // flux), on blocks of 10 x 10 texels: relative L2 within 1.5 x its Monte-Carlo expectation
+  // sqrt(sum_b flux_per_ray F_b) / sqrt(sum_b F_b^2). Measured 0.0097 against 0.0097; keeping
+  // the positive part only, as the sampler once did, gave 0.0295 (the texels' negative
+  // fractions differ).
+  {
+    const SlabLayout& layout = f.info.layout;
+    const int block = 10, nbx = layout.res_x / block, nby = layout.res_y / block;
+    std::vector<double> slab(size_t(nbx) * nby, 0.0), from_rays(slab.size(), 0.0);
+    const double texel_m2 = layout.TexelW() * layout.TexelH() * 1e-6;
+    for (const SlabPosition& p : f.positions)
+      for (int row = 0; row < layout.res_y; ++row)
+        for (int col = 0; col < layout.res_x; ++col)
+          if (p.mask.at(col, row, 0) >= 0.5f)
+            slab[size_t(row / block) * nbx + col / block] +=
+                texel_m2 * LuminanceWeights().dot(Eigen::Vector3d(p.irradiance.at(col, row, 0),
+                                                                  p.irradiance.at(col, row, 1),
+                                                                  p.irradiance.at(col, row, 2)));
+    for (const SlabRay& r : rays.rays) {
+      const Eigen::Vector3d at = r.origin_mm + r.direction * (f.info.distance_mm / r.direction.z());
+      const Eigen::Vector2d texel = layout.ToTexel(at.x(), at.y());
+      const int col = int(std::lround(texel.x())), row = int(std::lround(texel.y()));
+      ASSERT_TRUE(col >= 0 && row >= 0 && col < layout.res_x && row < layout.res_y);
+      from_rays[size_t(row / block) * nbx + col / block] += rays.flux_per_ray;
+    }
+    double num = 0, den = 0, expected = 0;
+    for (size_t b = 0; b < slab.size(); ++b) {
+      num += std::pow(from_rays[b] - slab[b], 2);
+      den += slab[b] * slab[b];
+      expected += rays.flux_per_ray * std::max(0.0, slab[b]);
+    }
+    std::printf("irradiance at d on %d x %d blocks: relative L2 %.4f, Monte-Carlo %.4f\n", nbx, nby,
+                std::sqrt(num / den), std::sqrt(expected / den));
+    EXPECT_LT(std::sqrt(num / den), 1.5 * std::sqrt(expected / den));
+  }
   // Bands of 5 degrees of gamma up to 25: the rays' flux against the far field integrated with
   // the zonal sum on a fine grid.
   std::vector<double> c, gamma;

@@ -275,7 +275,7 @@ int RunRays(const RayCommand& c, int threads) {
     return 0;
   }
   const Slab slab = LoadCompleteSlab(c.slab, threads);
-  const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed);
+  const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed, threads);
   Tm25RaySet set;
   set.photometric = Photometric(slab.info);
   const double nan = std::nan("");
@@ -300,7 +300,11 @@ int RunRays(const RayCommand& c, int threads) {
   const char* unit = set.photometric ? " lm" : " W";
   LogInfo(c.rays, " rays of ", Num(drawn.flux_per_ray, 6), unit, ", total ",
           Num(drawn.total_flux, 6), unit,
-          "; the light field's negative part left out: ", Num(drawn.negative_flux, 4), unit);
+          "; the light field's negative part cancelled: ", Num(drawn.moved_flux, 4), unit,
+          " within texels over ", Num(drawn.moved_mean_mm, 3), " mm on S on average (at most ",
+          Num(drawn.moved_max_mm, 3), " mm; ", Num(drawn.uncentred_flux, 4), unit,
+          " of it with the centroid not kept), ", Num(drawn.texel_moved_flux, 4), unit,
+          " between texels over ", Num(drawn.texel_moved_mean_mm, 4), " mm on M on average");
   WriteTm25(set, c.out);
   std::printf("tm25: %s\n", c.out.c_str());
   return 0;

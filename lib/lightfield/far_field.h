@@ -54,20 +54,31 @@ struct SlabRay {
 };
 struct SlabRays {
   std::vector<SlabRay> rays;
-  double flux_per_ray = 0;   // W (lm for lux slabs); the same for every ray
-  double total_flux = 0;     // the slab's flux: sum over positions and seen texels of E dA
-  double negative_flux = 0;  // estimate of the light field's negative part, left out
+  double flux_per_ray = 0;  // W (lm for lux slabs); the same for every ray
+  double total_flux = 0;    // the slab's flux: sum over positions and seen texels of E dA
+  // What making the light field non-negative moved (docs/design.md §5.17), W and mm:
+  double moved_flux = 0;           // the negative part within texels, cancelled over (u, v)
+  double moved_mean_mm = 0;        // mean distance on S from the mass taken to the nearest lobe
+  double moved_max_mm = 0;         // the largest such distance
+  double uncentred_flux = 0;       // of moved_flux, where the profile's centroid could not be kept
+  double texel_moved_flux = 0;     // texels of negative net flux, cancelled against neighbours
+  double texel_moved_mean_mm = 0;  // their mean distance on M
 };
 
 // N rays distributed as the slab's light field (the exact model, §3.3): through texel dA of M,
 // basis function ij sends Phi_ij(u, v) E_ij(s, t) / h^2 du dv dA (W), so the flux density over
 // (u, v, s, t) is sum_ij Phi_ij E_ij / h^2. E_ij is signed (the dual filter has negative lobes)
-// while the sum is the light field, so the rays are drawn from |E_ij| dA (position and seen
-// texel), (u, v) from Phi_ij by rejection, (s, t) uniformly in the texel, and kept with
-// probability max(0, sum Phi E) / sum Phi |E| over the positions at (u, v). Every ray carries
-// total_flux / N. Deterministic for a seed.
+// and so is the sum; a ray file carries no negative flux, so the field is first made
+// non-negative keeping what planes at any distance see to first order: each texel's profile
+// over (u, v), on cells of h / 4, has its negative cells cancelled against positive cells within
+// h of them, keeping the texel's flux (the irradiance at d, exactly) and its (u, v) centroid
+// (the centre of its light on every plane); texels of negative net flux are first cancelled
+// against their nearest neighbours. Then each ray draws a texel by its flux, a cell of its
+// profile by its flux, (u, v) uniformly in the cell and (s, t) uniformly in the texel. Every
+// ray carries total_flux / N. Deterministic for a seed, whatever the thread count (texels run
+// on `threads` threads, each with its own random stream).
 SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                        int64_t count, uint64_t seed,
+                        int64_t count, uint64_t seed, int threads = 1,
                         const Eigen::Vector3d& channel_weights = LuminanceWeights());
 
 }  // namespace lumislab

@@ -100,14 +100,24 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = RunTool("lumislab-reconstruct", "--dataset " + ds + " --resolution 64");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const int n_out = 1000000;
-  r = RunTool("lumislab-export", "tm25 --slab " + ds + " --out " + ShellQuote(dir + "/out.ray") +
-                                     " --rays " + std::to_string(n_out));
-  ASSERT_EQ(r.exit_code, 0) << r.output;
   const double chain_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const Tm25RaySet output = ReadTm25(dir + "/out.ray");
-  ASSERT_EQ(output.rays.size(), size_t(n_out));
+  // Three exports of the slab (seeds 0, 1, 2), each checked below.
+  const int n_out = 1000000;
+  std::vector<Tm25RaySet> outputs;
+  for (int seed = 0; seed < 3; ++seed) {
+    const std::string out = dir + "/out" + std::to_string(seed) + ".ray";
+    r = RunTool("lumislab-export", "tm25 --slab " + ds + " --out " + ShellQuote(out) + " --rays " +
+                                       std::to_string(n_out) + " --seed " + std::to_string(seed));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    if (seed == 0) {  // what making the light field non-negative moved (the export's log)
+      const size_t at = r.output.find("rays of");
+      if (at != std::string::npos)
+        std::printf("export: %s\n", r.output.substr(at, r.output.find('\n', at) - at).c_str());
+    }
+    outputs.push_back(ReadTm25(out));
+    ASSERT_EQ(outputs.back().rays.size(), size_t(n_out));
+  }
 
   // The slab's own irradiance at d, sum_ij E_ij (exact at D = d, no rays drawn), on bins of 4 x 4
   // texels against the input rays': what the capture and the reconstruction got right.
@@ -133,8 +143,7 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
   setting.h_mm = 8;
   setting.nu = setting.nv = 5;
   setting.resolution = 64;
-  std::printf("TM-25 source round trip: capture, calibration, reconstruction, export %.1f s\n",
-              chain_s);
+  std::printf("TM-25 source round trip: capture, calibration, reconstruction %.1f s\n", chain_s);
   for (const double factor : {1.0, 4.0}) {
     plan_in.receiver_mm = factor * scene.distance_mm;
     const Plan plan = EvaluatePlan(plan_in, setting);
@@ -153,19 +162,22 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
       EXPECT_NEAR(c.flux_ratio, 1, bound);
     }
     const Bins in = BinOnPlane(input, plan_in.receiver_mm, w, h, 12);
-    const Bins out = BinOnPlane(output, plan_in.receiver_mm, w, h, 12);
-    const Comparison c = Compare(out, in);
-    const double bound = std::sqrt(std::pow(plan.at_D.total, 2) + std::pow(c.mc, 2));
-    std::printf(
-        "  plane at %.0f mm (%.0f x %.0f mm, 12 x 12 bins): relative L2 %.4f, flux out / in "
-        "%.5f; predicted: plan %.4f, rays' Monte-Carlo %.4f, together %.4f\n",
-        plan_in.receiver_mm, w, h, c.rel_l2, c.flux_ratio, plan.at_D.total, c.mc, bound);
-    // The margin: the exported rays keep the light field's positive part only (SampleSlabRays,
-    // docs/design.md §5.17; 18 % of this slab's flux left out), a centre-to-edge pattern of a few
-    // per cent on these bins that the accuracy model does not include (measured 1.12 x and
-    // 1.03 x the prediction at d and 4d).
-    EXPECT_LT(c.rel_l2, 1.5 * bound);
-    EXPECT_NEAR(c.flux_ratio, 1, 1.5 * bound);
+    for (size_t seed = 0; seed < outputs.size(); ++seed) {
+      const Bins out = BinOnPlane(outputs[seed], plan_in.receiver_mm, w, h, 12);
+      const Comparison c = Compare(out, in);
+      const double bound = std::sqrt(std::pow(plan.at_D.total, 2) + std::pow(c.mc, 2));
+      std::printf(
+          "  plane at %.0f mm (%.0f x %.0f mm, 12 x 12 bins), seed %zu: relative L2 %.4f, flux "
+          "out / in %.5f; predicted: plan %.4f, rays' Monte-Carlo %.4f, together %.4f (%.2f x)\n",
+          plan_in.receiver_mm, w, h, seed, c.rel_l2, c.flux_ratio, plan.at_D.total, c.mc, bound,
+          c.rel_l2 / bound);
+      // Within the prediction itself: the exported rays carry the slab's light field, its
+      // negative part cancelled within each texel keeping the texel's flux and centroid
+      // (SampleSlabRays, docs/design.md §5.17). Measured 0.5 - 0.6 x at d and 4d (when the rays
+      // kept only the positive part, 1.12 x and 1.03 x: a +-4 % centre-to-edge pattern).
+      EXPECT_LT(c.rel_l2, bound);
+      EXPECT_NEAR(c.flux_ratio, 1, bound);
+    }
   }
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
 }

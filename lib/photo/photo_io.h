@@ -115,7 +115,8 @@ inline int CodeAtOrAbove(uint16_t fractional_code) {
 // A new image for a photo's pixels (type as cv::Mat::create). Large ones are allocated in
 // transparent huge pages (madvise(MADV_HUGEPAGE), for a kernel whose THP mode is `madvise`):
 // filling a fresh 144 MB image costs ~37000 first-touch page faults in 4 kB pages, 0.5 - 1 s on
-// the development VM, against ~72 faults of 2 MB pages. Released as any cv::Mat.
+// the development VM, against ~72 faults of 2 MB pages. Released as any cv::Mat; a large one's
+// buffer is kept for the next image of its size (the kernel zeroes fresh pages, photo_io.cc).
 cv::Mat NewPhotoImage(int rows, int cols, int type);
 
 // The spec of a dataset's slide photo (its radiometry and the photo's exposure), and of its

@@ -101,11 +101,15 @@ struct Photo {
 constexpr int kFractionalCodeOne = 256;
 // The one reading of a fractional code through a per-code table (256 entries; the curve value
 // of each whole code): the table's value read linearly between the two codes around it.
+// Without a branch, which the merge's row loop mispredicted (f = 0 at every code 0 and 255 and
+// at random elsewhere; a test loop: 1.2 - 4 ns per value with the branch, 0.8 without): at a
+// whole code (f = 0) both reads are table[k] and the value is table[k] + 0 = table[k] exactly
+// (the tables hold finite values or NaN, never an infinity).
 inline float ReadBetweenCodes(const float* table, uint16_t fractional_code) {
   const int k = fractional_code >> 8, f = fractional_code & 255;
   // f > 0 only below code 255: table[k + 1] is in the table.
-  return f ? table[k] + float(f) * (1.f / kFractionalCodeOne) * (table[k + 1] - table[k])
-           : table[k];
+  const float a = table[k], b = table[k + (f != 0)];
+  return a + float(f) * (1.f / kFractionalCodeOne) * (b - a);
 }
 // The whole code at or above a fractional code: its clipping decides the fractional code's.
 inline int CodeAtOrAbove(uint16_t fractional_code) {

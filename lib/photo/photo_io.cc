@@ -34,9 +34,9 @@ double LinearToSrgb(double v) {
 // cv::Mat's standard allocator (OpenCV's StdMatAllocator), except that a buffer of 4 MB or more
 // is aligned to 2 MB, marked for transparent huge pages, and kept when released for the next
 // image of the same byte size. (Fresh pages are zeroed by the kernel at first touch: 864 MB of
-// JPEG photo buffers per position, ~10 % of that position's CPU time, and more, and varying,
-// where huge pages are short; the photos of the next position have the same sizes.) The kept
-// buffers and those in use add up to at most the most bytes ever in use at once (the oldest
+// JPEG photo buffers per position, ~0.75 s of a 6000 x 4000 position's ~2.35 s CPU time on the
+// development VM, docs/design.md 8.3; the photos of the next position have the same sizes.) The
+// kept buffers and those in use add up to at most the most bytes ever in use at once (the oldest
 // kept buffers are freed first), so the process never holds more than at its busiest. Other
 // buffers are freed with std::free.
 class HugePageAllocator : public cv::MatAllocator {
@@ -58,8 +58,10 @@ class HugePageAllocator : public cv::MatAllocator {
     void* data = data0;
     if (!data) data = Huge(total) ? TakeKept(total) : nullptr;
     if (!data) {
-      if (posix_memalign(&data, Huge(total) ? kHuge : 64, std::max<size_t>(total, 1)) != 0)
+      if (posix_memalign(&data, Huge(total) ? kHuge : 64, std::max<size_t>(total, 1)) != 0) {
+        if (Huge(total)) Uncount(total);
         throw std::bad_alloc();
+      }
 #ifdef MADV_HUGEPAGE
       // Advice only: where the kernel has no THP the pages stay 4 kB.
       if (Huge(total)) madvise(data, total / kHuge * kHuge, MADV_HUGEPAGE);
@@ -90,8 +92,8 @@ class HugePageAllocator : public cv::MatAllocator {
   static constexpr size_t kHuge = size_t(2) << 20;
   static bool Huge(size_t bytes) { return bytes >= 2 * kHuge; }
 
-  // A kept buffer of exactly `bytes` (the most recently kept), or a fresh one's accounting and
-  // nullptr.
+  // A kept buffer of exactly `bytes` (the most recently kept), or nullptr: the caller allocates
+  // a fresh one, counted here as in use.
   void* TakeKept(size_t bytes) const {
     std::lock_guard<std::mutex> lock(mutex_);
     in_use_ += bytes;
@@ -105,6 +107,10 @@ class HugePageAllocator : public cv::MatAllocator {
     peak_ = std::max(peak_, in_use_);
     FreeOldestKept();
     return nullptr;
+  }
+  void Uncount(size_t bytes) const {  // a fresh buffer that could not be allocated
+    std::lock_guard<std::mutex> lock(mutex_);
+    in_use_ -= bytes;
   }
   void Keep(void* data, size_t bytes) const {
     std::lock_guard<std::mutex> lock(mutex_);

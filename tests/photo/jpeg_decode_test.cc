@@ -1,13 +1,17 @@
 // The colour JPEG decoder (lib/photo/jpeg_decode.h): the same picture as OpenCV's decoder, less
 // the rounding of the colour conversion; truncated files refused; other JPEGs left to OpenCV.
+// Also the reading of its fractional codes (ReadBetweenCodes) and its images' buffers
+// (NewPhotoImage).
 #include "lib/photo/jpeg_decode.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "lib/photo/photo_io.h"
 #include "photo_test_util.h"
@@ -105,6 +109,48 @@ TEST(JpegDecode, TruncatedJpegIsRefusedNamingIt) {
   std::string message;
   EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(path); }, path, &message));
   EXPECT_NE(message.find("JPEG"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace lumislab
+
+namespace lumislab {
+namespace {
+
+// Between codes the table is read linearly; at a whole code its entry is returned exactly, even
+// where the next code up is clipped (NaN), which a code above the whole one reads.
+TEST(ReadBetweenCodes, LinearBetweenCodesExactAtWholeCodes) {
+  std::vector<float> table(256);
+  for (int k = 0; k < 256; ++k) table[k] = 0.001f * float(k * k) + 0.1f;
+  table[201] = std::numeric_limits<float>::quiet_NaN();  // clipped from code 201 up
+  for (int k = 0; k < 200; ++k) {
+    EXPECT_EQ(ReadBetweenCodes(table.data(), uint16_t(k * kFractionalCodeOne)), table[k]);
+    const float half = ReadBetweenCodes(table.data(), uint16_t(k * kFractionalCodeOne + 128));
+    EXPECT_NEAR(half, 0.5f * (table[k] + table[k + 1]), 1e-6f * table[k + 1]) << k;
+  }
+  EXPECT_EQ(ReadBetweenCodes(table.data(), uint16_t(200 * kFractionalCodeOne)), table[200]);
+  EXPECT_TRUE(std::isnan(ReadBetweenCodes(table.data(), uint16_t(200 * kFractionalCodeOne + 1))));
+  EXPECT_EQ(ReadBetweenCodes(table.data(), uint16_t(255 * kFractionalCodeOne)), table[255]);
+}
+
+// A large image's buffer (>= 4 MB) is kept when released and given to the next image of the
+// same size (no fresh pages for the kernel to zero); one of another size gets its own buffer.
+TEST(NewPhotoImage, ReleasedLargeBufferServesTheNextImageOfItsSize) {
+  cv::Mat a = NewPhotoImage(1000, 1500, CV_16UC3);  // 9 MB
+  a.setTo(cv::Scalar::all(7));
+  const uchar* data = a.data;
+  a.release();
+  cv::Mat b = NewPhotoImage(1000, 1500, CV_16UC3);
+  EXPECT_EQ(b.data, data);
+  // The same pages, not fresh (zeroed) ones at the same address: a's values are still there.
+  EXPECT_EQ(b.at<cv::Vec3w>(0, 0)[0], 7);
+  EXPECT_EQ(b.at<cv::Vec3w>(999, 1499)[2], 7);
+  cv::Mat c = NewPhotoImage(1000, 1600, CV_16UC3);
+  EXPECT_NE(c.data, data);
+  EXPECT_EQ(c.total(), size_t(1000) * 1600);
+  // Both in use at once: two buffers.
+  cv::Mat d = NewPhotoImage(1000, 1500, CV_16UC3);
+  EXPECT_NE(d.data, b.data);
 }
 
 }  // namespace

@@ -7,13 +7,14 @@
 // The cases are written to the contract, not to today's behaviour: a failing case is a bug in a
 // tool (or a contract to settle), never a reason to edit the expectation.
 //
-// Each case is its own ctest entry (TEST_P; ctest runs them in separate processes, several at
-// once; ctest -L catalogue runs them all). The valid inputs (a 2x2 grid of 320x240 photos,
-// 16-bit PNG and half-float EXR, calibrated, a 40x40 slab) are made once per build of the tools
-// under a lock in the build tree (see Masters) and copied into a fresh folder per case; the
-// tools run from the case folder (paths in messages read "ds/dataset.json"), through `timeout`
-// and under `ulimit -v` 2 GiB, so a hang or an allocation of gigabytes fails the case instead of
-// the machine. LUMISLAB_KEEP_CASES=1 keeps the case folders.
+// Each case is a TEST_P; ctest runs them in 8 shards (Cli/Catalogue.shard<i>of8, each one process
+// running every 8th case: tests/cli/CMakeLists.txt; ctest -L catalogue runs them all; one case
+// alone: bad_input_catalogue_test --gtest_filter='*/<name>'). The valid inputs (a 2x2 grid of
+// 320x240 photos, 16-bit PNG and half-float EXR, calibrated, a 40x40 slab) are made once per build
+// of the tools under a lock in the build tree (see Masters) and copied into a fresh folder per
+// case; the tools run from the case folder (paths in messages read "ds/dataset.json"), through
+// `timeout` and under `ulimit -v` 2 GiB, so a hang or an allocation of gigabytes fails the case
+// instead of the machine. LUMISLAB_KEEP_CASES=1 keeps the case folders.
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -101,12 +102,12 @@ enum class Input {
   kExrCalibrated,  // ds/: acquired with half-float EXR photos, + calib/screen.json
 };
 
-// The valid datasets, made once for a build of the tools and shared by every case process:
-// ctest starts one process per case, and making them in each (acquire, calibrate, reconstruct:
-// about 0.5 s) would double the catalogue's time. They live in the build tree under a key of the
-// sizes and times of the tools and of this test, are made under an exclusive lock (flock) into a
-// staging folder that is renamed into place, and are only ever read (each case works on its own
-// copy).
+// The valid datasets, made once for a build of the tools and shared by every process (the
+// shards, which ctest runs side by side, and single cases run by hand): making them in each
+// (acquire, calibrate, reconstruct: about 0.5 s) is what this saves. They live in the build tree
+// under a key of the sizes and times of the tools and of this test, are made under an exclusive
+// lock (flock) into a staging folder that is renamed into place, and are only ever read (each case
+// works on its own copy).
 class Masters {
  public:
   // The master dataset folder for `input` ("" for kScene); "" and `error` when making it failed.

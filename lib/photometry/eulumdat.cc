@@ -319,7 +319,10 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
      << field(TrimField(d.Keyword("ISSUEDATE") + " " + d.Keyword("TESTLAB"))) << "\n";
   for (double v : {length, width, height, length, width, height, height, height, height})
     os << Num(v, 8) << "\n";
-  os << Num(100.0 * d.FluxWithin(90) / flux, 8) << "\n"  // DFF: gamma < 90 is downward
+  // Ratios first, then the scale (here and for the intensities below): with values near the
+  // largest double, 100 * flux or value * 1000 overflowed to "inf", which the reader refuses
+  // (found by fuzz_eulumdat).
+  os << Num(d.FluxWithin(90) / flux * 100.0, 8) << "\n"  // DFF: gamma < 90 is downward
      << "100\n1\n0\n1\n1\n"
      << (d.photometric ? keyword_or("LAMP", "luminaire (absolute photometry)") : kRadiometricLamp)
      << "\n"
@@ -331,7 +334,7 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
   for (double g : d.gamma_deg) os << Num(g, 15) << "\n";
   for (size_t c = 0; c < stored.size(); ++c)
     for (size_t g = 0; g < d.gamma_deg.size(); ++g)
-      os << Num(d.At(c, g) * 1000.0 / flux, 8) << "\n";
+      os << Num(d.At(c, g) / flux * 1000.0, 8) << "\n";
   return os.str();
 }
 

@@ -374,6 +374,19 @@ TEST(Eulumdat, FuzzFindingsEndPlanesNearASymmetryPlane) {
   }
 }
 
+// Found by fuzz/fuzz_eulumdat (fuzz/corpus/fuzz_eulumdat/regression_values_near_max_double.ldt):
+// intensities near the largest double (a finite total flux) were written as "inf", the downward
+// flux fraction as 100 * flux / flux and the intensities as value * 1000 / flux both overflowing;
+// the reader then refused what the writer wrote.
+TEST(Eulumdat, FuzzFindingValuesNearTheLargestDoubleAreWrittenFinite) {
+  IntensityDistribution d = Analytic({0, 90, 180, 270}, [](double) { return 1.0; });
+  for (double& v : d.values) v *= 1e304;  // peak 1e306 cd: value * 1000 and 100 * flux overflow
+  ASSERT_TRUE(std::isfinite(d.TotalFlux()));
+  const std::string text = FormatEulumdat(d, "big.ldt");
+  EXPECT_EQ(text.find("inf"), std::string::npos);
+  ExpectSameDistribution(d, ParseEulumdat(text, "big.ldt"), "values near the largest double");
+}
+
 // lumislab-export info --json on a file whose text is not UTF-8 (an ISO-8859-1 maker's name, as
 // European IES files have): nlohmann's dump threw type_error 316, exit 1 ("failure") for a good
 // file. The description replaces the bytes (U+FFFD) and keeps the rest (found by reading

@@ -147,6 +147,15 @@ void CancelNegativeRayCells(const RayCellAxis& ax, const RayCellAxis& ay,
         givers.push_back({c, f[c], 1.0, std::sqrt(nearest2), Eigen::Vector3d(1, a - mx, b - my)});
       }
   }
+  if (givers.empty()) {
+    // No positive cell at all: only where the texel's net flux, positive, is below the rounding
+    // of its sums over the cells. The profile is left empty; a ray drawn for such a texel (its
+    // share of the flux is at that rounding level) starts at the grid's centre cell.
+    std::fill(f.begin(), f.end(), 0.0);
+    stats->moved += negative;
+    stats->uncentred += negative;
+    return;
+  }
   double k_max = 0;
   for (const Giver& g : givers) k_max = std::max(k_max, g.k);
   for (Giver& g : givers) g.k /= k_max;
@@ -419,8 +428,10 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
     for (int k = first[t]; k < first[t + 1]; ++k) {
       const auto it = std::upper_bound(cell_cumulative.begin(), cell_cumulative.end(),
                                        unit(texel_rng) * cell_running);
-      const size_t c =
-          size_t(std::min<ptrdiff_t>(it - cell_cumulative.begin(), ptrdiff_t(profile.size()) - 1));
+      const size_t c = cell_running > 0
+                           ? size_t(std::min<ptrdiff_t>(it - cell_cumulative.begin(),
+                                                        ptrdiff_t(profile.size()) - 1))
+                           : size_t(ay.cells / 2) * ax.cells + ax.cells / 2;  // an empty profile
       const double u = ax.start_mm + (double(c % ax.cells) + unit(texel_rng)) * ax.width_mm;
       const double v = ay.start_mm + (double(c / ax.cells) + unit(texel_rng)) * ay.width_mm;
       const double s = centre.x() + (unit(texel_rng) - 0.5) * layout.TexelW();

@@ -101,6 +101,17 @@ void CancelNegativeRayCells(const RayCellAxis& ax, const RayCellAxis& ay,
   std::vector<Giver> givers;
   double available = 0;
   const int radius = kRayCancelRadius;
+  // The distance (mm) from cell (a, b) to the nearest negative cell within `window` cells.
+  auto nearest_negative_mm = [&](int a, int b, int window) {
+    double nearest2 = std::numeric_limits<double>::infinity();  // mm^2
+    for (int y = std::max(0, b - window); y <= std::min(ny - 1, b + window); ++y) {
+      const double dy2 = std::pow((y - b) * ay.width_mm, 2);
+      for (int x = std::max(0, a - window); x <= std::min(nx - 1, a + window); ++x)
+        if (f[size_t(y) * nx + x] < 0)
+          nearest2 = std::min(nearest2, std::pow((x - a) * ax.width_mm, 2) + dy2);
+    }
+    return std::sqrt(nearest2);
+  };
   // k by two box passes: along rows, then along columns.
   std::vector<double> row_box(f.size(), 0.0);
   for (int b = 0; b < ny; ++b) {
@@ -120,14 +131,8 @@ void CancelNegativeRayCells(const RayCellAxis& ax, const RayCellAxis& ay,
       for (int y = std::max(0, b - radius); y <= std::min(ny - 1, b + radius); ++y)
         k += row_box[size_t(y) * nx + a];
       if (!(k > 0)) continue;
-      double nearest2 = std::numeric_limits<double>::infinity();  // mm^2
-      for (int y = std::max(0, b - radius); y <= std::min(ny - 1, b + radius); ++y) {
-        const double dy2 = std::pow((y - b) * ay.width_mm, 2);
-        for (int x = std::max(0, a - radius); x <= std::min(nx - 1, a + radius); ++x)
-          if (f[size_t(y) * nx + x] < 0)
-            nearest2 = std::min(nearest2, std::pow((x - a) * ax.width_mm, 2) + dy2);
-      }
-      givers.push_back({c, f[c], k, std::sqrt(nearest2), Eigen::Vector3d(1, a - mx, b - my)});
+      givers.push_back(
+          {c, f[c], k, nearest_negative_mm(a, b, radius), Eigen::Vector3d(1, a - mx, b - my)});
       available += f[c];
     }
   if (available < negative) {
@@ -138,13 +143,8 @@ void CancelNegativeRayCells(const RayCellAxis& ax, const RayCellAxis& ay,
       for (int a = 0; a < nx; ++a) {
         const size_t c = size_t(b) * nx + a;
         if (!(f[c] > 0)) continue;
-        double nearest2 = std::numeric_limits<double>::infinity();
-        for (int y = 0; y < ny; ++y)
-          for (int x = 0; x < nx; ++x)
-            if (f[size_t(y) * nx + x] < 0)
-              nearest2 = std::min(nearest2, std::pow((x - a) * ax.width_mm, 2) +
-                                                std::pow((y - b) * ay.width_mm, 2));
-        givers.push_back({c, f[c], 1.0, std::sqrt(nearest2), Eigen::Vector3d(1, a - mx, b - my)});
+        givers.push_back({c, f[c], 1.0, nearest_negative_mm(a, b, std::max(nx, ny)),
+                          Eigen::Vector3d(1, a - mx, b - my)});
       }
   }
   if (givers.empty()) {

@@ -111,12 +111,6 @@ TEST(JpegDecode, TruncatedJpegIsRefusedNamingIt) {
   EXPECT_NE(message.find("JPEG"), std::string::npos) << message;
 }
 
-}  // namespace
-}  // namespace lumislab
-
-namespace lumislab {
-namespace {
-
 // Between codes the table is read linearly; at a whole code its entry is returned exactly, even
 // where the next code up is clipped (NaN), which a code above the whole one reads.
 TEST(ReadBetweenCodes, LinearBetweenCodesExactAtWholeCodes) {

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 
 #include "core/error.h"
@@ -94,13 +95,14 @@ vec3 DecodeSrgbe(uint p) {
 }
 )";
 
-// Early depth tests even with discard (depth writes are off in light passes): only the visible
-// fragment of each pixel is shaded.
+// Deferred: a full-screen pass that shades what the G-buffer holds (kGeometryFragment), one
+// fragment per pixel. (Drawing the scene again instead runs the light loop for every 4 x 4 block
+// each visible triangle touches: on llvmpipe the cloister's light pass then cost nearly as much
+// at 400 x 400 as at 800 x 800.)
 const std::string kLightFragment = std::string(R"(#version 450 core
-layout(early_fragment_tests) in;
-in vec3 v_lum_position;
-in vec3 v_lum_normal;
-in vec3 v_albedo;
+uniform sampler2D u_gbuffer_position;  // luminaire frame, w = 1 where a surface was seen
+uniform sampler2D u_gbuffer_normal;    // unit normal, luminaire frame
+uniform sampler2D u_gbuffer_albedo;
 uniform sampler2DArray u_intensity;
 uniform sampler2DArrayShadow u_shadow;
 uniform int u_count;
@@ -119,14 +121,11 @@ uniform int u_near_end;
 uniform int u_far_begin;
 uniform float u_z_far;
 #endif
-uniform bool u_shadows;
 uniform float u_offset_scale;  // normal offset per mm of distance (one shadow texel)
 uniform float u_radiance_scale;
 uniform bool u_unit_albedo;  // irradiance view (false colour): E before the materials
-uniform bool u_srgbe;
 uniform usampler2D u_previous;
 uniform vec2 u_grid_half;  // half extent of the filter centres: the union of all spot cones
-uniform int u_texture_filter;  // TextureFilter: 0 bilinear (hardware), 1 nearest, 2 cubic
 layout(location = 0) out vec4 o_float;
 layout(location = 1) out uint o_packed;
 )") + kLightClip + kSrgbeCode + R"(
@@ -143,10 +142,14 @@ vec4 CatmullRom(float f) {
               0.5 * f3 - 0.5 * f2);
 }
 vec3 SampleIntensity(vec2 uv, int layer) {
-  if (u_texture_filter == 0) return texture(u_intensity, vec3(uv, float(layer))).rgb;
+#if TEXTURE_FILTER == 0
+  return texture(u_intensity, vec3(uv, float(layer))).rgb;
+#else
   ivec2 size = textureSize(u_intensity, 0).xy;
   vec2 p = uv * vec2(size) - 0.5;  // texel-centre coordinates
-  if (u_texture_filter == 1) return TexelClamped(ivec2(floor(p + 0.5)), size, layer);
+#if TEXTURE_FILTER == 1
+  return TexelClamped(ivec2(floor(p + 0.5)), size, layer);
+#else
   ivec2 base = ivec2(floor(p));
   vec2 f = p - vec2(base);
   vec4 wx = CatmullRom(f.x), wy = CatmullRom(f.y);
@@ -157,17 +160,24 @@ vec3 SampleIntensity(vec2 uv, int layer) {
     sum += wy[b] * row;
   }
   return sum;
+#endif
+#endif
 }
 
 void main() {
-  vec3 x = v_lum_position;
-  vec3 n = normalize(v_lum_normal);
+  const ivec2 pixel = ivec2(gl_FragCoord.xy);
+  const vec4 surface = texelFetch(u_gbuffer_position, pixel, 0);
+  if (surface.w == 0.0) discard;  // no surface: both sRGBE targets keep their cleared 0
+  const vec3 x = surface.xyz;
+  const vec3 n = texelFetch(u_gbuffer_normal, pixel, 0).xyz;
   vec3 sum = vec3(0.0);
   // Outside every spot light's cone (behind S, or not through the window from any c_ij): no
   // light. In float mode the fragment is dropped before the light loop (adds 0 anyway).
   vec2 reach = 0.5 * u_window + u_grid_half * abs(1.0 - u_d / max(x.z, 1e-6));
   bool dark = x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
-  if (dark && !u_srgbe) discard;
+#if !SRGBE
+  if (dark) discard;
+#endif
 #if FAST
   const bool far = x.z >= u_z_far;
   const int first = far ? u_far_begin : 0;
@@ -186,7 +196,8 @@ void main() {
     if (abs(st.x) > 0.5 * u_window.x || abs(st.y) > 0.5 * u_window.y) continue;
     vec2 uv = vec2(st.x / u_window.x + 0.5, 0.5 - st.y / u_window.y);
     float visible = 1.0;
-    if (u_shadows) {
+#if SHADOWS
+    {
 #if FAST
       visible = 0.0;
       const int begin = u_shadow_span[k].x, end = begin + u_shadow_span[k].y;
@@ -204,17 +215,35 @@ void main() {
                                        0.5 * ndc.z + 0.5));
 #endif
     }
+#endif
     vec3 intensity = SampleIntensity(uv, u_layers[k]);
     sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
   }
-  vec3 radiance = sum * (u_unit_albedo ? vec3(1.0) : v_albedo) * u_radiance_scale;
+  vec3 radiance = sum * (u_unit_albedo ? vec3(1.0) : texelFetch(u_gbuffer_albedo, pixel, 0).rgb) *
+                  u_radiance_scale;
   o_float = vec4(radiance, 1.0);
-  if (u_srgbe) {
-    vec3 previous = DecodeSrgbe(texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r);
-    o_packed = EncodeSrgbe(previous + radiance);
-  } else {
-    o_packed = 0u;
-  }
+#if SRGBE
+  vec3 previous = DecodeSrgbe(texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r);
+  o_packed = EncodeSrgbe(previous + radiance);
+#else
+  o_packed = 0u;
+#endif
+}
+)";
+
+// The G-buffer: what each pixel sees, in the luminaire frame (redrawn when the view, the scene or
+// the pose changes; the light passes read it).
+const char* kGeometryFragment = R"(#version 450 core
+in vec3 v_lum_position;
+in vec3 v_lum_normal;
+in vec3 v_albedo;
+layout(location = 0) out vec4 o_position;
+layout(location = 1) out vec4 o_normal;
+layout(location = 2) out vec4 o_albedo;
+void main() {
+  o_position = vec4(v_lum_position, 1.0);
+  o_normal = vec4(normalize(v_lum_normal), 0.0);
+  o_albedo = vec4(v_albedo, 1.0);
 }
 )";
 
@@ -279,14 +308,26 @@ GLuint Link(const std::string& vertex, const std::string& fragment) {
 
 GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
+// The light pass's fragment shader, its options compiled in: llvmpipe runs both sides of a
+// branch on a uniform, masked, so a run-time switch costs its untaken side in every light
+// iteration (the cubic filter's 16 texel reads: a third of the light pass, measured).
+std::string LightFragment(const std::string& defines) {
+  std::string f = kLightFragment;
+  f.insert(f.find('\n') + 1, defines);
+  return f;
+}
+
 }  // namespace
 
 struct Renderer::Gl {
   GLuint vao = 0, vbo = 0, quad_vao = 0;
-  GLuint scene_program = 0, fast_program = 0, depth_program = 0, shadow_program = 0,
-         display_program = 0;
+  GLuint geometry_program = 0, shadow_program = 0, display_program = 0;
+  // Light-pass programs by their #defines (Renderer::LightProgram), linked when first used.
+  std::map<std::string, GLuint> light_programs;
   GLuint intensity = 0, shadow = 0, shadow_fbo = 0;
-  GLuint colour = 0, packed[2] = {0, 0}, depth = 0, fbo[2] = {0, 0};
+  GLuint colour = 0, packed[2] = {0, 0}, fbo[2] = {0, 0};
+  // The G-buffer (kGeometryFragment): position, normal, albedo and depth.
+  GLuint gbuffer[3] = {0, 0, 0}, depth = 0, gbuffer_fbo = 0;
 };
 
 Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options)
@@ -304,17 +345,11 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   intensity_.resize(lights);
   // Merged textures follow the positions' layers: at most one per 2 x 2 block.
   const int merge_layers = ((info_.grid.nu + 1) / 2) * ((info_.grid.nv + 1) / 2);
-  auto light_fragment = [](int per_pass, bool fast) {
-    std::string f = kLightFragment;
-    f.insert(f.find('\n') + 1, "#define LIGHTS_PER_PASS " + std::to_string(per_pass) +
-                                   "\n#define FAST " + (fast ? "1" : "0") + "\n");
-    return f;
-  };
-  gl_->scene_program = Link(kSceneVertex, light_fragment(kLightsPerPass, false));
-  // The shortcuts' program is linked when first used (its uniform arrays are larger: a driver
-  // that refuses it then fails only the shortcuts, not the full render).
-  fast_fragment_ = light_fragment(kFastLightsPerPass, true);
-  gl_->depth_program = Link(kSceneVertex, kEmptyFragment);
+  // The light program of these options now, so that a driver that refuses it fails here; the
+  // others are linked when first used (the shortcuts' uniform arrays are larger: a driver that
+  // refuses them then fails only the shortcuts, not the full render).
+  LightProgram(false);
+  gl_->geometry_program = Link(kSceneVertex, kGeometryFragment);
   gl_->shadow_program = Link(kShadowVertex, kEmptyFragment);
   gl_->display_program = Link(kQuadVertex, kDisplayFragment);
   glGenVertexArrays(1, &gl_->vao);
@@ -347,15 +382,17 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
 
 Renderer::~Renderer() {
   glDeleteFramebuffers(2, gl_->fbo);
+  glDeleteFramebuffers(1, &gl_->gbuffer_fbo);
   glDeleteFramebuffers(1, &gl_->shadow_fbo);
-  GLuint textures[] = {gl_->intensity, gl_->shadow,    gl_->colour,
-                       gl_->packed[0], gl_->packed[1], gl_->depth};
-  glDeleteTextures(6, textures);
+  GLuint textures[] = {gl_->intensity,  gl_->shadow,     gl_->colour,
+                       gl_->packed[0],  gl_->packed[1],  gl_->depth,
+                       gl_->gbuffer[0], gl_->gbuffer[1], gl_->gbuffer[2]};
+  glDeleteTextures(9, textures);
   glDeleteBuffers(1, &gl_->vbo);
   glDeleteVertexArrays(1, &gl_->vao);
   glDeleteVertexArrays(1, &gl_->quad_vao);
-  for (GLuint p : {gl_->scene_program, gl_->fast_program, gl_->depth_program, gl_->shadow_program,
-                   gl_->display_program}) {
+  for (const auto& [defines, program] : gl_->light_programs) glDeleteProgram(program);
+  for (GLuint p : {gl_->geometry_program, gl_->shadow_program, gl_->display_program}) {
     glDeleteProgram(p);
   }
   delete gl_;
@@ -364,8 +401,10 @@ Renderer::~Renderer() {
 void Renderer::AllocateTargets() {
   if (gl_->fbo[0]) {
     glDeleteFramebuffers(2, gl_->fbo);
-    GLuint textures[] = {gl_->colour, gl_->packed[0], gl_->packed[1], gl_->depth};
-    glDeleteTextures(4, textures);
+    glDeleteFramebuffers(1, &gl_->gbuffer_fbo);
+    GLuint textures[] = {gl_->colour,     gl_->packed[0],  gl_->packed[1], gl_->depth,
+                         gl_->gbuffer[0], gl_->gbuffer[1], gl_->gbuffer[2]};
+    glDeleteTextures(7, textures);
   }
   auto make = [&](GLenum format) {
     GLuint t = 0;
@@ -381,12 +420,23 @@ void Renderer::AllocateTargets() {
   gl_->packed[0] = make(GL_R32UI);
   gl_->packed[1] = make(GL_R32UI);
   gl_->depth = make(GL_DEPTH_COMPONENT32F);
+  for (GLuint& t : gl_->gbuffer) t = make(GL_RGBA32F);  // 32-bit: the values the scene gives
+  glGenFramebuffers(1, &gl_->gbuffer_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->gbuffer_fbo);
+  for (int k = 0; k < 3; ++k) {
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, gl_->gbuffer[k], 0);
+  }
+  glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->depth, 0);
+  const GLenum gbuffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  glDrawBuffers(3, gbuffers);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw Failure("G-buffer framebuffer incomplete");
+  }
   glGenFramebuffers(2, gl_->fbo);
   for (int k = 0; k < 2; ++k) {
     glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[k]);
     glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, gl_->colour, 0);
     glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, gl_->packed[k], 0);
-    glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->depth, 0);
     const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glDrawBuffers(2, buffers);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
@@ -770,19 +820,13 @@ void Renderer::SetCommonUniforms(unsigned program, bool /*fast*/) {
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[target]);
   glViewport(0, 0, width_, height_);
   glUseProgram(p);
-  const Eigen::Matrix4f to_lum = pose_.inverse().matrix().cast<float>();
-  glUniformMatrix4fv(Loc(p, "u_view_projection"), 1, GL_FALSE, view_projection_.data());
-  glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
   glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
   const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
   const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
   glUniform2f(Loc(p, "u_depth"), float(a), float(b));
-  glUniform1i(Loc(p, "u_shadows"), options_.shadows);
-  glUniform1i(Loc(p, "u_srgbe"), options_.srgbe);
   glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
   glUniform1i(Loc(p, "u_unit_albedo"), options_.unit_albedo ? 1 : 0);
-  glUniform1i(Loc(p, "u_texture_filter"), int(options_.texture_filter));
   const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);
   glUniform2f(Loc(p, "u_grid_half"), float(corner.x()), float(corner.y()));
   // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.
@@ -800,11 +844,27 @@ void Renderer::SetCommonUniforms(unsigned program, bool /*fast*/) {
   glUniform1i(Loc(p, "u_intensity"), 0);
   glUniform1i(Loc(p, "u_shadow"), 1);
   glUniform1i(Loc(p, "u_previous"), 2);
+  const char* gbuffer[] = {"u_gbuffer_position", "u_gbuffer_normal", "u_gbuffer_albedo"};
+  for (int k = 0; k < 3; ++k) {
+    glActiveTexture(GL_TEXTURE3 + k);
+    glBindTexture(GL_TEXTURE_2D, gl_->gbuffer[k]);
+    glUniform1i(Loc(p, gbuffer[k]), 3 + k);
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
+unsigned Renderer::LightProgram(bool fast) {
+  const std::string defines =
+      "#define LIGHTS_PER_PASS " + std::to_string(fast ? kFastLightsPerPass : kLightsPerPass) +
+      "\n#define FAST " + std::to_string(fast) + "\n#define SHADOWS " +
+      std::to_string(options_.shadows) + "\n#define SRGBE " + std::to_string(options_.srgbe) +
+      "\n#define TEXTURE_FILTER " + std::to_string(int(options_.texture_filter)) + "\n";
+  GLuint& program = gl_->light_programs[defines];
+  if (!program) program = Link(kQuadVertex, LightFragment(defines));
+  return program;
 }
 
 void Renderer::LightPass(const std::vector<int>& lights) {
-  const GLuint p = gl_->scene_program;
-  SetCommonUniforms(p, false);
   float centres[2 * kLightsPerPass];
   int layers[kLightsPerPass];
   for (size_t k = 0; k < lights.size(); ++k) {
@@ -814,6 +874,8 @@ void Renderer::LightPass(const std::vector<int>& lights) {
     centres[2 * k + 1] = float(c.y());
     layers[k] = l;
   }
+  const GLuint p = LightProgram(false);
+  SetCommonUniforms(p, false);
   glUniform1i(Loc(p, "u_count"), int(lights.size()));
   glUniform2fv(Loc(p, "u_centres"), GLsizei(lights.size()), centres);
   glUniform1iv(Loc(p, "u_layers"), GLsizei(lights.size()), layers);
@@ -822,9 +884,6 @@ void Renderer::LightPass(const std::vector<int>& lights) {
 
 void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
                              double z_far) {
-  if (!gl_->fast_program) gl_->fast_program = Link(kSceneVertex, fast_fragment_);
-  const GLuint p = gl_->fast_program;
-  SetCommonUniforms(p, true);
   float centres[2 * kFastLightsPerPass], shadow_centres[2 * kFastLightsPerPass];
   int layers[kFastLightsPerPass], shadow_layers[kFastLightsPerPass];
   int spans[2 * kFastLightsPerPass];
@@ -840,6 +899,8 @@ void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_en
     spans[2 * k] = e.span_begin < 0 ? int(k) : e.span_begin;
     spans[2 * k + 1] = e.span_count;
   }
+  const GLuint p = LightProgram(true);
+  SetCommonUniforms(p, true);
   glUniform1i(Loc(p, "u_count"), n);
   glUniform2fv(Loc(p, "u_centres"), n, centres);
   glUniform1iv(Loc(p, "u_layers"), n, layers);
@@ -852,10 +913,10 @@ void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_en
   DrawLightPass();
 }
 
+// Runs the bound light program over the image: float adds into the accumulation, sRGBE packs
+// the new sum into the other target.
 void Renderer::DrawLightPass() {
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LEQUAL);
-  glDepthMask(GL_FALSE);
+  glDisable(GL_DEPTH_TEST);
   if (options_.srgbe) {
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -866,14 +927,11 @@ void Renderer::DrawLightPass() {
     glEnablei(GL_BLEND, 0);
     glBlendFunci(0, GL_ONE, GL_ONE);
   }
-  if (options_.cull_back_faces) glEnable(GL_CULL_FACE);
-  glBindVertexArray(gl_->vao);
-  glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
-  glDisable(GL_CULL_FACE);
+  glBindVertexArray(gl_->quad_vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisablei(GL_BLEND, 0);
   glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthMask(GL_TRUE);
   if (options_.srgbe) ping_ = 1 - ping_;
 }
 
@@ -890,7 +948,8 @@ int Renderer::Render() {
     mark = now;
   };
   if (!view_valid_) {
-    // Clear both targets, then the depth pre-pass (light passes shade visible fragments only).
+    // Clear both targets, then draw the G-buffer (what each pixel sees; the light passes shade
+    // it).
     for (int k = 0; k < 2; ++k) {
       glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[k]);
       const float zero_f[4] = {0, 0, 0, 0};
@@ -899,20 +958,22 @@ int Renderer::Render() {
       glClearBufferuiv(GL_COLOR, 1, zero_u);
     }
     ping_ = 0;
-    glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[0]);
+    glBindFramebuffer(GL_FRAMEBUFFER, gl_->gbuffer_fbo);
     glViewport(0, 0, width_, height_);
+    const float zero[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 3; ++k) glClearBufferfv(GL_COLOR, k, zero);
     glDepthMask(GL_TRUE);
     glClear(GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     if (options_.cull_back_faces) glEnable(GL_CULL_FACE);
-    glUseProgram(gl_->depth_program);
-    glUniformMatrix4fv(Loc(gl_->depth_program, "u_view_projection"), 1, GL_FALSE,
-                       view_projection_.data());
+    const GLuint p = gl_->geometry_program;
+    glUseProgram(p);
+    const Eigen::Matrix4f to_lum = pose_.inverse().matrix().cast<float>();
+    glUniformMatrix4fv(Loc(p, "u_view_projection"), 1, GL_FALSE, view_projection_.data());
+    glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
     glBindVertexArray(gl_->vao);
     glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDisable(GL_CULL_FACE);
     accumulated_.assign(accumulated_.size(), false);
     view_valid_ = true;

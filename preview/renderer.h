@@ -4,10 +4,13 @@
 // materials; float (RGBA32F, additive blending) or sRGBE-packed accumulation (paper §4.2).
 // Needs a current GL 4.5 core context (OffscreenContext or WindowContext).
 //
+// Deferred shading: a G-buffer (luminaire-frame position, normal, albedo per pixel) is drawn when
+// the view changes, and each light pass is one full-screen pass over it; the shaders have the
+// options compiled in (LightProgram).
 // Caching: shadow maps are kept until the scene or the luminaire pose changes; the accumulated
-// image is kept until the camera, the scene, the pose or an option changes, so a newly arrived
-// position only costs its own light pass. Lights are batched (texture arrays, up to
-// kLightsPerPass per pass).
+// image and the G-buffer are kept until the camera, the scene, the pose or an option changes, so
+// a newly arrived position only costs its own light pass. Lights are batched (texture arrays, up
+// to kLightsPerPass per pass).
 #pragma once
 
 #include <Eigen/Core>
@@ -53,7 +56,7 @@ struct RenderOptions {
 
 // Wall time of the phases of the last Render() (milliseconds; only with time_phases).
 struct PhaseTimes {
-  double depth_ms = 0, shadow_ms = 0, light_ms = 0;
+  double depth_ms = 0, shadow_ms = 0, light_ms = 0;  // depth_ms: the G-buffer
 };
 
 constexpr int kLightsPerPass = 64;
@@ -116,6 +119,8 @@ class Renderer {
   void FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
                      double z_far);
   void SetCommonUniforms(unsigned program, bool fast);
+  // The light program for the present options (fast: the shortcuts'), linked when first used.
+  unsigned LightProgram(bool fast);
   void DrawLightPass();
   void FastPasses(const std::vector<int>& todo);
   void AllocateTargets();
@@ -139,7 +144,6 @@ class Renderer {
   bool groups_valid_ = false;
   std::vector<bool> merged_valid_;
   std::vector<double> merged_z_;  // z_G times the error bound (mm)
-  std::string fast_fragment_;
   int merged_group_size_ = 0;
   ShortcutState state_;
   Gl* gl_;

@@ -99,6 +99,7 @@ int Run(int argc, char** argv) {
   SceneSetup setup = MakeSceneSetup("crypt", info);
   RenderOptions options;
   options.cull_back_faces = setup.closed_room;
+  options.shadow_cull = setup.closed_room;  // as lumislab-preview
   Renderer renderer(info, w, h, options);
   renderer.SetScene(setup.mesh);
   renderer.SetPose(setup.pose);

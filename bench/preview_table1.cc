@@ -60,7 +60,7 @@ void UploadAll(const Slab& slab, Renderer& r) {
 int Run(int argc, char** argv) {
   int frames = 7, size = 400, shadow_size = 512;
   std::string csv = "preview_table1.csv";
-  bool quick = false, profile = false;
+  bool quick = false, profile = false, no_cull = false;
   RenderOptions fast;  // the shortcuts' settings of the "on" columns (defaults: the tool's)
   fast.shadow_share_texels = 0;
   fast.merge_group = 0;  // auto, as lumislab-preview: 2 without shadows, off with them
@@ -80,6 +80,9 @@ int Run(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--merge-error", fast.merge_error, "on columns: merged lights' error bound")
       ->capture_default_str();
+  app.add_flag("--no-shadow-cull", no_cull,
+               "on columns: every face in the shadow maps (default: only those turned to the "
+               "light, as lumislab-preview in a closed room)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -97,8 +100,9 @@ int Run(int argc, char** argv) {
   const Paper paper[] = {
       {5, 5, 2.7, 3.2, 1.3, 1.6}, {7, 7, 1.5, 1.7, 0.7, 0.85}, {9, 7, 1.2, 1.4, 0.55, 0.7}};
   std::ofstream out(csv);
-  std::printf("shortcuts on: --shadow-share %g --merge-group %d --merge-error %g\n",
-              fast.shadow_share_texels, fast.merge_group, fast.merge_error);
+  std::printf("shortcuts on: --shadow-share %g --merge-group %d --merge-error %g%s\n",
+              fast.shadow_share_texels, fast.merge_group, fast.merge_error,
+              no_cull ? " --no-shadow-cull" : "");
   out << "scene,triangles,grid,shadows,paper_fps,fps_cached_off,fps_full_off,fps_cached_on,"
          "fps_full_on,ratio_cached_off,ratio_full_off,ratio_cached_on,ratio_full_on,"
          "rel_l2_on_vs_off,shadow_group,shadow_shift_texels,merged_lights,z_merge_mm\n";
@@ -131,6 +135,7 @@ int Run(int argc, char** argv) {
         options_on.shadow_share_texels = fast.shadow_share_texels;
         options_on.merge_group = fast.merge_group > 0 ? fast.merge_group : (shadows ? 1 : 2);
         options_on.merge_error = fast.merge_error;
+        options_on.shadow_cull = setup.closed_room && !no_cull;  // as lumislab-preview
         Renderer off(slab.info, size, size, options), on(slab.info, size, size, options_on);
         for (Renderer* r : {&off, &on}) {
           r->SetScene(setup.mesh);

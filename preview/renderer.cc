@@ -490,7 +490,8 @@ void Renderer::SetOptions(const RenderOptions& options) {
   }
   if (options.merge_group < 1 || !(options.merge_error > 0) || !(options.shadow_share_texels >= 0))
     throw BadInput("merge group must be >= 1, merge error > 0, shadow sharing >= 0 texels");
-  if (options.shadow_share_texels != options_.shadow_share_texels) {
+  if (options.shadow_share_texels != options_.shadow_share_texels ||
+      options.shadow_cull != options_.shadow_cull) {
     shadow_valid_.assign(shadow_valid_.size(), false);
     groups_valid_ = false;
   }
@@ -560,7 +561,12 @@ void Renderer::RenderShadowMapAt(int layer, const Eigen::Vector2d& c) {
   const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
   glUniform2f(Loc(p, "u_depth"), float(a), float(b));
   glBindVertexArray(gl_->vao);
+  // Faces turned to the light wind counter-clockwise in the map (LightClip), so GL_BACK, the
+  // default, drops the faces turned away (culling GL_FRONT instead drops the room's walls: the
+  // crypt then moves by 3.1 %, PreviewSlabFiles.ShadowCullKeepsTheImage).
+  if (options_.shadow_cull) glEnable(GL_CULL_FACE);
   glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+  glDisable(GL_CULL_FACE);
   glDisable(GL_POLYGON_OFFSET_FILL);
   ++shadow_renders_;
 }

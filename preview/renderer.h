@@ -36,6 +36,10 @@ struct RenderOptions {
   bool shadow_pcf = false;  // 2x2 filtered depth compare (softer edges, ~15 % slower)
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
   bool cull_back_faces = false;  // camera passes only: see into a closed room from outside
+  // Shadow maps hold only the faces turned to the light (docs/design.md §4.2). In a closed scene
+  // (every surface facing the room, solids facing out) the nearest surface along a ray from the
+  // light faces it; silhouettes can lose up to a shadow texel (crypt: 0.6 % of the image).
+  bool shadow_cull = false;
   // Albedo 1 everywhere: with radiance_scale 1 the image is the irradiance E arriving at each
   // surface (W/m^2), which --view false-colour maps.
   bool unit_albedo = false;

@@ -95,6 +95,9 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
                "also render with the other accumulation format and report the difference");
   app.add_option("--shadow-size", config.shadow_size, "shadow-map size")->capture_default_str();
   app.add_flag("--shadow-pcf", config.shadow_pcf, "2x2 filtered shadow-map lookups");
+  app.add_flag("!--no-shadow-cull", config.shadow_cull,
+               "closed rooms: draw every face into the shadow maps, not only those turned to the "
+               "light (the default: 22 - 30 % faster maps, crypt image within 0.6 %)");
   app.add_option("--texture-filter", extras.texture_filter,
                  "E' between its texel centres: bilinear (the hardware's, the paper's) | nearest "
                  "| cubic (Catmull-Rom, 16 texel reads)")
@@ -217,6 +220,7 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
                                       {config.srgbe, "--srgbe"},
                                       {config.report_srgbe_error, "--srgbe-error"},
                                       {config.shadow_pcf, "--shadow-pcf"},
+                                      {!config.shadow_cull, "--no-shadow-cull"},
                                       {config.texture_filter != TextureFilter::kBilinear,
                                        "--texture-filter (it reads the slab bilinearly)"},
 
@@ -375,6 +379,7 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;
   options.cull_back_faces = setup.closed_room;
+  options.shadow_cull = setup.closed_room && config.shadow_cull;
   return options;
 }
 
@@ -493,6 +498,7 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   if (!config.shadows) line << arg("--no-shadows");
   line << arg("--shadow-size") << arg(std::to_string(config.shadow_size));
   if (config.shadow_pcf) line << arg("--shadow-pcf");
+  if (!config.shadow_cull) line << arg("--no-shadow-cull");
   if (config.shadow_share > 0) line << arg("--shadow-share") << arg(values({config.shadow_share}));
   if (config.merge_group != 0)
     line << arg("--merge-group") << arg(std::to_string(config.merge_group));

@@ -45,6 +45,9 @@ struct PreviewConfig {
   bool srgbe = false;
   int shadow_size = 512;
   bool shadow_pcf = false;
+  // Shadow maps of a closed room hold only the faces turned to the light (RenderOptions::
+  // shadow_cull); --no-shadow-cull draws every face.
+  bool shadow_cull = true;
   TextureFilter texture_filter = TextureFilter::kBilinear;  // --texture-filter
   // Faster frames (RenderOptions): shadow-map sharing (largest edge shift in shadow texels, 0:
   // off), merged lights (block side, 1: off; 0: auto, MergeGroup) and their error bound. On by

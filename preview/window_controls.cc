@@ -59,6 +59,8 @@ void ShadowsPanel(WindowState& s) {
   s.options_changed |= ImGui::Checkbox("shadows", &c.shadows);
   ImGui::SameLine();
   s.options_changed |= ImGui::Checkbox("PCF", &c.shadow_pcf);
+  ImGui::SameLine();
+  s.options_changed |= ImGui::Checkbox("cull", &c.shadow_cull);
   const int sizes[] = {128, 256, 512, 1024, 2048, 4096};
   const char* names[] = {"128", "256", "512", "1024", "2048", "4096"};
   int index = int(std::find(std::begin(sizes), std::end(sizes), c.shadow_size) - sizes);

@@ -142,6 +142,7 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   config.shadows = false;
   config.shadow_size = 1024;
   config.shadow_pcf = true;
+  config.shadow_cull = false;
   config.shadow_share = 0.75;
   config.merge_group = 3;
   config.merge_error = 0.25;
@@ -175,6 +176,7 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   EXPECT_FALSE(back.shadows);
   EXPECT_EQ(back.shadow_size, 1024);
   EXPECT_TRUE(back.shadow_pcf);
+  EXPECT_FALSE(back.shadow_cull);
   EXPECT_EQ(back.shadow_share, 0.75);
   EXPECT_EQ(back.merge_group, 3);
   EXPECT_EQ(back.merge_error, 0.25);

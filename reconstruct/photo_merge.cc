@@ -436,12 +436,8 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
     if (order.size() < 2) continue;
     // The ratios long / short; their median is taken, then its log (the median of the logs,
     // as the log is monotonic, with one log instead of one per sample).
-    // Row k: pair k's ratios, count[k] of them. A NewPhotoImage (~3 MB per pair at 2^18
-    // pixels): fresh pages cost 15 - 50 us each on the development VM (~25 ms per position as
-    // vectors), its kept buffers none from a run's second position on.
-    const int pairs = int(order.size()) - 1;
-    cv::Mat sample_ratios = NewPhotoImage(pairs, int(3 * grid), CV_32F);
-    std::vector<size_t> count(pairs, 0);
+    std::vector<std::vector<float>> sample_ratios(order.size() - 1);
+    for (auto& v : sample_ratios) v.reserve(3 * grid);
     std::vector<float> u(order.size() * 3);  // NaN where clipped
     for (int y = stride / 2; y < h; y += stride)
       for (int x = stride / 2; x < w; x += stride) {
@@ -468,7 +464,7 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
             const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
             if (!(a >= 4 * exposures[order[k]].floor_u && a > 0)) continue;
             if (!(b >= 4 * exposures[order[k + 1]].floor_u && b > 0)) continue;
-            sample_ratios.ptr<float>(int(k))[count[k]++] = b / a;
+            sample_ratios[k].push_back(b / a);
           }
       }
     for (size_t k = 0; k + 1 < order.size(); ++k) {
@@ -477,10 +473,10 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
       r.recorded_short = exposures[order[k]].recorded;
       r.recorded_long = exposures[order[k + 1]].recorded;
       r.estimated = r.Recorded();
-      const size_t n = count[k];
+      const size_t n = sample_ratios[k].size();
       if (n >= size_t(kMinRatioSamples)) {
         // (The ratios are > 0: both values are.)
-        const float median = KthSmallestNonNegative(sample_ratios.ptr<float>(int(k)), n, n / 2);
+        const float median = KthSmallestNonNegative(sample_ratios[k].data(), n, n / 2);
         r.estimated = std::exp(double(std::log(median)));
         r.samples = (long long)n;
       }

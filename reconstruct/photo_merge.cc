@@ -5,6 +5,10 @@
 #include <atomic>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -185,6 +189,13 @@ float ResponseSlope(const ResponseCurve& response, float l) {
   return std::max(0.f, (g[b] - g[a]) * 255.f / float(b - a));
 }
 
+// The entry of Exposure::quant_var (kQuantTable entries, 1025) at curve value l: the nearest
+// 1/1024 step, the last at l >= 1, the first at l <= 0 and NaN (an unused lane of the merge).
+inline int QuantTableEntry(float l) {
+  constexpr int kLast = 1024;
+  return l >= 1.f ? kLast : l > 0.f ? int(l * kLast + 0.5f) : 0;
+}
+
 // One photo in the merge, with what the noise model and the near-black test need. u is the
 // recorded value above black in units of the white level (the reader's value times the
 // recorded exposure), the same whatever exposure the merge assumes.
@@ -198,9 +209,12 @@ struct Exposure {
   // 8-bit photos: u per code and channel, [c * 256 + code] for c = R, G, B, NaN where clipped,
   // read through the reader from a 256-pixel photo holding every code, so the table is the
   // decoder's own linearisation. Valid because LinearReader maps a code the same way at every
-  // pixel. A JPEG's fractional codes read it between codes (ReadFractionalCodes). Empty for
-  // other photos.
+  // pixel. Empty for other photos.
   std::vector<float> code_u;
+  // A JPEG's fractional codes: code_u of R, G, B read between codes (ReadBetweenCodes) at every
+  // fractional code (FractionalCodeTable), for ReadFractionalCodes; equal tables are one, shared
+  // by the channels and exposures that have them (MakeExposures). Null for other photos.
+  std::array<std::shared_ptr<const std::vector<float>>, 3> fractional_u;
   int slide = 0;        // 0: p, 1: n
   float recorded = 1;   // exposure in dataset.json
   float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
@@ -209,12 +223,13 @@ struct Exposure {
   float read_var = 0;   // (read noise / full well)^2, u^2
   float code_step = 0;  // one code in u units at curve slope 1 (0: float photo)
   Transfer transfer = Transfer::kLinear;
-  float black = 0, range = 1;  // curve value = u * range + black
-  static constexpr int kQuantTable = 1025;
+  float black = 0, range = 1;                  // curve value = u * range + black
+  static constexpr int kQuantTable = 1025;     // (QuantTableEntry)
   std::array<float, kQuantTable> quant_var{};  // q^2 / 12 at curve value k / (kQuantTable - 1)
   // The table varies (sRGB, or a calibrated response curve); otherwise entry 0 holds for all.
   bool curved = false;
 
+  static_assert(kQuantTable == 1025, "Exposure: QuantTableEntry's last entry is 1024");
   explicit Exposure(const DecodedPhoto& p, const NoiseModel& noise, double near_black_codes)
       : reader(p.photo) {
     const Photo& photo = p.photo;
@@ -277,9 +292,7 @@ struct Exposure {
   // exposure would cost more than decoding the photo).
   float Variance(float u, float inv_full_well) const {
     if (!curved) return u * inv_full_well + read_var + quant_var[0];
-    const float l = u * range + black;  // NaN (an unused lane of the merge) reads entry 0
-    const int k = l >= 1.f ? kQuantTable - 1 : l > 0.f ? int(l * (kQuantTable - 1) + 0.5f) : 0;
-    return u * inv_full_well + read_var + quant_var[k];
+    return u * inv_full_well + read_var + quant_var[QuantTableEntry(u * range + black)];
   }
 };
 
@@ -288,6 +301,22 @@ std::vector<Exposure> MakeExposures(const std::vector<DecodedPhoto>& photos,
   std::vector<Exposure> exposures;
   exposures.reserve(photos.size());
   for (const auto& p : photos) exposures.emplace_back(p, options.noise, options.near_black_codes);
+  // The fractional-code tables, one per distinct per-code table: with sRGB and no calibration the
+  // channels' tables are equal, and so are the exposures' where the exposures' ratios are powers
+  // of 2 (u = value / exposure x exposure). One table (256 kB) stays in the cache, and is built
+  // once.
+  std::vector<std::pair<const float*, std::shared_ptr<const std::vector<float>>>> built;
+  for (Exposure& e : exposures) {
+    if (e.code_u.empty() || !e.source->fractional_codes) continue;
+    for (int c = 0; c < 3; ++c) {
+      const float* table = e.code_u.data() + c * 256;
+      for (const auto& [other, entries] : built)
+        if (std::memcmp(other, table, 256 * sizeof(float)) == 0) e.fractional_u[c] = entries;
+      if (e.fractional_u[c]) continue;
+      e.fractional_u[c] = std::make_shared<const std::vector<float>>(FractionalCodeTable(table));
+      built.emplace_back(table, e.fractional_u[c]);
+    }
+  }
   return exposures;
 }
 
@@ -343,8 +372,18 @@ void ReadCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict u
 // NaN (clipped) when the next whole code up is, as LinearReader has it:
 void ReadFractionalCodes(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
   const uint16_t* __restrict row = e.source->pixels.ptr<uint16_t>(y) + 3 * x0;
-  for (int x = 0; x < pixels; ++x, row += 3, uk += 3)
-    for (int c = 0; c < 3; ++c) uk[c] = ReadBetweenCodes(e.code_u.data() + c * 256, row[c]);
+  const float* __restrict r = e.fractional_u[0]->data();
+  const float* __restrict g = e.fractional_u[1]->data();
+  const float* __restrict b = e.fractional_u[2]->data();
+  if (r == g && g == b) {
+    for (int j = 0; j < 3 * pixels; ++j) uk[j] = r[row[j]];
+    return;
+  }
+  for (int x = 0; x < pixels; ++x, row += 3, uk += 3) {
+    uk[0] = r[row[0]];
+    uk[1] = g[row[1]];
+    uk[2] = b[row[2]];
+  }
 }
 
 // Any other photo (calib/'s dark map, hot pixels or flat field), pixel by pixel:
@@ -358,6 +397,32 @@ void ReadPixels(const Exposure& e, int y, int x0, int pixels, float* __restrict 
       uk[x * 3 + ch] = !c[ch] && std::isfinite(value) ? value : kClipped;
     }
   }
+}
+
+// The k-th smallest of n non-negative floats (k < n), the value std::nth_element would put at
+// k: their bit patterns order as unsigned integers, so two counting passes, over the upper 16
+// bits and then the lower 16 bits of the values in the upper bits' bin, find it (cheaper than
+// nth_element's partitions for the ~790 k ratios per pair of EstimateRatios).
+float KthSmallestNonNegative(const float* v, size_t n, size_t k) {
+  std::vector<uint32_t> count(65536, 0);
+  auto bits = [](float f) {
+    uint32_t b;
+    std::memcpy(&b, &f, sizeof b);
+    return b;
+  };
+  for (size_t i = 0; i < n; ++i) ++count[bits(v[i]) >> 16];
+  uint32_t high = 0;
+  size_t below = 0;  // values in the bins before `high`
+  while (below + count[high] <= k) below += count[high++];
+  std::fill(count.begin(), count.end(), 0);
+  for (size_t i = 0; i < n; ++i)
+    if (bits(v[i]) >> 16 == high) ++count[bits(v[i]) & 0xFFFF];
+  uint32_t low = 0;
+  while (below + count[low] <= k) below += count[low++];
+  const uint32_t b = high << 16 | low;
+  float value;
+  std::memcpy(&value, &b, sizeof value);
+  return value;
 }
 
 std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w, int h) {
@@ -408,11 +473,12 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
       r.recorded_short = exposures[order[k]].recorded;
       r.recorded_long = exposures[order[k + 1]].recorded;
       r.estimated = r.Recorded();
-      std::vector<float>& v = sample_ratios[k];
-      if (v.size() >= size_t(kMinRatioSamples)) {
-        std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-        r.estimated = std::exp(double(std::log(v[v.size() / 2])));
-        r.samples = (long long)v.size();
+      const size_t n = sample_ratios[k].size();
+      if (n >= size_t(kMinRatioSamples)) {
+        // (The ratios are > 0: both values are.)
+        const float median = KthSmallestNonNegative(sample_ratios[k].data(), n, n / 2);
+        r.estimated = std::exp(double(std::log(median)));
+        r.samples = (long long)n;
       }
       ratios.push_back(r);
     }
@@ -448,22 +514,34 @@ struct MergeStats {
 // Bits, so that the states of a pixel's channels combine with OR.
 enum : uint8_t { kMeasured = 0, kNearBlackEverywhere = 1, kClippedEverywhere = 2 };
 
-// GCC on x86-64: the row kernels below are compiled for the SSE2 baseline, AVX2 and AVX-512F, and
-// the loader picks the best one the processor runs (glibc ifunc). All do the same IEEE operations
-// in the same order (neither target enables FMA, so nothing is contracted): the same numbers on
-// every machine. (AVX-512F: 16 values per operation and mask registers for the selects, ~10 %
-// faster than AVX2 on the AMD Zen 5 development machine.)
+// GCC on x86-64: the row kernels below are compiled for the SSE2 baseline, AVX2 and x86-64-v4
+// (AVX-512F, BW, DQ, VL), and the loader picks the best one the processor runs (glibc ifunc). All
+// do the same IEEE operations in the same order (nothing is contracted into FMAs:
+// -ffp-contract=off, reconstruct/CMakeLists.txt): the same numbers on every machine. (x86-64-v4:
+// 16 values per operation and mask registers for the selects; with AVX-512F alone GCC kept the
+// weighted pass, whose states are bytes, in 256-bit AVX, ~8 % slower on the AMD Zen 5
+// development machine.)
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
     !defined(LUMISLAB_NO_TARGET_CLONES)
-#define LUMISLAB_ROW_KERNEL __attribute__((target_clones("avx512f", "avx2", "default")))
+#define LUMISLAB_ROW_KERNEL __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #else
 #define LUMISLAB_ROW_KERNEL
 #endif
 #define LUMISLAB_INLINE inline __attribute__((always_inline))
+// The quantisation term's table lookups (QuantLookups) have an AVX-512F version besides the plain
+// one, chosen by the loader likewise (GCC's function multiversioning).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && \
+    !defined(LUMISLAB_NO_TARGET_CLONES)
+#define LUMISLAB_QUANT_AVX512
+#define LUMISLAB_QUANT_DEFAULT __attribute__((target("default")))
+#else
+#define LUMISLAB_QUANT_DEFAULT
+#endif
 
-// A row is merged in chunks of this many values (256 pixels x 3 channels), so that the
-// per-exposure values and the scratch of the passes below stay in the L1/L2 cache.
-constexpr int kChunk = 3 * 256;
+// A row is merged in chunks of this many values (128 pixels x 3 channels), so that the
+// per-exposure values and the scratch of the passes below stay in the L1 cache (48 kB on Zen 5;
+// 256 pixels were ~4 % slower).
+constexpr int kChunk = 3 * 128;
 // Slides with up to this many exposures get kernels with the exposure loop unrolled (vectorised
 // over the values); more take the same code with a run-time count.
 constexpr int kMaxUnrolled = 4;
@@ -531,27 +609,66 @@ LUMISLAB_INLINE void PilotPass(const SlideParams& p, const float* __restrict u, 
   }
 }
 
-// The table term of each curved exposure's variance at the pilot's expected u = e * pilot (the
-// curve value's 1/1024 step, as Exposure::Variance); 0 for the others. A NaN pilot (an unused
-// lane) reads entry 0.
+// The table term of m values: table[entry] at the expected u = eff * pilot (Exposure's
+// quant_var, the curve value's 1/1024 step, as Exposure::Variance). A NaN pilot (an unused lane)
+// reads entry 0. The plain version: the entries first (vectorised), then the lookups.
+LUMISLAB_QUANT_DEFAULT void QuantLookups(const float* __restrict table,
+                                         const float* __restrict pilot, int m, float eff,
+                                         float range, float black, int* __restrict entry,
+                                         float* __restrict q) {
+  for (int i = 0; i < m; ++i) entry[i] = QuantTableEntry(eff * pilot[i] * range + black);
+  for (int i = 0; i < m; ++i) q[i] = table[entry[i]];
+}
+
+#ifdef LUMISLAB_QUANT_AVX512
+// AVX-512F: 16 entries at a time, the same float operations in the same order. The lookups as
+// one permute from a window of 32 consecutive entries, from 16 below lane 0's entry; the lanes
+// outside it gathered (~18 % of the vectors on the bench's colour photos: the lanes hold R, G, B
+// in turn). The same table entries as the plain version, so the same values. (Three windows,
+// one per channel, left ~0.2 % to gather but were slower.)
+__attribute__((target("avx512f"))) void QuantLookups(const float* __restrict table,
+                                                     const float* __restrict pilot, int m,
+                                                     float eff, float range, float black,
+                                                     int* __restrict, float* __restrict q) {
+  constexpr int kLast = Exposure::kQuantTable - 1, kWindow = 32;
+  const __m512 veff = _mm512_set1_ps(eff), vrange = _mm512_set1_ps(range),
+               vblack = _mm512_set1_ps(black), vlast = _mm512_set1_ps(float(kLast)),
+               half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f), zero = _mm512_setzero_ps();
+  const __m512i last = _mm512_set1_epi32(kLast), window = _mm512_set1_epi32(kWindow);
+  for (int i = 0; i < m; i += 16) {
+    const __mmask16 lanes = m - i >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (m - i)) - 1);
+    const __m512 l = _mm512_add_ps(
+        _mm512_mul_ps(_mm512_mul_ps(veff, _mm512_maskz_loadu_ps(lanes, pilot + i)), vrange),
+        vblack);
+    // l >= 1: the last entry; 0 < l < 1: int(l * kLast + 0.5); else (and NaN) 0.
+    __m512i e = _mm512_maskz_cvttps_epi32(_mm512_cmp_ps_mask(l, zero, _CMP_GT_OQ),
+                                          _mm512_add_ps(_mm512_mul_ps(l, vlast), half));
+    e = _mm512_mask_mov_epi32(e, _mm512_cmp_ps_mask(l, one, _CMP_GE_OQ), last);
+    alignas(64) int entries[16];
+    _mm512_store_si512(entries, e);
+    // 16 below lane 0's entry the window starts.
+    const int base = std::clamp(entries[0] - 16, 0, kLast + 1 - kWindow);
+    const __m512i d = _mm512_sub_epi32(e, _mm512_set1_epi32(base));
+    const __mmask16 outside = _mm512_cmpge_epu32_mask(d, window) & lanes;
+    __m512 v = _mm512_permutex2var_ps(_mm512_loadu_ps(table + base), d,
+                                      _mm512_loadu_ps(table + base + 16));
+    if (outside) v = _mm512_mask_i32gather_ps(v, outside, e, table, 4);
+    _mm512_mask_storeu_ps(q + i, lanes, v);
+  }
+}
+#endif
+
+// The table term of each curved exposure's variance at the pilot's expected u = e * pilot; 0 for
+// the others.
 LUMISLAB_INLINE void QuantPass(const SlideParams& p, int m, SlideScratch& __restrict s,
                                float* __restrict quant) {
-  constexpr int kLast = Exposure::kQuantTable - 1;
   for (int k = 0; k < p.n; ++k) {
     float* __restrict q = quant + k * kChunk;
-    const float* __restrict table = p.quant_var[k];
-    if (!table) {
+    if (!p.quant_var[k]) {
       std::fill_n(q, m, 0.f);
       continue;
     }
-    // The entries first (vectorised), then the lookups.
-    int* __restrict entry = s.entry;
-    const float eff = p.eff[k], range = p.range[k], black = p.black[k];
-    for (int i = 0; i < m; ++i) {
-      const float l = eff * s.pilot[i] * range + black;
-      entry[i] = l >= 1.f ? kLast : l > 0.f ? int(l * kLast + 0.5f) : 0;
-    }
-    for (int i = 0; i < m; ++i) q[i] = table[entry[i]];
+    QuantLookups(p.quant_var[k], s.pilot, m, p.eff[k], p.range[k], p.black[k], s.entry, q);
   }
 }
 

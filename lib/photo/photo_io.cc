@@ -333,6 +333,13 @@ double Photo::SaturationCode() const {
   return std::ceil(spec.saturation_level * CodeMax() - 1e-9);
 }
 
+std::vector<float> FractionalCodeTable(const float* table) {
+  constexpr int kTop = 255 * kFractionalCodeOne;
+  std::vector<float> entries(kFractionalCodeTable, table[255]);
+  for (int c = 0; c <= kTop; ++c) entries[c] = ReadBetweenCodes(table, uint16_t(c));
+  return entries;
+}
+
 cv::Mat NewPhotoImage(int rows, int cols, int type) {
   // Never destroyed: images held by other static objects may outlive any static allocator.
   static HugePageAllocator* const allocator = new HugePageAllocator;

@@ -1,12 +1,13 @@
 // The colour JPEG decoder (lib/photo/jpeg_decode.h): the same picture as OpenCV's decoder, less
 // the rounding of the colour conversion; truncated files refused; other JPEGs left to OpenCV.
-// Also the reading of its fractional codes (ReadBetweenCodes) and its images' buffers
-// (NewPhotoImage).
+// Also the reading of its fractional codes (ReadBetweenCodes, FractionalCodeTable) and its images'
+// buffers (NewPhotoImage).
 #include "lib/photo/jpeg_decode.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
@@ -125,6 +126,29 @@ TEST(ReadBetweenCodes, LinearBetweenCodesExactAtWholeCodes) {
   EXPECT_EQ(ReadBetweenCodes(table.data(), uint16_t(200 * kFractionalCodeOne)), table[200]);
   EXPECT_TRUE(std::isnan(ReadBetweenCodes(table.data(), uint16_t(200 * kFractionalCodeOne + 1))));
   EXPECT_EQ(ReadBetweenCodes(table.data(), uint16_t(255 * kFractionalCodeOne)), table[255]);
+}
+
+// The precomputed table gives what ReadBetweenCodes gives at every fractional code, bit for bit
+// (NaN where it reads a clipped code), and the value at code 255 above the largest code.
+TEST(FractionalCodeTable, EveryCodeAsReadBetweenCodes) {
+  std::vector<float> table(256);
+  for (int k = 0; k < 256; ++k) table[k] = 0.001f * float(k * k) + 0.1f;
+  table[201] = std::numeric_limits<float>::quiet_NaN();  // clipped from code 201 up
+  const std::vector<float> entries = FractionalCodeTable(table.data());
+  ASSERT_EQ(entries.size(), size_t(kFractionalCodeTable));
+  int nan = 0;
+  for (int c = 0; c <= 255 * kFractionalCodeOne; ++c) {
+    const float expected = ReadBetweenCodes(table.data(), uint16_t(c));
+    if (std::isnan(expected)) {
+      ++nan;
+      EXPECT_TRUE(std::isnan(entries[c])) << c;
+    } else {
+      EXPECT_EQ(std::memcmp(&entries[c], &expected, sizeof(float)), 0) << c;
+    }
+  }
+  EXPECT_EQ(nan, 2 * kFractionalCodeOne - 1);  // (200, 202): 200 + f and 201 + f read code 201
+  for (int c = 255 * kFractionalCodeOne + 1; c < kFractionalCodeTable; ++c)
+    EXPECT_EQ(entries[c], table[255]) << c;
 }
 
 // A large image's buffer (>= 4 MB) is kept when released and given to the next image of the

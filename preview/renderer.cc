@@ -18,6 +18,9 @@ namespace {
 
 constexpr double kShadowNear = 10.0;  // mm: occluders nearer to c_ij than this are ignored
 constexpr double kShadowFar = 100000.0;
+// The shadow maps' depth mapping (u_depth in LightClip): NDC z = A + B / z between those planes.
+constexpr double kShadowDepthA = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
+constexpr double kShadowDepthB = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
 
 const char* kSceneVertex = R"(#version 450 core
 layout(location = 0) in vec3 a_position;
@@ -557,9 +560,7 @@ void Renderer::RenderShadowMapAt(int layer, const Eigen::Vector2d& c) {
   glUniform2f(Loc(p, "u_centre"), float(c.x()), float(c.y()));
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
   glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
-  const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
-  const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
-  glUniform2f(Loc(p, "u_depth"), float(a), float(b));
+  glUniform2f(Loc(p, "u_depth"), float(kShadowDepthA), float(kShadowDepthB));
   glBindVertexArray(gl_->vao);
   // Faces turned to the light wind counter-clockwise in the map (LightClip), so GL_BACK, the
   // default, drops the faces turned away (culling GL_FRONT instead drops the room's walls: the
@@ -615,12 +616,10 @@ void Renderer::ChooseShadowGroups() {
     std::vector<float> depth(size_t(size) * size);
     glGetTextureSubImage(gl_->shadow, 0, 0, 0, centre, size, size, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
                          GLsizei(depth.size() * sizeof(float)), depth.data());
-    const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
-    const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
     double z_min = kShadowFar, z_max = 0;
     for (float w : depth) {
       if (!(w < 1.0f)) continue;  // cleared: nothing seen through this texel
-      const double z = b / (2.0 * w - 1.0 - a);
+      const double z = kShadowDepthB / (2.0 * w - 1.0 - kShadowDepthA);
       z_min = std::min(z_min, z);
       z_max = std::max(z_max, z);
     }
@@ -828,9 +827,7 @@ void Renderer::SetCommonUniforms(unsigned program, bool /*fast*/) {
   glUseProgram(p);
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
   glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
-  const double a = (kShadowFar + kShadowNear) / (kShadowFar - kShadowNear);
-  const double b = -2 * kShadowFar * kShadowNear / (kShadowFar - kShadowNear);
-  glUniform2f(Loc(p, "u_depth"), float(a), float(b));
+  glUniform2f(Loc(p, "u_depth"), float(kShadowDepthA), float(kShadowDepthB));
   glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
   glUniform1i(Loc(p, "u_unit_albedo"), options_.unit_albedo ? 1 : 0);
   const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);

@@ -65,6 +65,8 @@ int Run(int argc, char** argv) {
   fast.shadow_share_texels = 0;
   fast.merge_group = 0;  // auto, as lumislab-preview: 2 without shadows, off with them
   fast.merge_error = 0.05;
+  fast.coarse_tolerance = -1;  // auto, as lumislab-preview: 0.1 with shadows, off without
+  fast.reproject_tolerance = 0.1;
   CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/design.md §8)"};
   app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
   app.add_option("--size", size, "image side")->capture_default_str();
@@ -79,6 +81,12 @@ int Run(int argc, char** argv) {
                  "on columns: merged block side (1: off; 0: auto, 2 without shadows)")
       ->capture_default_str();
   app.add_option("--merge-error", fast.merge_error, "on columns: merged lights' error bound")
+      ->capture_default_str();
+  app.add_option("--coarse-shading", fast.coarse_tolerance,
+                 "on columns: coarse shading's tolerance (0: off; < 0: auto, 0.1 with shadows)")
+      ->capture_default_str();
+  app.add_option("--reproject", fast.reproject_tolerance,
+                 "on columns: reprojection's tolerance after camera moves (0: off)")
       ->capture_default_str();
   app.add_flag("--no-shadow-cull", no_cull,
                "on columns: every face in the shadow maps (default: only those turned to the "
@@ -100,18 +108,22 @@ int Run(int argc, char** argv) {
   const Paper paper[] = {
       {5, 5, 2.7, 3.2, 1.3, 1.6}, {7, 7, 1.5, 1.7, 0.7, 0.85}, {9, 7, 1.2, 1.4, 0.55, 0.7}};
   std::ofstream out(csv);
-  std::printf("shortcuts on: --shadow-share %g --merge-group %d --merge-error %g%s\n",
-              fast.shadow_share_texels, fast.merge_group, fast.merge_error,
-              no_cull ? " --no-shadow-cull" : "");
+  std::printf(
+      "shortcuts on: --shadow-share %g --merge-group %d --merge-error %g --coarse-shading %g "
+      "--reproject %g%s\n",
+      fast.shadow_share_texels, fast.merge_group, fast.merge_error, fast.coarse_tolerance,
+      fast.reproject_tolerance, no_cull ? " --no-shadow-cull" : "");
   out << "scene,triangles,grid,shadows,paper_fps,fps_cached_off,fps_full_off,fps_cached_on,"
          "fps_full_on,ratio_cached_off,ratio_full_off,ratio_cached_on,ratio_full_on,"
-         "rel_l2_on_vs_off,shadow_group,shadow_shift_texels,merged_lights,z_merge_mm\n";
-  std::printf("%-9s %5s %-5s %-4s %6s %13s %13s | %11s %11s | %8s %3s %6s %3s %7s\n", "", "", "",
-              "", "", "--- off ---", "--- on ----", "ratio off", "ratio on", "on vs", "sha",
-              "shift", "mrg", "z merge");
-  std::printf("%-9s %5s %-5s %-4s %6s %6s %6s %6s %6s | %5s %5s %5s %5s | %8s %3s %6s %3s %7s\n",
-              "scene", "tris", "grid", "shad", "paper", "camera", "full", "camera", "full", "cam",
-              "full", "cam", "full", "off L2", "g", "texel", "n", "mm");
+         "rel_l2_on_vs_off,rel_l2_moved,shadow_group,shadow_shift_texels,merged_lights,z_merge_mm,"
+         "reprojected_exact\n";
+  std::printf("%-9s %5s %-5s %-4s %6s %13s %13s | %11s %11s | %8s %8s %3s %6s %3s %7s %5s\n", "",
+              "", "", "", "", "--- off ---", "--- on ----", "ratio off", "ratio on", "on vs",
+              "on vs", "sha", "shift", "mrg", "z merge", "repr");
+  std::printf(
+      "%-9s %5s %-5s %-4s %6s %6s %6s %6s %6s | %5s %5s %5s %5s | %8s %8s %3s %6s %3s %7s %5s\n",
+      "scene", "tris", "grid", "shad", "paper", "camera", "full", "camera", "full", "cam", "full",
+      "cam", "full", "off L2", "moved", "g", "texel", "n", "mm", "exact");
   for (const std::string scene : {"crypt", "cloister"}) {
     SceneRequest request;
     request.name = scene;
@@ -135,6 +147,9 @@ int Run(int argc, char** argv) {
         options_on.shadow_share_texels = fast.shadow_share_texels;
         options_on.merge_group = fast.merge_group > 0 ? fast.merge_group : (shadows ? 1 : 2);
         options_on.merge_error = fast.merge_error;
+        options_on.coarse_tolerance =
+            fast.coarse_tolerance >= 0 ? fast.coarse_tolerance : (shadows ? 0.1 : 0);
+        options_on.reproject_tolerance = fast.reproject_tolerance;
         options_on.shadow_cull = setup.closed_room && !no_cull;  // as lumislab-preview
         Renderer off(slab.info, size, size, options), on(slab.info, size, size, options_on);
         for (Renderer* r : {&off, &on}) {
@@ -145,6 +160,7 @@ int Run(int argc, char** argv) {
           r->Render();  // warm-up: shaders, shadow maps
         }
         const ImageDifference error = CompareImages(on.Read(), off.Read());
+
         struct Times {
           std::vector<double> cached, full, c_light, f_shadow, f_light;
         } times[2];
@@ -170,6 +186,17 @@ int Run(int argc, char** argv) {
             times[k].f_light.push_back(r.phase_times().light_ms);
           }
         }
+        // The image after camera moves: three more views, 2 degrees apart, after the last full
+        // frame (what reprojection reuses), each compared on against off; the largest error.
+        double move_error = 0;
+        for (int m = 1; m <= 3; ++m) {
+          moving.camera_yaw_deg = setup.camera_yaw_deg + 2.0 * (2 * frames) + 2.0 * m;
+          for (Renderer* r : {&off, &on}) {
+            r->SetCamera(OrbitCamera(moving, 1.0));
+            r->Render();
+          }
+          move_error = std::max(move_error, CompareImages(on.Read(), off.Read()).relative_l2);
+        }
         if (profile) {
           std::printf("  on: depth range of the maps %.0f .. %.0f mm\n", on.shortcuts().z_min,
                       on.shortcuts().z_max);
@@ -193,18 +220,20 @@ int Run(int argc, char** argv) {
         std::snprintf(grid, sizeof(grid), "%dx%d", p.nu, p.nv);
         std::printf(
             "%-9s %5zu %-5s %-4s %6.2f %6.2f %6.2f %6.2f %6.2f | %5.1f %5.1f %5.1f %5.1f | "
-            "%8.2e %3d %6.2f %3d %7.0f\n",
+            "%8.2e %8.2e %3d %6.2f %3d %7.0f %4.1f%%\n",
             scene.c_str(), setup.mesh.triangles(), grid, shadows ? "yes" : "no", paper_fps,
             fps[0][0], fps[0][1], fps[1][0], fps[1][1], fps[0][0] / paper_fps,
             fps[0][1] / paper_fps, fps[1][0] / paper_fps, fps[1][1] / paper_fps, error.relative_l2,
-            state.shadow_group, state.shadow_shift, state.merged_lights, state.z_merge);
+            move_error, state.shadow_group, state.shadow_shift, state.merged_lights, state.z_merge,
+            100 * state.reprojected_exact);
         std::fflush(stdout);
         out << scene << ',' << setup.mesh.triangles() << ',' << grid << ','
             << (shadows ? "yes" : "no") << ',' << paper_fps << ',' << fps[0][0] << ',' << fps[0][1]
             << ',' << fps[1][0] << ',' << fps[1][1] << ',' << fps[0][0] / paper_fps << ','
             << fps[0][1] / paper_fps << ',' << fps[1][0] / paper_fps << ',' << fps[1][1] / paper_fps
-            << ',' << error.relative_l2 << ',' << state.shadow_group << ',' << state.shadow_shift
-            << ',' << state.merged_lights << ',' << state.z_merge << '\n';
+            << ',' << error.relative_l2 << ',' << move_error << ',' << state.shadow_group << ','
+            << state.shadow_shift << ',' << state.merged_lights << ',' << state.z_merge << ','
+            << state.reprojected_exact << '\n';
       }
     }
   }

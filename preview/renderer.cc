@@ -129,8 +129,40 @@ uniform float u_radiance_scale;
 uniform bool u_unit_albedo;  // irradiance view (false colour): E before the materials
 uniform usampler2D u_previous;
 uniform vec2 u_grid_half;  // half extent of the filter centres: the union of all spot cones
+#if COARSE
+// Coarse shading, first pass: the lights' sum at every second pixel of every second row (pixel
+// 2 gl_FragCoord), before albedo and radiance scale; 0 where nothing is lit.
+layout(location = 0) out vec4 o_coarse;
+#elif !EXACT_LIST
 layout(location = 0) out vec4 o_float;
 layout(location = 1) out uint o_packed;
+#endif
+#if RESOLVE || REPROJECT
+uniform sampler2D u_source;       // the sums reused: the coarse samples, or the last full frame's
+uniform float u_reuse_tolerance;  // largest spread of four sums, relative to their peak
+#endif
+#if REPROJECT
+uniform sampler2D u_source_position;  // the last full frame's G-buffer
+uniform sampler2D u_source_normal;
+uniform mat4 u_source_from_luminaire;  // its clip coordinates of a luminaire-frame point
+#endif
+#if !COARSE && !EXACT_LIST
+layout(location = 2) out vec4 o_irradiance;  // the sum alone (before albedo), reused by REPROJECT
+#endif
+#if RESOLVE || REPROJECT || EXACT_LIST
+// The pixels that coarse shading shades exactly: the resolve pass lists them (x | y << 16) and a
+// compute pass (EXACT_LIST) shades them, all its invocations busy (a fragment pass would run the
+// light loop for every 4 x 4 block with one such pixel). groups_x counts its work groups, one
+// per 64 pixels listed, for glDispatchComputeIndirect.
+layout(std430, binding = 0) buffer ExactCount { uint groups_x, groups_y, groups_z, count; };
+layout(std430, binding = 1) buffer ExactList { uint exact_pixels[]; };
+#endif
+#if EXACT_LIST
+layout(local_size_x = 64) in;
+layout(rgba32f, binding = 0) uniform image2D u_accumulation;  // float mode
+layout(r32ui, binding = 1) uniform uimage2D u_packed_sum;     // sRGBE mode: the new sum
+layout(rgba32f, binding = 2) uniform image2D u_irradiance;    // o_irradiance's target
+#endif
 )") + kLightClip + kSrgbeCode + R"(
 // E'_ij at texture coordinate uv of layer `layer`, reconstructed from the texel centres as
 // --texture-filter says: bilinear through the hardware (the paper's), the nearest texel, or
@@ -167,20 +199,15 @@ vec3 SampleIntensity(vec2 uv, int layer) {
 #endif
 }
 
-void main() {
-  const ivec2 pixel = ivec2(gl_FragCoord.xy);
-  const vec4 surface = texelFetch(u_gbuffer_position, pixel, 0);
-  if (surface.w == 0.0) discard;  // no surface: both sRGBE targets keep their cleared 0
-  const vec3 x = surface.xyz;
-  const vec3 n = texelFetch(u_gbuffer_normal, pixel, 0).xyz;
-  vec3 sum = vec3(0.0);
-  // Outside every spot light's cone (behind S, or not through the window from any c_ij): no
-  // light. In float mode the fragment is dropped before the light loop (adds 0 anyway).
+// Outside every spot light's cone (behind S, or not through the window from any c_ij): no light.
+bool Dark(vec3 x) {
   vec2 reach = 0.5 * u_window + u_grid_half * abs(1.0 - u_d / max(x.z, 1e-6));
-  bool dark = x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
-#if !SRGBE
-  if (dark) discard;
-#endif
+  return x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
+}
+
+// The sum over this pass's lights at surface point x (normal n), luminaire frame.
+vec3 ShadeLights(vec3 x, vec3 n) {
+  vec3 sum = vec3(0.0);
 #if FAST
   const bool far = x.z >= u_z_far;
   const int first = far ? u_far_begin : 0;
@@ -222,16 +249,123 @@ void main() {
     vec3 intensity = SampleIntensity(uv, u_layers[k]);
     sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
   }
-  vec3 radiance = sum * (u_unit_albedo ? vec3(1.0) : texelFetch(u_gbuffer_albedo, pixel, 0).rgb) *
-                  u_radiance_scale;
+  return sum;
+}
+
+#if RESOLVE || REPROJECT
+// The pixel's sum taken from four source samples around source coordinate q (texels, centres at
+// integers), bilinear: when every sample with a weight saw a point of the pixel's own surface
+// (normals within 25 degrees, off the pixel's tangent plane by under a quarter of the distance)
+// and their sums spread by at most u_reuse_tolerance of their largest magnitude in every
+// channel, so the light varies smoothly there. False elsewhere (edges of objects, shadows and
+// spots): the pixel is shaded exactly. Sources: RESOLVE, the coarse samples (sample s at pixel
+// 2 s of the G-buffer); REPROJECT, the last frame shaded in full (its own G-buffer).
+bool Reused(vec2 q, vec3 x, vec3 n, out vec3 sum) {
+  sum = vec3(0.0);
+  const ivec2 size = textureSize(u_source, 0);
+  const ivec2 base = ivec2(floor(q));
+  const vec2 f = q - vec2(base);
+  if (any(lessThan(base, ivec2(0))) || any(greaterThan(base, size - 1))) return false;
+  vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  for (int k = 0; k < 4; ++k) {
+    const ivec2 corner = ivec2(k & 1, k >> 1);
+    const float w = ((k & 1) != 0 ? f.x : 1.0 - f.x) * ((k & 2) != 0 ? f.y : 1.0 - f.y);
+    if (w == 0.0) continue;
+    const ivec2 s = base + corner;
+    if (any(greaterThan(s, size - 1))) return false;
+#if RESOLVE
+    const vec4 p = texelFetch(u_gbuffer_position, 2 * s, 0);
+    const vec3 ns = texelFetch(u_gbuffer_normal, 2 * s, 0).xyz;
+#else
+    const vec4 p = texelFetch(u_source_position, s, 0);
+    const vec3 ns = texelFetch(u_source_normal, s, 0).xyz;
+#endif
+    const vec3 d = p.xyz - x;
+    if (p.w == 0.0 || dot(n, ns) < 0.9 || abs(dot(n, d)) > 0.25 * length(d) + 1e-3) return false;
+    const vec3 e = texelFetch(u_source, s, 0).rgb;
+    lo = min(lo, e);
+    hi = max(hi, e);
+    sum += w * e;
+  }
+  const vec3 peak = max(abs(lo), abs(hi));
+  return all(lessThanEqual(hi - lo, u_reuse_tolerance * vec3(max(peak.r, max(peak.g, peak.b)))));
+}
+#endif
+
+vec3 Radiance(vec3 sum, ivec2 pixel) {
+  return sum * (u_unit_albedo ? vec3(1.0) : texelFetch(u_gbuffer_albedo, pixel, 0).rgb) *
+         u_radiance_scale;
+}
+
+#if EXACT_LIST
+void main() {
+  const uint k = gl_GlobalInvocationID.x;
+  if (k >= count) return;
+  const ivec2 pixel = ivec2(exact_pixels[k] & 0xffffu, exact_pixels[k] >> 16);
+  const vec3 sum = ShadeLights(texelFetch(u_gbuffer_position, pixel, 0).xyz,
+                               texelFetch(u_gbuffer_normal, pixel, 0).xyz);
+  imageStore(u_irradiance, pixel, imageLoad(u_irradiance, pixel) + vec4(sum, 0.0));
+  const vec3 radiance = Radiance(sum, pixel);
+#if SRGBE
+  const vec3 previous = DecodeSrgbe(imageLoad(u_packed_sum, pixel).r);  // carried by RESOLVE
+  imageStore(u_packed_sum, pixel, uvec4(EncodeSrgbe(previous + radiance)));
+#else
+  imageStore(u_accumulation, pixel, imageLoad(u_accumulation, pixel) + vec4(radiance, 0.0));
+#endif
+}
+#else
+void main() {
+#if COARSE
+  const ivec2 pixel = 2 * ivec2(gl_FragCoord.xy);
+  const vec4 surface = texelFetch(u_gbuffer_position, pixel, 0);
+  if (surface.w == 0.0 || Dark(surface.xyz)) {
+    o_coarse = vec4(0.0);
+    return;
+  }
+  o_coarse = vec4(ShadeLights(surface.xyz, texelFetch(u_gbuffer_normal, pixel, 0).xyz), 1.0);
+#else
+  const ivec2 pixel = ivec2(gl_FragCoord.xy);
+  const vec4 surface = texelFetch(u_gbuffer_position, pixel, 0);
+  if (surface.w == 0.0) discard;  // no surface: both sRGBE targets keep their cleared 0
+  const vec3 x = surface.xyz;
+  const vec3 n = texelFetch(u_gbuffer_normal, pixel, 0).xyz;
+  // In float mode a dark fragment is dropped before the light loop (it adds 0 anyway).
+#if !SRGBE
+  if (Dark(x)) discard;
+#endif
+  vec3 sum;
+#if RESOLVE || REPROJECT
+#if RESOLVE
+  const vec2 q = 0.5 * vec2(pixel);
+#else
+  const vec4 clip = u_source_from_luminaire * vec4(x, 1.0);
+  const vec2 q = clip.w > 0.0 ? (0.5 * clip.xy / clip.w + 0.5) * vec2(textureSize(u_source, 0)) - 0.5
+                              : vec2(-1.0);
+#endif
+  if (!Reused(q, x, n, sum)) {
+    const uint k = atomicAdd(count, 1u);
+    if (k % 64u == 0u) atomicAdd(groups_x, 1u);
+    exact_pixels[k] = uint(pixel.x) | (uint(pixel.y) << 16);
+#if !SRGBE
+    discard;
+#endif
+    sum = vec3(0.0);  // sRGBE: the previous sum is carried, the compute pass adds to it
+  }
+#else
+  sum = ShadeLights(x, n);
+#endif
+  const vec3 radiance = Radiance(sum, pixel);
   o_float = vec4(radiance, 1.0);
+  o_irradiance = vec4(sum, 1.0);
 #if SRGBE
   vec3 previous = DecodeSrgbe(texelFetch(u_previous, ivec2(gl_FragCoord.xy), 0).r);
   o_packed = EncodeSrgbe(previous + radiance);
 #else
   o_packed = 0u;
 #endif
+#endif
 }
+#endif
 )";
 
 // The G-buffer: what each pixel sees, in the luminaire frame (redrawn when the view, the scene or
@@ -309,6 +443,22 @@ GLuint Link(const std::string& vertex, const std::string& fragment) {
   return program;
 }
 
+GLuint LinkCompute(const std::string& compute) {
+  const GLuint program = glCreateProgram();
+  const GLuint cs = Compile(GL_COMPUTE_SHADER, compute);
+  glAttachShader(program, cs);
+  glLinkProgram(program);
+  glDeleteShader(cs);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    throw Failure(std::string("GLSL link error: ") + log);
+  }
+  return program;
+}
+
 GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
 // The light pass's fragment shader, its options compiled in: llvmpipe runs both sides of a
@@ -331,6 +481,12 @@ struct Renderer::Gl {
   GLuint colour = 0, packed[2] = {0, 0}, fbo[2] = {0, 0};
   // The G-buffer (kGeometryFragment): position, normal, albedo and depth.
   GLuint gbuffer[3] = {0, 0, 0}, depth = 0, gbuffer_fbo = 0;
+  // Coarse shading's samples (RGBA32F, every second pixel of every second row), and the list
+  // of the pixels it shades exactly (ExactCount, ExactList in kLightFragment).
+  GLuint coarse = 0, coarse_fbo = 0, exact_count = 0, exact_list = 0;
+  // The lights' sum before albedo (o_irradiance) of the present view, and the last view shaded
+  // in full: its sums, positions and normals (what reprojection reuses).
+  GLuint irradiance = 0, source[3] = {0, 0, 0};
 };
 
 Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options)
@@ -379,6 +535,8 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
   glGenFramebuffers(1, &gl_->shadow_fbo);
+  glCreateBuffers(1, &gl_->exact_count);
+  glNamedBufferStorage(gl_->exact_count, 4 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
   AllocateTargets();
   if (glGetError() != GL_NO_ERROR) throw Failure("GL error while creating the renderer");
 }
@@ -387,10 +545,14 @@ Renderer::~Renderer() {
   glDeleteFramebuffers(2, gl_->fbo);
   glDeleteFramebuffers(1, &gl_->gbuffer_fbo);
   glDeleteFramebuffers(1, &gl_->shadow_fbo);
-  GLuint textures[] = {gl_->intensity,  gl_->shadow,     gl_->colour,
-                       gl_->packed[0],  gl_->packed[1],  gl_->depth,
-                       gl_->gbuffer[0], gl_->gbuffer[1], gl_->gbuffer[2]};
-  glDeleteTextures(9, textures);
+  glDeleteFramebuffers(1, &gl_->coarse_fbo);
+  glDeleteBuffers(1, &gl_->exact_count);
+  glDeleteBuffers(1, &gl_->exact_list);
+  GLuint textures[] = {gl_->intensity,  gl_->shadow,   gl_->colour,     gl_->packed[0],
+                       gl_->packed[1],  gl_->depth,    gl_->gbuffer[0], gl_->gbuffer[1],
+                       gl_->gbuffer[2], gl_->coarse,   gl_->irradiance, gl_->source[0],
+                       gl_->source[1],  gl_->source[2]};
+  glDeleteTextures(14, textures);
   glDeleteBuffers(1, &gl_->vbo);
   glDeleteVertexArrays(1, &gl_->vao);
   glDeleteVertexArrays(1, &gl_->quad_vao);
@@ -405,15 +567,18 @@ void Renderer::AllocateTargets() {
   if (gl_->fbo[0]) {
     glDeleteFramebuffers(2, gl_->fbo);
     glDeleteFramebuffers(1, &gl_->gbuffer_fbo);
-    GLuint textures[] = {gl_->colour,     gl_->packed[0],  gl_->packed[1], gl_->depth,
-                         gl_->gbuffer[0], gl_->gbuffer[1], gl_->gbuffer[2]};
-    glDeleteTextures(7, textures);
+    glDeleteFramebuffers(1, &gl_->coarse_fbo);
+    glDeleteBuffers(1, &gl_->exact_list);
+    GLuint textures[] = {gl_->colour,     gl_->packed[0],  gl_->packed[1],  gl_->depth,
+                         gl_->gbuffer[0], gl_->gbuffer[1], gl_->gbuffer[2], gl_->coarse,
+                         gl_->irradiance, gl_->source[0],  gl_->source[1],  gl_->source[2]};
+    glDeleteTextures(12, textures);
   }
-  auto make = [&](GLenum format) {
+  auto make = [&](GLenum format, int width = 0, int height = 0) {
     GLuint t = 0;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
-    glTexStorage2D(GL_TEXTURE_2D, 1, format, width_, height_);
+    glTexStorage2D(GL_TEXTURE_2D, 1, format, width ? width : width_, height ? height : height_);
     const GLint filter = (format == GL_R32UI) ? GL_NEAREST : GL_LINEAR;
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
@@ -435,13 +600,27 @@ void Renderer::AllocateTargets() {
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     throw Failure("G-buffer framebuffer incomplete");
   }
+  // Samples at pixels 0, 2, 4, ... up to the last pixel.
+  gl_->coarse = make(GL_RGBA32F, (width_ + 1) / 2, (height_ + 1) / 2);
+  glGenFramebuffers(1, &gl_->coarse_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->coarse_fbo);
+  glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, gl_->coarse, 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw Failure("coarse-shading framebuffer incomplete");
+  }
+  gl_->irradiance = make(GL_RGBA32F);
+  for (GLuint& t : gl_->source) t = make(GL_RGBA32F);
+  source_valid_ = false;
+  glCreateBuffers(1, &gl_->exact_list);
+  glNamedBufferStorage(gl_->exact_list, GLsizeiptr(width_) * height_ * sizeof(GLuint), nullptr, 0);
   glGenFramebuffers(2, gl_->fbo);
   for (int k = 0; k < 2; ++k) {
     glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[k]);
     glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, gl_->colour, 0);
     glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, gl_->packed[k], 0);
-    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, gl_->irradiance, 0);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(3, buffers);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       throw Failure("accumulation framebuffer incomplete");
     }
@@ -459,6 +638,7 @@ void Renderer::SetScene(const Mesh& mesh) {
     }
   }
   vertex_count_ = int(mesh.positions.size());
+  source_valid_ = view_shaded_in_full_ = false;
   glBindVertexArray(gl_->vao);
   glBindBuffer(GL_ARRAY_BUFFER, gl_->vbo);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
@@ -476,6 +656,7 @@ void Renderer::SetScene(const Mesh& mesh) {
 
 void Renderer::SetPose(const Eigen::Isometry3d& luminaire_to_scene) {
   pose_ = luminaire_to_scene;
+  source_valid_ = view_shaded_in_full_ = false;
   shadow_valid_.assign(shadow_valid_.size(), false);
   groups_valid_ = false;
   view_valid_ = false;
@@ -491,8 +672,13 @@ void Renderer::SetOptions(const RenderOptions& options) {
   if (options.shadow_size != options_.shadow_size) {
     throw BadInput("the shadow-map size is fixed when the renderer is created");
   }
-  if (options.merge_group < 1 || !(options.merge_error > 0) || !(options.shadow_share_texels >= 0))
-    throw BadInput("merge group must be >= 1, merge error > 0, shadow sharing >= 0 texels");
+  if (options.merge_group < 1 || !(options.merge_error > 0) ||
+      !(options.shadow_share_texels >= 0) || !(options.coarse_tolerance >= 0) ||
+      !(options.reproject_tolerance >= 0)) {
+    throw BadInput(
+        "merge group must be >= 1, merge error > 0, shadow sharing >= 0 texels, coarse and "
+        "reprojection tolerances >= 0");
+  }
   if (options.shadow_share_texels != options_.shadow_share_texels ||
       options.shadow_cull != options_.shadow_cull) {
     shadow_valid_.assign(shadow_valid_.size(), false);
@@ -503,6 +689,7 @@ void Renderer::SetOptions(const RenderOptions& options) {
   }
   options_ = options;
   view_valid_ = false;
+  source_valid_ = view_shaded_in_full_ = false;
 }
 
 void Renderer::Resize(int width, int height) {
@@ -523,6 +710,9 @@ void Renderer::SetPosition(int i, int j, const ImageF& intensity) {
   glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, intensity.width, intensity.height, 1, GL_RGB,
                   GL_FLOAT, intensity.data.data());
   if (accumulated_[layer]) view_valid_ = false;  // replaced: the sum must be redone
+  if (accumulated_[layer] || (source_valid_ && source_lights_[layer])) {
+    source_valid_ = view_shaded_in_full_ = false;  // the sums hold the texture replaced
+  }
   present_[layer] = true;
   intensity_[layer] = intensity;
   merged_valid_.clear();  // the merged textures are rebuilt from the copies when next used
@@ -819,11 +1009,16 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
 }
 
 // Everything of a light pass but the lights: target, uniforms, textures.
-void Renderer::SetCommonUniforms(unsigned program, bool /*fast*/) {
+void Renderer::SetCommonUniforms(unsigned program, Shading shading) {
   const GLuint p = program;
-  const int target = options_.srgbe ? 1 - ping_ : 0;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[target]);
-  glViewport(0, 0, width_, height_);
+  if (shading == Shading::kCoarse) {
+    glBindFramebuffer(GL_FRAMEBUFFER, gl_->coarse_fbo);
+    glViewport(0, 0, (width_ + 1) / 2, (height_ + 1) / 2);
+  } else {
+    const int target = options_.srgbe ? 1 - ping_ : 0;
+    glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[target]);
+    glViewport(0, 0, width_, height_);
+  }
   glUseProgram(p);
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
   glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
@@ -853,17 +1048,49 @@ void Renderer::SetCommonUniforms(unsigned program, bool /*fast*/) {
     glBindTexture(GL_TEXTURE_2D, gl_->gbuffer[k]);
     glUniform1i(Loc(p, gbuffer[k]), 3 + k);
   }
+  if (shading == Shading::kResolve || shading == Shading::kReproject) {
+    const bool coarse = shading == Shading::kResolve;
+    glActiveTexture(GL_TEXTURE6);
+    glBindTexture(GL_TEXTURE_2D, coarse ? gl_->coarse : gl_->source[0]);
+    glUniform1i(Loc(p, "u_source"), 6);
+    glUniform1f(Loc(p, "u_reuse_tolerance"),
+                float(coarse ? options_.coarse_tolerance : options_.reproject_tolerance));
+  }
+  if (shading == Shading::kReproject) {
+    for (int k = 1; k < 3; ++k) {
+      glActiveTexture(GL_TEXTURE6 + k);
+      glBindTexture(GL_TEXTURE_2D, gl_->source[k]);
+    }
+    glUniform1i(Loc(p, "u_source_position"), 7);
+    glUniform1i(Loc(p, "u_source_normal"), 8);
+    const Eigen::Matrix4f m = source_view_projection_ * pose_.matrix().cast<float>();
+    glUniformMatrix4fv(Loc(p, "u_source_from_luminaire"), 1, GL_FALSE, m.data());
+  }
   glActiveTexture(GL_TEXTURE0);
 }
 
-unsigned Renderer::LightProgram(bool fast) {
+std::vector<Renderer::Shading> Renderer::ShadingPasses(int lights) const {
+  if (list_only_) return {Shading::kExactList};
+  if (options_.coarse_tolerance > 0 && lights >= kCoarseMinLights)
+    return {Shading::kCoarse, Shading::kResolve, Shading::kExactList};
+  return {Shading::kExact};
+}
+
+unsigned Renderer::LightProgram(bool fast, Shading shading) {
   const std::string defines =
       "#define LIGHTS_PER_PASS " + std::to_string(fast ? kFastLightsPerPass : kLightsPerPass) +
       "\n#define FAST " + std::to_string(fast) + "\n#define SHADOWS " +
       std::to_string(options_.shadows) + "\n#define SRGBE " + std::to_string(options_.srgbe) +
-      "\n#define TEXTURE_FILTER " + std::to_string(int(options_.texture_filter)) + "\n";
+      "\n#define TEXTURE_FILTER " + std::to_string(int(options_.texture_filter)) +
+      "\n#define COARSE " + std::to_string(shading == Shading::kCoarse) + "\n#define RESOLVE " +
+      std::to_string(shading == Shading::kResolve) + "\n#define EXACT_LIST " +
+      std::to_string(shading == Shading::kExactList) + "\n#define REPROJECT " +
+      std::to_string(shading == Shading::kReproject) + "\n";
   GLuint& program = gl_->light_programs[defines];
-  if (!program) program = Link(kQuadVertex, LightFragment(defines));
+  if (!program) {
+    program = shading == Shading::kExactList ? LinkCompute(LightFragment(defines))
+                                             : Link(kQuadVertex, LightFragment(defines));
+  }
   return program;
 }
 
@@ -877,12 +1104,14 @@ void Renderer::LightPass(const std::vector<int>& lights) {
     centres[2 * k + 1] = float(c.y());
     layers[k] = l;
   }
-  const GLuint p = LightProgram(false);
-  SetCommonUniforms(p, false);
-  glUniform1i(Loc(p, "u_count"), int(lights.size()));
-  glUniform2fv(Loc(p, "u_centres"), GLsizei(lights.size()), centres);
-  glUniform1iv(Loc(p, "u_layers"), GLsizei(lights.size()), layers);
-  DrawLightPass();
+  for (Shading shading : ShadingPasses(int(lights.size()))) {
+    const GLuint p = LightProgram(false, shading);
+    SetCommonUniforms(p, shading);
+    glUniform1i(Loc(p, "u_count"), int(lights.size()));
+    glUniform2fv(Loc(p, "u_centres"), GLsizei(lights.size()), centres);
+    glUniform1iv(Loc(p, "u_layers"), GLsizei(lights.size()), layers);
+    DrawLightPass(shading);
+  }
 }
 
 void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
@@ -902,24 +1131,50 @@ void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_en
     spans[2 * k] = e.span_begin < 0 ? int(k) : e.span_begin;
     spans[2 * k + 1] = e.span_count;
   }
-  const GLuint p = LightProgram(true);
-  SetCommonUniforms(p, true);
-  glUniform1i(Loc(p, "u_count"), n);
-  glUniform2fv(Loc(p, "u_centres"), n, centres);
-  glUniform1iv(Loc(p, "u_layers"), n, layers);
-  glUniform2fv(Loc(p, "u_shadow_centres"), n, shadow_centres);
-  glUniform1iv(Loc(p, "u_shadow_layers"), n, shadow_layers);
-  glUniform2iv(Loc(p, "u_shadow_span"), n, spans);
-  glUniform1i(Loc(p, "u_near_end"), near_end);
-  glUniform1i(Loc(p, "u_far_begin"), far_begin);
-  glUniform1f(Loc(p, "u_z_far"), float(std::min(z_far, 3.0e38)));
-  DrawLightPass();
+  for (Shading shading : ShadingPasses(n)) {
+    const GLuint p = LightProgram(true, shading);
+    SetCommonUniforms(p, shading);
+    glUniform1i(Loc(p, "u_count"), n);
+    glUniform2fv(Loc(p, "u_centres"), n, centres);
+    glUniform1iv(Loc(p, "u_layers"), n, layers);
+    glUniform2fv(Loc(p, "u_shadow_centres"), n, shadow_centres);
+    glUniform1iv(Loc(p, "u_shadow_layers"), n, shadow_layers);
+    glUniform2iv(Loc(p, "u_shadow_span"), n, spans);
+    glUniform1i(Loc(p, "u_near_end"), near_end);
+    glUniform1i(Loc(p, "u_far_begin"), far_begin);
+    glUniform1f(Loc(p, "u_z_far"), float(std::min(z_far, 3.0e38)));
+    DrawLightPass(shading);
+  }
 }
 
 // Runs the bound light program over the image: float adds into the accumulation, sRGBE packs
-// the new sum into the other target.
-void Renderer::DrawLightPass() {
+// the new sum into the other target; coarse shading's first pass writes its samples.
+void Renderer::DrawLightPass(Shading shading) {
   glDisable(GL_DEPTH_TEST);
+  glBindVertexArray(gl_->quad_vao);
+  if (shading == Shading::kExactList) {
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl_->exact_count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, gl_->exact_list);
+    glBindImageTexture(0, gl_->colour, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, gl_->packed[ping_], 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(2, gl_->irradiance, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, gl_->exact_count);
+    glDispatchComputeIndirect(0);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    return;
+  }
+  if (shading == Shading::kResolve || shading == Shading::kReproject) {
+    const GLuint reset[4] = {0, 1, 1, 0};
+    glNamedBufferSubData(gl_->exact_count, 0, sizeof(reset), reset);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl_->exact_count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, gl_->exact_list);
+  }
+  if (shading == Shading::kCoarse) {
+    glDisablei(GL_BLEND, 0);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    return;
+  }
   if (options_.srgbe) {
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -930,12 +1185,47 @@ void Renderer::DrawLightPass() {
     glEnablei(GL_BLEND, 0);
     glBlendFunci(0, GL_ONE, GL_ONE);
   }
-  glBindVertexArray(gl_->quad_vao);
+  // The sums alone, kept only where reprojection reuses them.
+  const GLboolean keep = options_.reproject_tolerance > 0 ? GL_TRUE : GL_FALSE;
+  glColorMaski(2, keep, keep, keep, keep);
+  glEnablei(GL_BLEND, 2);
+  glBlendFunci(2, GL_ONE, GL_ONE);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisablei(GL_BLEND, 0);
+  glDisablei(GL_BLEND, 2);
   glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glColorMaski(2, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   if (options_.srgbe) ping_ = 1 - ping_;
+}
+
+// Reprojection: each pixel takes the source view's sums where its point lies between four source
+// pixels of its own surface whose sums agree (Reused in kLightFragment); the pixels it lists are
+// shaded by the source's lights. A source whose reuse listed over a quarter of the pixels (the
+// view moved far) is replaced: the next view is shaded in full and becomes the source.
+void Renderer::Reproject() {
+  const GLuint p = LightProgram(false, Shading::kReproject);
+  SetCommonUniforms(p, Shading::kReproject);
+  DrawLightPass(Shading::kReproject);
+  std::vector<int> lights;
+  for (size_t l = 0; l < source_lights_.size(); ++l) {
+    if (source_lights_[l]) lights.push_back(int(l));
+  }
+  list_only_ = true;
+  if (Fast()) {
+    FastPasses(lights);
+  } else {
+    for (size_t start = 0; start < lights.size(); start += kLightsPerPass) {
+      const size_t end = std::min(lights.size(), start + kLightsPerPass);
+      LightPass(std::vector<int>(lights.begin() + start, lights.begin() + end));
+    }
+  }
+  list_only_ = false;
+  GLuint count[4] = {0, 0, 0, 0};
+  glGetNamedBufferSubData(gl_->exact_count, 0, sizeof(count), count);
+  state_.reprojected_exact = double(count[3]) / (double(width_) * height_);
+  reproject_next_ = state_.reprojected_exact <= 0.25;
+  accumulated_ = source_lights_;
 }
 
 int Renderer::Render() {
@@ -950,7 +1240,20 @@ int Renderer::Render() {
     *ms += std::chrono::duration<double, std::milli>(now - mark).count();
     mark = now;
   };
+  bool reprojected = false;
   if (!view_valid_) {
+    // The view shaded in full so far becomes reprojection's source before the G-buffer changes.
+    if (options_.reproject_tolerance > 0 && view_shaded_in_full_) {
+      const GLuint from[3] = {gl_->irradiance, gl_->gbuffer[0], gl_->gbuffer[1]};
+      for (int k = 0; k < 3; ++k) {
+        glCopyImageSubData(from[k], GL_TEXTURE_2D, 0, 0, 0, 0, gl_->source[k], GL_TEXTURE_2D, 0, 0,
+                           0, 0, width_, height_, 1);
+      }
+      source_view_projection_ = drawn_view_projection_;
+      source_lights_ = accumulated_;
+      source_valid_ = true;
+    }
+    view_shaded_in_full_ = false;
     // Clear both targets, then draw the G-buffer (what each pixel sees; the light passes shade
     // it).
     for (int k = 0; k < 2; ++k) {
@@ -959,6 +1262,7 @@ int Renderer::Render() {
       const GLuint zero_u[4] = {0, 0, 0, 0};
       glClearBufferfv(GL_COLOR, 0, zero_f);
       glClearBufferuiv(GL_COLOR, 1, zero_u);
+      glClearBufferfv(GL_COLOR, 2, zero_f);
     }
     ping_ = 0;
     glBindFramebuffer(GL_FRAMEBUFFER, gl_->gbuffer_fbo);
@@ -978,9 +1282,17 @@ int Renderer::Render() {
     glBindVertexArray(gl_->vao);
     glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
     glDisable(GL_CULL_FACE);
+    drawn_view_projection_ = view_projection_;
     accumulated_.assign(accumulated_.size(), false);
     view_valid_ = true;
     lap(&times_.depth_ms);
+    if (options_.reproject_tolerance > 0 && source_valid_ && reproject_next_) {
+      Reproject();
+      reprojected = true;
+    } else {
+      view_shaded_in_full_ = options_.reproject_tolerance > 0;
+      reproject_next_ = true;
+    }
   }
   std::vector<int> todo;
   for (size_t l = 0; l < present_.size(); ++l) {
@@ -1010,7 +1322,7 @@ int Renderer::Render() {
     FastPasses(todo);
   }
   for (int l : todo) accumulated_[l] = true;
-  lap(&times_.light_ms);
+  if (reprojected || !todo.empty()) lap(&times_.light_ms);
   glFinish();
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) throw Failure("GL error " + std::to_string(error) + " while rendering");

@@ -54,6 +54,16 @@ struct RenderOptions {
   // bounded by merge_error times the block's peak term (1: off).
   int merge_group = 1;
   double merge_error = 0.01;
+  // Coarse shading: a pass with at least kCoarseMinLights lights is shaded at every second pixel
+  // of every second row, and a pixel takes the mean of its (up to four) samples where they lie on
+  // its plane and their sums spread by at most this fraction of their peak; the others are
+  // shaded exactly (0: off, every pixel exact).
+  double coarse_tolerance = 0;
+  // Reprojection: after a camera move (pose, scene, lights unchanged) a pixel takes the sums of
+  // the last view shaded in full, interpolated where four of its pixels lie on the pixel's
+  // surface and their sums spread by at most this fraction of their peak; the others are shaded
+  // exactly (0: off).
+  double reproject_tolerance = 0;
   // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
   bool time_phases = false;
 };
@@ -64,16 +74,20 @@ struct PhaseTimes {
 };
 
 constexpr int kLightsPerPass = 64;
+// Coarse shading pays where the light loop outweighs the interpolation test (about as costly as
+// a few lights); passes with fewer lights (live mode adds one) are shaded exactly.
+constexpr int kCoarseMinLights = 8;
 constexpr int kFastLightsPerPass = 128;  // the shortcuts' program (members + merged lights)
 
 // What the shortcuts chose at the last Render() (for the bench, the window and the log).
 struct ShortcutState {
-  int shadow_group = 1;         // g of the shadow-map sharing (1: none)
-  double shadow_shift = 0;      // its largest shadow-edge shift (shadow texels)
-  double z_min = 0, z_max = 0;  // depth range the maps see (mm, luminaire frame)
-  int shadow_maps = 0;          // distinct maps in use
-  int merged_lights = 0;        // merged lights in the last pass
-  double z_merge = 0;           // receivers at least this deep (mm) used the merged lights
+  int shadow_group = 1;          // g of the shadow-map sharing (1: none)
+  double shadow_shift = 0;       // its largest shadow-edge shift (shadow texels)
+  double z_min = 0, z_max = 0;   // depth range the maps see (mm, luminaire frame)
+  int shadow_maps = 0;           // distinct maps in use
+  int merged_lights = 0;         // merged lights in the last pass
+  double z_merge = 0;            // receivers at least this deep (mm) used the merged lights
+  double reprojected_exact = 0;  // the last reprojection: fraction of the pixels shaded exactly
 };
 
 class Renderer {
@@ -122,11 +136,16 @@ class Renderer {
   void LightPass(const std::vector<int>& lights);
   void FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
                      double z_far);
-  void SetCommonUniforms(unsigned program, bool fast);
+  // How a light pass shades: every pixel exactly, or the two passes of coarse shading.
+  enum class Shading { kExact, kCoarse, kResolve, kExactList, kReproject };
+  // The passes that shade `lights` lights at the present options.
+  std::vector<Shading> ShadingPasses(int lights) const;
+  void SetCommonUniforms(unsigned program, Shading shading);
   // The light program for the present options (fast: the shortcuts'), linked when first used.
-  unsigned LightProgram(bool fast);
-  void DrawLightPass();
+  unsigned LightProgram(bool fast, Shading shading = Shading::kExact);
+  void DrawLightPass(Shading shading);
   void FastPasses(const std::vector<int>& todo);
+  void Reproject();
   void AllocateTargets();
 
   SlabInfo info_;
@@ -137,6 +156,14 @@ class Renderer {
   int vertex_count_ = 0;
   std::vector<bool> present_, shadow_valid_, accumulated_;
   bool view_valid_ = false;
+  // Reprojection (RenderOptions::reproject_tolerance): the view drawn now and whether every pixel
+  // of it was shaded (the sums can be reused); the source view, its lights; whether the next
+  // view may reuse it; while Reproject() shades its list, the light passes run only that.
+  Eigen::Matrix4f drawn_view_projection_ = Eigen::Matrix4f::Identity();
+  Eigen::Matrix4f source_view_projection_ = Eigen::Matrix4f::Identity();
+  std::vector<bool> source_lights_;
+  bool view_shaded_in_full_ = false, source_valid_ = false, reproject_next_ = true;
+  bool list_only_ = false;
   int shadow_renders_ = 0;
   int ping_ = 0;  // sRGBE: which of the two targets holds the current sum
   PhaseTimes times_;

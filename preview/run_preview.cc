@@ -118,6 +118,16 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
                  "(sets the depth beyond which it is used)")
       ->check(CLI::Range(1e-6, 100.0))
       ->capture_default_str();
+  app.add_option("--coarse-shading", config.coarse_tolerance,
+                 "shade every second pixel of every second row and interpolate where four "
+                 "samples on the pixel's surface agree within this fraction (0: off; default "
+                 "auto: 0.1 with shadows, off without)")
+      ->check(CLI::Range(0.0, 100.0));
+  app.add_option("--reproject", config.reproject_tolerance,
+                 "after a camera move, reuse the last frame shaded in full where four of its "
+                 "pixels on the pixel's surface agree within this fraction (0: off)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
 }
 
 void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
@@ -366,6 +376,11 @@ int MergeGroup(const PreviewConfig& config) {
   return config.shadows ? 1 : 2;
 }
 
+double CoarseTolerance(const PreviewConfig& config) {
+  if (config.coarse_tolerance >= 0) return config.coarse_tolerance;
+  return config.shadows ? 0.1 : 0;
+}
+
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
   RenderOptions options;
   options.shadows = config.shadows;
@@ -376,6 +391,8 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.shadow_share_texels = config.shadow_share;
   options.merge_group = MergeGroup(config);
   options.merge_error = config.merge_error;
+  options.coarse_tolerance = CoarseTolerance(config);
+  options.reproject_tolerance = config.reproject_tolerance;
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;
   options.cull_back_faces = setup.closed_room;
@@ -503,6 +520,10 @@ std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& 
   if (config.merge_group != 0)
     line << arg("--merge-group") << arg(std::to_string(config.merge_group));
   if (config.merge_error != 0.05) line << arg("--merge-error") << arg(values({config.merge_error}));
+  if (config.coarse_tolerance >= 0)
+    line << arg("--coarse-shading") << arg(values({config.coarse_tolerance}));
+  if (config.reproject_tolerance != 0.1)
+    line << arg("--reproject") << arg(values({config.reproject_tolerance}));
   if (config.srgbe) line << arg("--srgbe");
   if (config.texture_filter != TextureFilter::kBilinear)
     line << arg("--texture-filter") << arg(TextureFilterName(config.texture_filter));

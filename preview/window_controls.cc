@@ -86,6 +86,17 @@ void ShadowsPanel(WindowState& s) {
     c.merge_error = merge_error;
     s.options_changed = true;
   }
+  // Coarse shading and reprojection: their tolerances (0: off; coarse shading starts at auto).
+  float coarse = float(CoarseTolerance(c));
+  if (ImGui::SliderFloat("coarse shading", &coarse, 0.0f, 0.5f, "%.3f")) {
+    c.coarse_tolerance = coarse;
+    s.options_changed = true;
+  }
+  float reproject = float(c.reproject_tolerance);
+  if (ImGui::SliderFloat("reproject", &reproject, 0.0f, 0.5f, "%.3f")) {
+    c.reproject_tolerance = reproject;
+    s.options_changed = true;
+  }
   int format = c.srgbe;
   ImGui::Text("accumulation");
   ImGui::SameLine();

@@ -323,6 +323,118 @@ TEST_F(PreviewSlabFiles, ShadowCullKeepsTheImage) {
   EXPECT_FALSE(MakeRenderOptions(config, MakeSceneSetup("crypt", info_)).shadow_cull);
 }
 
+// Coarse shading and reprojection (docs/design.md §4.2, "Faster frames") against the full
+// per-position render of the same view: within 1 %, not identical (they really interpolate), the
+// tolerance matters, and reprojection never reuses sums that a pose, a scene or a replaced
+// position made stale.
+TEST_F(PreviewSlabFiles, CoarseShadingAndReprojectionStayWithinOnePercent) {
+  const SceneSetup setup = MakeSceneSetup("crypt", info_);
+  const auto positions = ScanSlabPositions(dir_.string(), info_);
+  SceneSetup moved = setup;
+  auto exact_at = [&](const SceneSetup& view, const RenderOptions& options = {}) {
+    auto r = MakeRenderer(options);
+    Upload(*r, positions);
+    r->SetCamera(OrbitCamera(view, 1.0));
+    r->Render();
+    return r->Read();
+  };
+  const ImageF reference = exact_at(setup);
+  std::vector<double> coarse_errors;
+  for (double tolerance : {0.1, 10.0}) {
+    RenderOptions coarse;
+    coarse.coarse_tolerance = tolerance;
+    auto r = MakeRenderer(coarse);
+    Upload(*r, positions);
+    r->Render();
+    coarse_errors.push_back(RelativeDifference(r->Read(), reference));
+  }
+  std::printf("coarse shading: relative L2 %.3f %% (tolerance 0.1), %.3f %% (10)\n",
+              100 * coarse_errors[0], 100 * coarse_errors[1]);
+  EXPECT_GT(coarse_errors[0], 0);
+  EXPECT_LE(coarse_errors[0], 0.01);
+  EXPECT_GT(coarse_errors[1], 1.5 * coarse_errors[0]);
+
+  RenderOptions reuse;
+  reuse.reproject_tolerance = 0.1;
+  auto r = MakeRenderer(reuse);
+  Upload(*r, positions);
+  r->Render();
+  EXPECT_EQ(r->Read().data, reference.data);  // the first view is shaded in full
+  for (int step = 1; step <= 3; ++step) {
+    moved.camera_yaw_deg = setup.camera_yaw_deg + 2 * step;
+    r->SetCamera(OrbitCamera(moved, 1.0));
+    EXPECT_EQ(r->Render(), 0);  // every light came from the source view
+    const double error = RelativeDifference(r->Read(), exact_at(moved));
+    const double listed = r->shortcuts().reprojected_exact;
+    std::printf("reprojected %d degrees: relative L2 %.3f %%, %.1f %% of the pixels exact\n",
+                2 * step, 100 * error, 100 * listed);
+    EXPECT_GT(error, 0);
+    EXPECT_LE(error, 0.01);
+    EXPECT_GT(listed, 0);
+    EXPECT_LT(listed, 0.5);
+  }
+  // A position replaced, then a camera move: the last view's sums are stale, the view is shaded
+  // anew.
+  ImageF brighter = ReadIntensity(dir_.string(), info_, 2, 2);
+  for (float& v : brighter.data) v *= 3;
+  r = MakeRenderer(reuse);
+  Upload(*r, positions);
+  r->Render();
+  r->SetPosition(2, 2, brighter);
+  moved.camera_yaw_deg = setup.camera_yaw_deg + 2;
+  r->SetCamera(OrbitCamera(moved, 1.0));
+  r->Render();
+  auto replaced = MakeRenderer();
+  Upload(*replaced, positions);
+  replaced->SetPosition(2, 2, brighter);
+  replaced->SetCamera(OrbitCamera(moved, 1.0));
+  replaced->Render();
+  EXPECT_EQ(r->Read().data, replaced->Read().data);
+  // A new pose: nothing is reused either.
+  const Eigen::Isometry3d pose = PoseFromValues({0, 2500, 0, 90, 0, 0});
+  r->SetPose(pose);
+  r->Render();
+  replaced->SetPose(pose);
+  replaced->Render();
+  EXPECT_EQ(r->Read().data, replaced->Read().data);
+}
+
+// Live mode with reprojection: the positions that arrive after a camera move are added to the
+// reused sums of the earlier ones.
+TEST_F(PreviewSlabFiles, ReprojectionAddsPositionsThatArriveAfterTheMove) {
+  const auto positions = ScanSlabPositions(dir_.string(), info_);
+  const size_t half = positions.size() / 2;
+  RenderOptions reuse;
+  reuse.reproject_tolerance = 0.1;
+  auto live = MakeRenderer(reuse);
+  Upload(*live, std::vector<std::pair<int, int>>(positions.begin(), positions.begin() + half));
+  EXPECT_EQ(live->Render(), int(half));
+  SceneSetup moved = MakeSceneSetup("crypt", info_);
+  moved.camera_yaw_deg += 2;
+  live->SetCamera(OrbitCamera(moved, 1.0));
+  Upload(*live, std::vector<std::pair<int, int>>(positions.begin() + half, positions.end()));
+  EXPECT_EQ(live->Render(), int(positions.size() - half));  // only the new ones shaded here
+  EXPECT_GT(live->shortcuts().reprojected_exact, 0);
+  auto full = MakeRenderer();
+  Upload(*full, positions);
+  full->SetCamera(OrbitCamera(moved, 1.0));
+  full->Render();
+  const double error = RelativeDifference(live->Read(), full->Read());
+  EXPECT_GT(error, 0);
+  EXPECT_LE(error, 0.01);
+  // sRGBE accumulation takes the same paths: within its own packing error of float.
+  RenderOptions packed = reuse;
+  packed.srgbe = true;
+  packed.coarse_tolerance = 0.1;
+  auto p = MakeRenderer(packed);
+  Upload(*p, positions);
+  p->Render();
+  p->SetCamera(OrbitCamera(moved, 1.0));
+  p->Render();
+  EXPECT_GT(p->shortcuts().reprojected_exact, 0);
+  EXPECT_LE(RelativeDifference(p->Read(), full->Read()), 0.015);
+}
+
 // --view false-colour maps the irradiance before the materials: with every albedo 0.5 the normal
 // view is 0.5 / pi of the unit-albedo one, pixel for pixel.
 TEST_F(PreviewSlabFiles, UnitAlbedoIsTheIrradianceBeforeTheMaterials) {

@@ -146,6 +146,8 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   config.shadow_share = 0.75;
   config.merge_group = 3;
   config.merge_error = 0.25;
+  config.coarse_tolerance = 0.125;
+  config.reproject_tolerance = 0;
   config.srgbe = true;
   config.texture_filter = TextureFilter::kCubic;
   const std::string line = HeadlessCommandLine(config, "out.png");
@@ -180,6 +182,8 @@ TEST(PreviewCommandLine, HeadlessCommandLineParsesBackToTheSameSettings) {
   EXPECT_EQ(back.shadow_share, 0.75);
   EXPECT_EQ(back.merge_group, 3);
   EXPECT_EQ(back.merge_error, 0.25);
+  EXPECT_EQ(back.coarse_tolerance, 0.125);
+  EXPECT_EQ(back.reproject_tolerance, 0);
   EXPECT_TRUE(back.srgbe);
   EXPECT_EQ(back.texture_filter, TextureFilter::kCubic);
   EXPECT_EQ(back.out, "out.png");

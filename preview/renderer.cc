@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -1244,10 +1245,17 @@ int Renderer::Render() {
   if (!view_valid_) {
     // The view shaded in full so far becomes reprojection's source before the G-buffer changes.
     if (options_.reproject_tolerance > 0 && view_shaded_in_full_) {
-      const GLuint from[3] = {gl_->irradiance, gl_->gbuffer[0], gl_->gbuffer[1]};
-      for (int k = 0; k < 3; ++k) {
-        glCopyImageSubData(from[k], GL_TEXTURE_2D, 0, 0, 0, 0, gl_->source[k], GL_TEXTURE_2D, 0, 0,
-                           0, 0, width_, height_, 1);
+      // Its textures change roles with the source's (no copies); the targets take the others.
+      std::swap(gl_->irradiance, gl_->source[0]);
+      std::swap(gl_->gbuffer[0], gl_->source[1]);
+      std::swap(gl_->gbuffer[1], gl_->source[2]);
+      glBindFramebuffer(GL_FRAMEBUFFER, gl_->gbuffer_fbo);
+      for (int k = 0; k < 2; ++k) {
+        glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + k, gl_->gbuffer[k], 0);
+      }
+      for (GLuint fbo : gl_->fbo) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, gl_->irradiance, 0);
       }
       source_view_projection_ = drawn_view_projection_;
       source_lights_ = accumulated_;

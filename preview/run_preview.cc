@@ -211,6 +211,14 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
     throw InputError("--exposure", "", "stops within [-64, 64]",
                      std::to_string(config.tone.exposure_stops));
   CheckCamera(config);
+  // CLI11's ranges let NaN through (every comparison with it is false).
+  for (const auto& [value, option] : {std::pair{config.shadow_share, "--shadow-share"},
+                                      {config.merge_error, "--merge-error"},
+                                      {config.reproject_tolerance, "--reproject"}}) {
+    if (!std::isfinite(value)) throw InputError(option, "", "a finite number", "nan");
+  }
+  if (std::isnan(config.coarse_tolerance))
+    throw InputError("--coarse-shading", "", "a finite number", "nan");
   if (config.shadow_size < 16 || config.shadow_size > 4096) {
     throw InputError("--shadow-size", "shadow-size", "16..4096",
                      std::to_string(config.shadow_size));

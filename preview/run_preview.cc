@@ -121,7 +121,8 @@ void AddRenderOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& e
   app.add_option("--coarse-shading", config.coarse_tolerance,
                  "shade every second pixel of every second row and interpolate where four "
                  "samples on the pixel's surface agree within this fraction (0: off; default "
-                 "auto: 0.1 with shadows, off without)")
+                 "auto: 0.1 in a room with shadows, off without them and on the plane, whose "
+                 "irradiance is a measurement)")
       ->check(CLI::Range(0.0, 100.0));
   app.add_option("--reproject", config.reproject_tolerance,
                  "after a camera move, reuse the last frame shaded in full where four of its "
@@ -384,9 +385,9 @@ int MergeGroup(const PreviewConfig& config) {
   return config.shadows ? 1 : 2;
 }
 
-double CoarseTolerance(const PreviewConfig& config) {
+double CoarseTolerance(const PreviewConfig& config, const SceneSetup& setup) {
   if (config.coarse_tolerance >= 0) return config.coarse_tolerance;
-  return config.shadows ? 0.1 : 0;
+  return config.shadows && !setup.plane ? 0.1 : 0;
 }
 
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup) {
@@ -399,7 +400,7 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   options.shadow_share_texels = config.shadow_share;
   options.merge_group = MergeGroup(config);
   options.merge_error = config.merge_error;
-  options.coarse_tolerance = CoarseTolerance(config);
+  options.coarse_tolerance = CoarseTolerance(config, setup);
   options.reproject_tolerance = config.reproject_tolerance;
   if (setup.plane || config.false_colour) options.radiance_scale = 1.0;
   options.unit_albedo = config.false_colour;

@@ -57,8 +57,8 @@ struct PreviewConfig {
   int merge_group = 0;
   double merge_error = 0.05;
   // Coarse shading's and reprojection's tolerances (RenderOptions; 0: off). Coarse shading: < 0
-  // is auto, CoarseTolerance (0.1 with shadows, where full frames wait on the light passes;
-  // off without). Both keep the default rooms within 1 % of the full render (design §4.2).
+  // is auto, CoarseTolerance (0.1 in a room with shadows, where full frames wait on the light
+  // passes). Both keep the default rooms within 1 % of the full render (design §4.2).
   double coarse_tolerance = -1;
   double reproject_tolerance = 0.1;
   bool watch = false;
@@ -105,8 +105,9 @@ void SetCameraValues(const std::vector<double>& values, SceneSetup& setup);
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);
 // --merge-group resolved: 0 (auto) is 2 without shadows, 1 (off) with them.
 int MergeGroup(const PreviewConfig& config);
-// Coarse shading's tolerance: --coarse-shading, or auto (0.1 with shadows, 0 without).
-double CoarseTolerance(const PreviewConfig& config);
+// Coarse shading's tolerance: --coarse-shading, or auto: 0.1 in a room with shadows; 0 without
+// them and on the plane (its irradiance is a measurement, written in W/m^2).
+double CoarseTolerance(const PreviewConfig& config, const SceneSetup& setup);
 
 // slab.json of --slab; with --watch, waits for it to appear (a live reconstruct writes it with
 // its first position); nothing when a stop signal arrives first.

@@ -87,7 +87,7 @@ void ShadowsPanel(WindowState& s) {
     s.options_changed = true;
   }
   // Coarse shading and reprojection: their tolerances (0: off; coarse shading starts at auto).
-  float coarse = float(CoarseTolerance(c));
+  float coarse = float(CoarseTolerance(c, s.setup));
   if (ImGui::SliderFloat("coarse shading", &coarse, 0.0f, 0.5f, "%.3f")) {
     c.coarse_tolerance = coarse;
     s.options_changed = true;

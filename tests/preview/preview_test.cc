@@ -397,6 +397,18 @@ TEST_F(PreviewSlabFiles, CoarseShadingAndReprojectionStayWithinOnePercent) {
   replaced->SetPose(pose);
   replaced->Render();
   EXPECT_EQ(r->Read().data, replaced->Read().data);
+  // The command line's defaults: coarse shading in a room with shadows only (the plane's
+  // irradiance is a measurement), reprojection everywhere; a value given is taken.
+  PreviewConfig config;
+  const SceneSetup plane = MakeSceneSetup("plane", info_);
+  EXPECT_EQ(MakeRenderOptions(config, setup).coarse_tolerance, 0.1);
+  EXPECT_EQ(MakeRenderOptions(config, plane).coarse_tolerance, 0);
+  EXPECT_EQ(MakeRenderOptions(config, plane).reproject_tolerance, 0.1);
+  config.coarse_tolerance = 0.2;
+  EXPECT_EQ(MakeRenderOptions(config, plane).coarse_tolerance, 0.2);
+  config.coarse_tolerance = -1;
+  config.shadows = false;
+  EXPECT_EQ(MakeRenderOptions(config, setup).coarse_tolerance, 0);
 }
 
 // Live mode with reprojection: the positions that arrive after a camera move are added to the

@@ -436,8 +436,11 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
     if (order.size() < 2) continue;
     // The ratios long / short; their median is taken, then its log (the median of the logs,
     // as the log is monotonic, with one log instead of one per sample).
-    std::vector<std::vector<float>> sample_ratios(order.size() - 1);
-    for (auto& v : sample_ratios) v.reserve(3 * grid);
+    // At most 3 per grid pixel; plain arrays with a count (push_back was not inlined: a call
+    // per sample, ~10 ms per merge at 6000 x 4000).
+    std::vector<std::unique_ptr<float[]>> sample_ratios(order.size() - 1);
+    std::vector<size_t> samples(order.size() - 1, 0);
+    for (auto& v : sample_ratios) v.reset(new float[3 * grid]);
     std::vector<float> u(order.size() * 3);  // NaN where clipped
     for (int y = stride / 2; y < h; y += stride)
       for (int x = stride / 2; x < w; x += stride) {
@@ -464,7 +467,7 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
             const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
             if (!(a >= 4 * exposures[order[k]].floor_u && a > 0)) continue;
             if (!(b >= 4 * exposures[order[k + 1]].floor_u && b > 0)) continue;
-            sample_ratios[k].push_back(b / a);
+            sample_ratios[k][samples[k]++] = b / a;
           }
       }
     for (size_t k = 0; k + 1 < order.size(); ++k) {
@@ -473,10 +476,10 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
       r.recorded_short = exposures[order[k]].recorded;
       r.recorded_long = exposures[order[k + 1]].recorded;
       r.estimated = r.Recorded();
-      const size_t n = sample_ratios[k].size();
+      const size_t n = samples[k];
       if (n >= size_t(kMinRatioSamples)) {
         // (The ratios are > 0: both values are.)
-        const float median = KthSmallestNonNegative(sample_ratios[k].data(), n, n / 2);
+        const float median = KthSmallestNonNegative(sample_ratios[k].get(), n, n / 2);
         r.estimated = std::exp(double(std::log(median)));
         r.samples = (long long)n;
       }

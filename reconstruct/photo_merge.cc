@@ -436,8 +436,11 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
     if (order.size() < 2) continue;
     // The ratios long / short; their median is taken, then its log (the median of the logs,
     // as the log is monotonic, with one log instead of one per sample).
-    std::vector<std::vector<float>> sample_ratios(order.size() - 1);
-    for (auto& v : sample_ratios) v.reserve(3 * grid);
+    // At most 3 per grid pixel; plain arrays with a count (push_back was not inlined: a call
+    // per sample, ~10 ms per merge at 6000 x 4000).
+    std::vector<std::unique_ptr<float[]>> sample_ratios(order.size() - 1);
+    std::vector<size_t> samples(order.size() - 1, 0);
+    for (auto& v : sample_ratios) v.reset(new float[3 * grid]);
     std::vector<float> u(order.size() * 3);  // NaN where clipped
     for (int y = stride / 2; y < h; y += stride)
       for (int x = stride / 2; x < w; x += stride) {
@@ -464,7 +467,7 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
             const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
             if (!(a >= 4 * exposures[order[k]].floor_u && a > 0)) continue;
             if (!(b >= 4 * exposures[order[k + 1]].floor_u && b > 0)) continue;
-            sample_ratios[k].push_back(b / a);
+            sample_ratios[k][samples[k]++] = b / a;
           }
       }
     for (size_t k = 0; k + 1 < order.size(); ++k) {
@@ -473,10 +476,10 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
       r.recorded_short = exposures[order[k]].recorded;
       r.recorded_long = exposures[order[k + 1]].recorded;
       r.estimated = r.Recorded();
-      const size_t n = sample_ratios[k].size();
+      const size_t n = samples[k];
       if (n >= size_t(kMinRatioSamples)) {
         // (The ratios are > 0: both values are.)
-        const float median = KthSmallestNonNegative(sample_ratios[k].data(), n, n / 2);
+        const float median = KthSmallestNonNegative(sample_ratios[k].get(), n, n / 2);
         r.estimated = std::exp(double(std::log(median)));
         r.samples = (long long)n;
       }
@@ -622,37 +625,69 @@ LUMISLAB_QUANT_DEFAULT void QuantLookups(const float* __restrict table,
 
 #ifdef LUMISLAB_QUANT_AVX512
 // AVX-512F: 16 entries at a time, the same float operations in the same order. The lookups as
-// one permute from a window of 32 consecutive entries, from 16 below lane 0's entry; the lanes
-// outside it gathered (~18 % of the vectors on the bench's colour photos: the lanes hold R, G, B
-// in turn). The same table entries as the plain version, so the same values. (Three windows,
-// one per channel, left ~0.2 % to gather but were slower.)
+// permutes from windows of 32 consecutive table entries; the lanes outside them gathered. Lane j
+// holds the channel of lane j % 3 (the values are R, G, B in turn from lane 0 of each chunk, and
+// a vector is 16 values): three windows, one per channel, each from 16 below an entry of that
+// channel (QuantBases). Any window gives the same values (the table's entries); the windows
+// only decide how many lanes are gathered. `need`: the lanes whose entry is used; the others
+// may hold any entry of the table.
+__attribute__((target("avx512f"), always_inline)) inline __m512i QuantEntries16(__m512 pilot,
+                                                                                float eff,
+                                                                                float range,
+                                                                                float black) {
+  constexpr int kLast = Exposure::kQuantTable - 1;
+  const __m512 l =
+      _mm512_add_ps(_mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(eff), pilot), _mm512_set1_ps(range)),
+                    _mm512_set1_ps(black));
+  // l >= 1: the last entry; 0 < l < 1: int(l * kLast + 0.5); else (and NaN) 0.
+  const __m512i e = _mm512_maskz_cvttps_epi32(
+      _mm512_cmp_ps_mask(l, _mm512_setzero_ps(), _CMP_GT_OQ),
+      _mm512_add_ps(_mm512_mul_ps(l, _mm512_set1_ps(float(kLast))), _mm512_set1_ps(0.5f)));
+  return _mm512_mask_mov_epi32(e, _mm512_cmp_ps_mask(l, _mm512_set1_ps(1.f), _CMP_GE_OQ),
+                               _mm512_set1_epi32(kLast));
+}
+
+// The windows' first entries from the entries e of a vector: for the same vector `first` = 0
+// (lanes 0, 1, 2), for the next one `first` = 1 (its lanes 0, 1, 2 hold the channels of lanes 1,
+// 2, 3 here, 5 pixels on): the fused merge takes the previous vector's, so that the table reads
+// need not wait for this vector's entries.
+__attribute__((target("avx512f"), always_inline)) inline void QuantBases(__m512i e, int first,
+                                                                         int* base) {
+  constexpr int kLast = Exposure::kQuantTable - 1, kWindow = 32;
+  alignas(64) int entries[16];
+  _mm512_store_si512(entries, e);
+  for (int c = 0; c < 3; ++c) base[c] = std::clamp(entries[first + c] - 16, 0, kLast + 1 - kWindow);
+}
+
+__attribute__((target("avx512f"), always_inline)) inline __m512 QuantLookup16(
+    const float* __restrict table, __m512i e, const int* base, __mmask16 need) {
+  constexpr int kWindow = 32;
+  constexpr __mmask16 kChannel1 = 0x2492, kChannel2 = 0x4924;  // lanes 1, 4, ...; 2, 5, ...
+  const __m512i lane_base = _mm512_mask_mov_epi32(
+      _mm512_mask_mov_epi32(_mm512_set1_epi32(base[0]), kChannel1, _mm512_set1_epi32(base[1])),
+      kChannel2, _mm512_set1_epi32(base[2]));
+  const __m512i d = _mm512_sub_epi32(e, lane_base);
+  const __mmask16 outside = _mm512_cmpge_epu32_mask(d, _mm512_set1_epi32(kWindow)) & need;
+  __m512 window[3];
+  for (int c = 0; c < 3; ++c)
+    window[c] = _mm512_permutex2var_ps(_mm512_loadu_ps(table + base[c]), d,
+                                       _mm512_loadu_ps(table + base[c] + 16));
+  __m512 v =
+      _mm512_mask_mov_ps(_mm512_mask_mov_ps(window[0], kChannel1, window[1]), kChannel2, window[2]);
+  if (outside) v = _mm512_mask_i32gather_ps(v, outside, e, table, 4);
+  return v;
+}
+
 __attribute__((target("avx512f"))) void QuantLookups(const float* __restrict table,
                                                      const float* __restrict pilot, int m,
                                                      float eff, float range, float black,
                                                      int* __restrict, float* __restrict q) {
-  constexpr int kLast = Exposure::kQuantTable - 1, kWindow = 32;
-  const __m512 veff = _mm512_set1_ps(eff), vrange = _mm512_set1_ps(range),
-               vblack = _mm512_set1_ps(black), vlast = _mm512_set1_ps(float(kLast)),
-               half = _mm512_set1_ps(0.5f), one = _mm512_set1_ps(1.f), zero = _mm512_setzero_ps();
-  const __m512i last = _mm512_set1_epi32(kLast), window = _mm512_set1_epi32(kWindow);
   for (int i = 0; i < m; i += 16) {
     const __mmask16 lanes = m - i >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (m - i)) - 1);
-    const __m512 l = _mm512_add_ps(
-        _mm512_mul_ps(_mm512_mul_ps(veff, _mm512_maskz_loadu_ps(lanes, pilot + i)), vrange),
-        vblack);
-    // l >= 1: the last entry; 0 < l < 1: int(l * kLast + 0.5); else (and NaN) 0.
-    __m512i e = _mm512_maskz_cvttps_epi32(_mm512_cmp_ps_mask(l, zero, _CMP_GT_OQ),
-                                          _mm512_add_ps(_mm512_mul_ps(l, vlast), half));
-    e = _mm512_mask_mov_epi32(e, _mm512_cmp_ps_mask(l, one, _CMP_GE_OQ), last);
-    alignas(64) int entries[16];
-    _mm512_store_si512(entries, e);
-    // 16 below lane 0's entry the window starts.
-    const int base = std::clamp(entries[0] - 16, 0, kLast + 1 - kWindow);
-    const __m512i d = _mm512_sub_epi32(e, _mm512_set1_epi32(base));
-    const __mmask16 outside = _mm512_cmpge_epu32_mask(d, window) & lanes;
-    __m512 v = _mm512_permutex2var_ps(_mm512_loadu_ps(table + base), d,
-                                      _mm512_loadu_ps(table + base + 16));
-    if (outside) v = _mm512_mask_i32gather_ps(v, outside, e, table, 4);
+    const __m512i e = QuantEntries16(_mm512_maskz_loadu_ps(lanes, pilot + i), eff, range, black);
+    int base[3];
+    QuantBases(e, 0, base);
+    const __m512 v = QuantLookup16(table, e, base, lanes);
     _mm512_mask_storeu_ps(q + i, lanes, v);
   }
 }
@@ -747,6 +782,119 @@ LUMISLAB_ROW_KERNEL void MergeSlideChunk(const SlideParams& p, const float* u, i
   }
 }
 
+// The three passes above fused into one, 16 values at a time with AVX-512F intrinsics: each
+// exposure's values are loaded once and the pilot, its sums and the table terms stay in
+// registers (the passes' loops stored and re-read them, and QuantLookups was a call per exposure
+// and chunk). The same IEEE operations in the same order on every lane as PilotPass, QuantPass
+// and WeightPass, so the same numbers. The table is read only where the exposure's value is well
+// exposed (elsewhere its weight is not used): fewer gathers. Slides of up to kMaxUnrolled
+// exposures; false (nothing done) for more, and on processors without AVX-512F (the default
+// version), where MergeSlideChunk does the work.
+#ifdef LUMISLAB_QUANT_AVX512
+template <int kN, bool kCurved>
+__attribute__((target("avx512f"), always_inline)) inline void FusedSlideChunk(
+    const SlideParams& p, const float* __restrict u, int m, float* __restrict value,
+    uint8_t* __restrict state, float* __restrict brightest, float* __restrict faintest) {
+  float eff[kN], inv_eff[kN], floor_u[kN], constant[kN], range[kN], black[kN];
+  const float* quant_var[kN];
+  for (int k = 0; k < kN; ++k) {
+    eff[k] = p.eff[k], inv_eff[k] = p.inv_eff[k], floor_u[k] = p.floor_u[k];
+    constant[k] = p.constant[k], range[k] = p.range[k], black[k] = p.black[k];
+    quant_var[k] = p.quant_var[k];
+  }
+  const __m512 zero = _mm512_setzero_ps();
+  const __m512 inv_full_well = _mm512_set1_ps(p.inv_full_well);
+  int base[kN][3] = {};  // QuantLookup16's windows, from the previous vector's entries
+  for (int i = 0; i < m; i += 16) {
+    const __mmask16 lanes = m - i >= 16 ? __mmask16(0xFFFF) : __mmask16((1u << (m - i)) - 1);
+    // Pilot (PilotPass).
+    __m512 x[kN];
+    __mmask16 well[kN];
+    __m512 su = zero, se = zero, lg = zero;
+    __mmask16 found = 0;
+    for (int k = 0; k < kN; ++k) {
+      x[k] = _mm512_maskz_loadu_ps(lanes, u + k * kChunk + i);
+      const __mmask16 unclipped = _mm512_cmp_ps_mask(x[k], x[k], _CMP_EQ_OQ);
+      well[k] = _mm512_cmp_ps_mask(x[k], _mm512_set1_ps(floor_u[k]), _CMP_GE_OQ) &
+                _mm512_cmp_ps_mask(x[k], zero, _CMP_GT_OQ);
+      su = _mm512_add_ps(su, _mm512_maskz_mov_ps(well[k], x[k]));
+      se = _mm512_add_ps(se, _mm512_maskz_mov_ps(well[k], _mm512_set1_ps(eff[k])));
+      lg = _mm512_add_ps(lg, _mm512_maskz_mov_ps(__mmask16(unclipped & ~found),
+                                                 _mm512_mul_ps(x[k], _mm512_set1_ps(inv_eff[k]))));
+      found = __mmask16(found | unclipped);
+    }
+    const __m512 pilot = _mm512_div_ps(su, se);
+    // Weights (QuantPass, WeightPass).
+    __m512 sw = zero, swx = zero;
+    for (int k = 0; k < kN; ++k) {
+      const __m512 e = _mm512_set1_ps(eff[k]);
+      __m512 variance = _mm512_add_ps(_mm512_mul_ps(_mm512_mul_ps(e, pilot), inv_full_well),
+                                      _mm512_set1_ps(constant[k]));
+      if (kCurved) {
+        __m512 q = zero;
+        if (quant_var[k]) {
+          const __m512i entry = QuantEntries16(pilot, eff[k], range[k], black[k]);
+          if (i == 0) QuantBases(entry, 0, base[k]);
+          q = QuantLookup16(quant_var[k], entry, base[k], __mmask16(well[k] & lanes));
+          QuantBases(entry, 1, base[k]);  // for the next vector
+        }
+        variance = _mm512_add_ps(variance, q);
+      }
+      const __m512 w_over_e = _mm512_div_ps(e, variance);
+      sw = _mm512_add_ps(sw, _mm512_maskz_mov_ps(well[k], _mm512_mul_ps(w_over_e, e)));
+      swx = _mm512_add_ps(swx, _mm512_maskz_mov_ps(well[k], _mm512_mul_ps(w_over_e, x[k])));
+    }
+    const __mmask16 measured = _mm512_cmp_ps_mask(se, zero, _CMP_GT_OQ);
+    // !any: 0; measured: swx / sw; else the longest unclipped value.
+    const __m512 v =
+        _mm512_maskz_mov_ps(found, _mm512_mask_mov_ps(lg, measured, _mm512_div_ps(swx, sw)));
+    _mm512_mask_storeu_ps(value + i, lanes, v);
+    const __m512i st = _mm512_mask_mov_epi32(
+        _mm512_set1_epi32(kClippedEverywhere), found,
+        _mm512_maskz_mov_epi32(__mmask16(~measured), _mm512_set1_epi32(kNearBlackEverywhere)));
+    _mm512_mask_cvtepi32_storeu_epi8(state + i, lanes, st);
+    const __m512 b = _mm512_maskz_mov_ps(measured, v);
+    const __m512 old_b = _mm512_maskz_loadu_ps(lanes, brightest + i);
+    _mm512_mask_storeu_ps(brightest + i, lanes,
+                          _mm512_mask_mov_ps(old_b, _mm512_cmp_ps_mask(old_b, b, _CMP_LT_OQ), b));
+    const __m512 old_f = _mm512_maskz_loadu_ps(lanes, faintest + i);
+    const __m512 f =
+        _mm512_mask_mov_ps(old_f, __mmask16(measured & _mm512_cmp_ps_mask(v, zero, _CMP_GT_OQ)), v);
+    _mm512_mask_storeu_ps(faintest + i, lanes,
+                          _mm512_mask_mov_ps(old_f, _mm512_cmp_ps_mask(f, old_f, _CMP_LT_OQ), f));
+  }
+}
+#endif
+
+LUMISLAB_QUANT_DEFAULT bool MergeSlideChunkFused(const SlideParams&, const float*, int, float*,
+                                                 uint8_t*, float*, float*) {
+  return false;
+}
+
+#ifdef LUMISLAB_QUANT_AVX512
+__attribute__((target("avx512f"))) bool MergeSlideChunkFused(const SlideParams& p, const float* u,
+                                                             int m, float* value, uint8_t* state,
+                                                             float* brightest, float* faintest) {
+  static_assert(kMaxUnrolled == 4, "MergeSlideChunkFused: one case per unrolled count");
+#define LUMISLAB_FUSED_CASE(kN)                                               \
+  case kN:                                                                    \
+    if (p.curved)                                                             \
+      FusedSlideChunk<kN, true>(p, u, m, value, state, brightest, faintest);  \
+    else                                                                      \
+      FusedSlideChunk<kN, false>(p, u, m, value, state, brightest, faintest); \
+    return true;
+  switch (p.n) {
+    LUMISLAB_FUSED_CASE(1)
+    LUMISLAB_FUSED_CASE(2)
+    LUMISLAB_FUSED_CASE(3)
+    LUMISLAB_FUSED_CASE(4)
+    default:
+      return false;
+  }
+#undef LUMISLAB_FUSED_CASE
+}
+#endif
+
 // Both slides of `pixels` pixels into gain * (v+ - v-) per value, 0 where the pixel is saturated
 // (a channel of a slide clipped in every exposure: the states are bits, so one OR over the six
 // channels tells), and 1 / 0 per pixel for saturated; counts the saturated and the near-black
@@ -771,9 +919,10 @@ LUMISLAB_ROW_KERNEL void CombineSlides(const float* __restrict v0, const float* 
 }
 
 // Merges one photo row of both slides. Each exposure's values of a chunk of the row are read
-// once (linear codes or per-code tables, NaN where clipped), then each slide is merged in three
-// passes over the chunk (pilot, the table term of curved photos, weighted sums) whose loops over
-// the slide's exposures are unrolled so that the compiler vectorises over the values.
+// once (linear codes or per-code tables, NaN where clipped), then each slide is merged: with
+// AVX-512F in one fused pass (MergeSlideChunkFused), else in three passes over the chunk (pilot,
+// the table term of curved photos, weighted sums) whose loops over the slide's exposures are
+// unrolled so that the compiler vectorises over the values.
 struct MergeRows {
   const std::vector<Exposure>& exposures;
   int width, n3;  // n3 = 3 * width
@@ -839,10 +988,13 @@ struct MergeRows {
         else
           ReadPixels(e, y, x0, pixels, uk);
       }
-      for (int s = 0; s < 2; ++s)
-        MergeSlideChunk(params[s], u.data() + size_t(first_slot[s]) * kChunk, m, *scratch,
-                        value[s].data() + 3 * x0, state[s].data() + 3 * x0, brightest.data(),
-                        faintest.data());
+      for (int s = 0; s < 2; ++s) {
+        const float* us = u.data() + size_t(first_slot[s]) * kChunk;
+        float* vs = value[s].data() + 3 * x0;
+        uint8_t* ss = state[s].data() + 3 * x0;
+        if (!MergeSlideChunkFused(params[s], us, m, vs, ss, brightest.data(), faintest.data()))
+          MergeSlideChunk(params[s], us, m, *scratch, vs, ss, brightest.data(), faintest.data());
+      }
       CombineSlides(value[0].data() + 3 * x0, value[1].data() + 3 * x0, state[0].data() + 3 * x0,
                     state[1].data() + 3 * x0, pixels, gain, difference.data() + 3 * x0,
                     saturated.data() + x0, &stats->saturated, &stats->near_black);

@@ -147,15 +147,19 @@ uniform sampler2D u_source_position;  // the last full frame's G-buffer
 uniform sampler2D u_source_normal;
 uniform mat4 u_source_from_luminaire;  // its clip coordinates of a luminaire-frame point
 #endif
+#if RESOLVE || REPROJECT
+// Row 4 of the sources' view's clip-from-luminaire matrix: a point's depth (clip w) there.
+uniform vec4 u_depth_row;
+#endif
 #if !COARSE && !EXACT_LIST
 layout(location = 2) out vec4 o_irradiance;  // the sum alone (before albedo), reused by REPROJECT
 #endif
 #if RESOLVE || REPROJECT || EXACT_LIST
-// The pixels that coarse shading shades exactly: the resolve pass lists them (x | y << 16) and a
-// compute pass (EXACT_LIST) shades them, all its invocations busy (a fragment pass would run the
-// light loop for every 4 x 4 block with one such pixel). groups_x counts its work groups, one
-// per 64 pixels listed, for glDispatchComputeIndirect.
-layout(std430, binding = 0) buffer ExactCount { uint groups_x, groups_y, groups_z, count; };
+// The pixels that coarse shading's resolve pass or reprojection do not take from their samples:
+// those passes list them (x | y << 16) and a compute pass (EXACT_LIST) shades them, all its
+// invocations busy (a fragment pass would run the light loop for every 4 x 4 block holding one
+// such pixel).
+layout(std430, binding = 0) buffer ExactCount { uint count; };
 layout(std430, binding = 1) buffer ExactList { uint exact_pixels[]; };
 #endif
 #if EXACT_LIST
@@ -255,19 +259,26 @@ vec3 ShadeLights(vec3 x, vec3 n) {
 
 #if RESOLVE || REPROJECT
 // The pixel's sum taken from four source samples around source coordinate q (texels, centres at
-// integers), bilinear: when every sample with a weight saw a point of the pixel's own surface
-// (normals within 25 degrees, off the pixel's tangent plane by under a quarter of the distance)
-// and their sums spread by at most u_reuse_tolerance of their largest magnitude in every
-// channel, so the light varies smoothly there. False elsewhere (edges of objects, shadows and
-// spots): the pixel is shaded exactly. Sources: RESOLVE, the coarse samples (sample s at pixel
-// 2 s of the G-buffer); REPROJECT, the last frame shaded in full (its own G-buffer).
-bool Reused(vec2 q, vec3 x, vec3 n, out vec3 sum) {
+// integers), bilinear: when every sample with a weight saw a point of the pixel's own surface and
+// their sums spread by at most u_reuse_tolerance of their largest magnitude in every channel, so
+// the light varies smoothly there. Own surface: normals within 25 degrees, off the pixel's
+// tangent plane by under a quarter of their distance, and the samples' 1/depth in the source
+// view, interpolated at q (linear across a plane there), within 1 % of the pixel point's (so a
+// surface in front of it, seen at a grazing angle, is not taken). False elsewhere (edges of
+// objects, shadows and spots): the pixel is shaded exactly. Not seen: a lit or shadowed sliver
+// narrower than the samples' spacing whose four samples agree. Sources: RESOLVE, the coarse
+// samples (sample s at pixel 2 s of the G-buffer); REPROJECT, the last view shaded in full (its
+// own G-buffer). depth: the pixel point's clip w in the source's view.
+bool Reused(vec2 q, vec3 x, vec3 n, float depth, out vec3 sum) {
   sum = vec3(0.0);
   const ivec2 size = textureSize(u_source, 0);
+  // In float first: a huge or NaN q has no defined integer conversion.
+  if (!(all(greaterThanEqual(q, vec2(0.0))) && all(lessThanEqual(q, vec2(size - 1)))))
+    return false;
   const ivec2 base = ivec2(floor(q));
   const vec2 f = q - vec2(base);
-  if (any(lessThan(base, ivec2(0))) || any(greaterThan(base, size - 1))) return false;
   vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  float inverse_depth = 0.0;
   for (int k = 0; k < 4; ++k) {
     const ivec2 corner = ivec2(k & 1, k >> 1);
     const float w = ((k & 1) != 0 ? f.x : 1.0 - f.x) * ((k & 2) != 0 ? f.y : 1.0 - f.y);
@@ -283,11 +294,13 @@ bool Reused(vec2 q, vec3 x, vec3 n, out vec3 sum) {
 #endif
     const vec3 d = p.xyz - x;
     if (p.w == 0.0 || dot(n, ns) < 0.9 || abs(dot(n, d)) > 0.25 * length(d) + 1e-3) return false;
+    inverse_depth += w / dot(u_depth_row, vec4(p.xyz, 1.0));
     const vec3 e = texelFetch(u_source, s, 0).rgb;
     lo = min(lo, e);
     hi = max(hi, e);
     sum += w * e;
   }
+  if (!(abs(inverse_depth * depth - 1.0) <= 0.01)) return false;
   const vec3 peak = max(abs(lo), abs(hi));
   return all(lessThanEqual(hi - lo, u_reuse_tolerance * vec3(max(peak.r, max(peak.g, peak.b)))));
 }
@@ -300,7 +313,9 @@ vec3 Radiance(vec3 sum, ivec2 pixel) {
 
 #if EXACT_LIST
 void main() {
-  const uint k = gl_GlobalInvocationID.x;
+  // Work groups of 64 in rows of at most 65535 (the smallest GL_MAX_COMPUTE_WORK_GROUP_COUNT).
+  const uint k = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 64u +
+                 gl_LocalInvocationIndex;
   if (k >= count) return;
   const ivec2 pixel = ivec2(exact_pixels[k] & 0xffffu, exact_pixels[k] >> 16);
   const vec3 sum = ShadeLights(texelFetch(u_gbuffer_position, pixel, 0).xyz,
@@ -308,7 +323,8 @@ void main() {
   imageStore(u_irradiance, pixel, imageLoad(u_irradiance, pixel) + vec4(sum, 0.0));
   const vec3 radiance = Radiance(sum, pixel);
 #if SRGBE
-  const vec3 previous = DecodeSrgbe(imageLoad(u_packed_sum, pixel).r);  // carried by RESOLVE
+  // Carried by RESOLVE or REPROJECT.
+  const vec3 previous = DecodeSrgbe(imageLoad(u_packed_sum, pixel).r);
   imageStore(u_packed_sum, pixel, uvec4(EncodeSrgbe(previous + radiance)));
 #else
   imageStore(u_accumulation, pixel, imageLoad(u_accumulation, pixel) + vec4(radiance, 0.0));
@@ -343,10 +359,8 @@ void main() {
   const vec2 q = clip.w > 0.0 ? (0.5 * clip.xy / clip.w + 0.5) * vec2(textureSize(u_source, 0)) - 0.5
                               : vec2(-1.0);
 #endif
-  if (!Reused(q, x, n, sum)) {
-    const uint k = atomicAdd(count, 1u);
-    if (k % 64u == 0u) atomicAdd(groups_x, 1u);
-    exact_pixels[k] = uint(pixel.x) | (uint(pixel.y) << 16);
+  if (!Reused(q, x, n, dot(u_depth_row, vec4(x, 1.0)), sum)) {
+    exact_pixels[atomicAdd(count, 1u)] = uint(pixel.x) | (uint(pixel.y) << 16);
 #if !SRGBE
     discard;
 #endif
@@ -537,7 +551,7 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
   glGenFramebuffers(1, &gl_->shadow_fbo);
   glCreateBuffers(1, &gl_->exact_count);
-  glNamedBufferStorage(gl_->exact_count, 4 * sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glNamedBufferStorage(gl_->exact_count, sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
   AllocateTargets();
   if (glGetError() != GL_NO_ERROR) throw Failure("GL error while creating the renderer");
 }
@@ -611,7 +625,8 @@ void Renderer::AllocateTargets() {
   }
   gl_->irradiance = make(GL_RGBA32F);
   for (GLuint& t : gl_->source) t = make(GL_RGBA32F);
-  source_valid_ = false;
+  source_valid_ = view_shaded_in_full_ = false;  // new, undefined contents
+  reproject_next_ = true;
   glCreateBuffers(1, &gl_->exact_list);
   glNamedBufferStorage(gl_->exact_list, GLsizeiptr(width_) * height_ * sizeof(GLuint), nullptr, 0);
   glGenFramebuffers(2, gl_->fbo);
@@ -1056,6 +1071,10 @@ void Renderer::SetCommonUniforms(unsigned program, Shading shading) {
     glUniform1i(Loc(p, "u_source"), 6);
     glUniform1f(Loc(p, "u_reuse_tolerance"),
                 float(coarse ? options_.coarse_tolerance : options_.reproject_tolerance));
+    const Eigen::Matrix4f m =
+        (coarse ? drawn_view_projection_ : source_view_projection_) * pose_.matrix().cast<float>();
+    const Eigen::Vector4f depth_row = m.row(3).transpose();
+    glUniform4fv(Loc(p, "u_depth_row"), 1, depth_row.data());
   }
   if (shading == Shading::kReproject) {
     for (int k = 1; k < 3; ++k) {
@@ -1160,14 +1179,16 @@ void Renderer::DrawLightPass(Shading shading) {
     glBindImageTexture(0, gl_->colour, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, gl_->packed[ping_], 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindImageTexture(2, gl_->irradiance, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, gl_->exact_count);
-    glDispatchComputeIndirect(0);
+    // Work groups of 64 in rows of at most 65535, the smallest GL_MAX_COMPUTE_WORK_GROUP_COUNT.
+    const GLuint groups = (exact_listed_ + 63) / 64, row = std::min<GLuint>(groups, 65535);
+    if (groups > 0) glDispatchCompute(row, (groups + row - 1) / row, 1);
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     return;
   }
-  if (shading == Shading::kResolve || shading == Shading::kReproject) {
-    const GLuint reset[4] = {0, 1, 1, 0};
-    glNamedBufferSubData(gl_->exact_count, 0, sizeof(reset), reset);
+  const bool listing = shading == Shading::kResolve || shading == Shading::kReproject;
+  if (listing) {
+    const GLuint zero = 0;
+    glNamedBufferSubData(gl_->exact_count, 0, sizeof(zero), &zero);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl_->exact_count);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, gl_->exact_list);
   }
@@ -1198,12 +1219,17 @@ void Renderer::DrawLightPass(Shading shading) {
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glColorMaski(2, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   if (options_.srgbe) ping_ = 1 - ping_;
+  if (listing) {  // how many it listed (sizes the compute passes' dispatch)
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glGetNamedBufferSubData(gl_->exact_count, 0, sizeof(exact_listed_), &exact_listed_);
+  }
 }
 
 // Reprojection: each pixel takes the source view's sums where its point lies between four source
 // pixels of its own surface whose sums agree (Reused in kLightFragment); the pixels it lists are
 // shaded by the source's lights. A source whose reuse listed over a quarter of the pixels (the
-// view moved far) is replaced: the next view is shaded in full and becomes the source.
+// view moved far) is replaced: the next view is shaded in full, and becomes the source at the
+// move after it.
 void Renderer::Reproject() {
   const GLuint p = LightProgram(false, Shading::kReproject);
   SetCommonUniforms(p, Shading::kReproject);
@@ -1212,7 +1238,12 @@ void Renderer::Reproject() {
   for (size_t l = 0; l < source_lights_.size(); ++l) {
     if (source_lights_[l]) lights.push_back(int(l));
   }
-  list_only_ = true;
+  // The light passes run only EXACT_LIST over the list while this lives (also if one throws).
+  struct ListOnly {
+    bool& flag;
+    explicit ListOnly(bool& f) : flag(f) { flag = true; }
+    ~ListOnly() { flag = false; }
+  } list_only(list_only_);
   if (Fast()) {
     FastPasses(lights);
   } else {
@@ -1221,10 +1252,7 @@ void Renderer::Reproject() {
       LightPass(std::vector<int>(lights.begin() + start, lights.begin() + end));
     }
   }
-  list_only_ = false;
-  GLuint count[4] = {0, 0, 0, 0};
-  glGetNamedBufferSubData(gl_->exact_count, 0, sizeof(count), count);
-  state_.reprojected_exact = double(count[3]) / (double(width_) * height_);
+  state_.reprojected_exact = double(exact_listed_) / (double(width_) * height_);
   reproject_next_ = state_.reprojected_exact <= 0.25;
   accumulated_ = source_lights_;
 }
@@ -1294,12 +1322,15 @@ int Renderer::Render() {
     accumulated_.assign(accumulated_.size(), false);
     view_valid_ = true;
     lap(&times_.depth_ms);
-    if (options_.reproject_tolerance > 0 && source_valid_ && reproject_next_) {
+    const bool source_lit =
+        std::find(source_lights_.begin(), source_lights_.end(), true) != source_lights_.end();
+    if (options_.reproject_tolerance > 0 && source_valid_ && source_lit && reproject_next_) {
       Reproject();
       reprojected = true;
     } else {
       view_shaded_in_full_ = options_.reproject_tolerance > 0;
       reproject_next_ = true;
+      state_.reprojected_exact = 0;
     }
   }
   std::vector<int> todo;

@@ -55,11 +55,11 @@ struct RenderOptions {
   int merge_group = 1;
   double merge_error = 0.01;
   // Coarse shading: a pass with at least kCoarseMinLights lights is shaded at every second pixel
-  // of every second row, and a pixel takes the mean of its (up to four) samples where they lie on
-  // its plane and their sums spread by at most this fraction of their peak; the others are
-  // shaded exactly (0: off, every pixel exact).
+  // of every second row, and a pixel takes the bilinear mean of its (up to four) samples where
+  // they lie on its surface and their sums spread by at most this fraction of their peak; the
+  // others are shaded exactly (0: off, every pixel exact).
   double coarse_tolerance = 0;
-  // Reprojection: after a camera move (pose, scene, lights unchanged) a pixel takes the sums of
+  // Reprojection: after a camera move (pose, scene, options unchanged) a pixel takes the sums of
   // the last view shaded in full, interpolated where four of its pixels lie on the pixel's
   // surface and their sums spread by at most this fraction of their peak; the others are shaded
   // exactly (0: off).
@@ -81,13 +81,14 @@ constexpr int kFastLightsPerPass = 128;  // the shortcuts' program (members + me
 
 // What the shortcuts chose at the last Render() (for the bench, the window and the log).
 struct ShortcutState {
-  int shadow_group = 1;          // g of the shadow-map sharing (1: none)
-  double shadow_shift = 0;       // its largest shadow-edge shift (shadow texels)
-  double z_min = 0, z_max = 0;   // depth range the maps see (mm, luminaire frame)
-  int shadow_maps = 0;           // distinct maps in use
-  int merged_lights = 0;         // merged lights in the last pass
-  double z_merge = 0;            // receivers at least this deep (mm) used the merged lights
-  double reprojected_exact = 0;  // the last reprojection: fraction of the pixels shaded exactly
+  int shadow_group = 1;         // g of the shadow-map sharing (1: none)
+  double shadow_shift = 0;      // its largest shadow-edge shift (shadow texels)
+  double z_min = 0, z_max = 0;  // depth range the maps see (mm, luminaire frame)
+  int shadow_maps = 0;          // distinct maps in use
+  int merged_lights = 0;        // merged lights in the last pass
+  double z_merge = 0;           // receivers at least this deep (mm) used the merged lights
+  // The last view: fraction of the pixels reprojection shaded exactly (0: not reprojected).
+  double reprojected_exact = 0;
 };
 
 class Renderer {
@@ -136,7 +137,8 @@ class Renderer {
   void LightPass(const std::vector<int>& lights);
   void FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
                      double z_far);
-  // How a light pass shades: every pixel exactly, or the two passes of coarse shading.
+  // How a light pass shades: every pixel exactly; coarse shading's samples, their resolve and the
+  // compute pass over the pixels listed; reprojection's pass (it lists for kExactList too).
   enum class Shading { kExact, kCoarse, kResolve, kExactList, kReproject };
   // The passes that shade `lights` lights at the present options.
   std::vector<Shading> ShadingPasses(int lights) const;
@@ -164,6 +166,7 @@ class Renderer {
   std::vector<bool> source_lights_;
   bool view_shaded_in_full_ = false, source_valid_ = false, reproject_next_ = true;
   bool list_only_ = false;
+  unsigned exact_listed_ = 0;  // pixels the last RESOLVE or REPROJECT pass listed
   int shadow_renders_ = 0;
   int ping_ = 0;  // sRGBE: which of the two targets holds the current sum
   PhaseTimes times_;

@@ -447,6 +447,123 @@ TEST_F(PreviewSlabFiles, ReprojectionAddsPositionsThatArriveAfterTheMove) {
   EXPECT_LE(RelativeDifference(p->Read(), full->Read()), 0.015);
 }
 
+// Reprojection across the renderer's other paths: a resize (new, undefined targets: nothing is
+// reused), a move so far that the source is replaced (its textures change roles a second time),
+// merged lights with coarse shading, and more lights than one pass holds (81: two batches over
+// one list).
+TEST_F(PreviewSlabFiles, ReprojectionThroughResizeSourceChangesMergingAndManyLights) {
+  const auto positions = ScanSlabPositions(dir_.string(), info_);
+  const SceneSetup setup = MakeSceneSetup("crypt", info_);
+  RenderOptions reuse;
+  reuse.reproject_tolerance = 0.1;
+  auto r = MakeRenderer(reuse);
+  Upload(*r, positions);
+  r->Render();
+  SceneSetup moved = setup;
+  moved.camera_yaw_deg += 2;
+  r->Resize(80, 72);
+  r->SetCamera(OrbitCamera(moved, 1.0));
+  r->Render();
+  EXPECT_EQ(r->shortcuts().reprojected_exact, 0);  // shaded in full, nothing reused
+  {
+    Renderer fresh(info_, 80, 72, RenderOptions{});
+    fresh.SetScene(setup.mesh);
+    fresh.SetPose(setup.pose);
+    fresh.SetCamera(OrbitCamera(moved, 1.0));
+    Upload(fresh, positions);
+    fresh.Render();
+    EXPECT_EQ(r->Read().data, fresh.Read().data);
+  }
+  // Far moves: the source is replaced after one that lists over a quarter of the pixels.
+  r->Resize(96, 96);
+  auto exact_at = [&](const SceneSetup& view, const RenderOptions& options) {
+    auto e = MakeRenderer(options);
+    Upload(*e, positions);
+    e->SetCamera(OrbitCamera(view, 1.0));
+    e->Render();
+    return e->Read();
+  };
+  bool replaced = false;
+  for (double yaw : {0.0, 2.0, 10.0, 12.0, 14.0}) {
+    moved.camera_yaw_deg = setup.camera_yaw_deg + yaw;
+    r->SetCamera(OrbitCamera(moved, 1.0));
+    r->Render();
+    replaced |= r->shortcuts().reprojected_exact > 0.25;
+    // 0.65-0.9 % after 2-6 degrees (the test above); 8 degrees from the source at 96 x 96: 1.0 %.
+    EXPECT_LE(RelativeDifference(r->Read(), exact_at(moved, RenderOptions{})), 0.015) << yaw;
+  }
+  EXPECT_TRUE(replaced);
+  EXPECT_GT(r->shortcuts().reprojected_exact, 0);  // 14: from the source shaded at 12
+  EXPECT_LT(r->shortcuts().reprojected_exact, 0.25);
+  // Merged lights (no shadows) with coarse shading and reprojection: within the merged lights'
+  // own error (0.83 %, the shortcuts' test) plus a little.
+  RenderOptions merged = reuse;
+  merged.shadows = false;
+  merged.merge_group = 2;
+  merged.merge_error = 0.05;
+  merged.coarse_tolerance = 0.1;
+  RenderOptions flat;
+  flat.shadows = false;
+  auto m = MakeRenderer(merged);
+  Upload(*m, positions);
+  m->Render();
+  // (At 96 x 96 a 2 degree move lists about a quarter of the pixels: the next view may be shaded
+  // in full, so each move starts from a view shaded in full.)
+  for (double yaw : {2.0, 4.0}) {
+    moved.camera_yaw_deg = setup.camera_yaw_deg + yaw - 2;
+    m->SetCamera(OrbitCamera(moved, 1.0));
+    m->SetOptions(merged);  // drops the source: this view is shaded in full
+    m->Render();
+    EXPECT_EQ(m->shortcuts().reprojected_exact, 0);
+    moved.camera_yaw_deg = setup.camera_yaw_deg + yaw;
+    m->SetCamera(OrbitCamera(moved, 1.0));
+    m->Render();
+    EXPECT_GT(m->shortcuts().reprojected_exact, 0);
+    EXPECT_LE(RelativeDifference(m->Read(), exact_at(moved, flat)), 0.015) << yaw;
+  }
+  // 9 x 9 positions: two light passes (64 + 17) over coarse shading's and reprojection's lists.
+  const std::filesystem::path many = dir_.string() + "_81";
+  std::filesystem::remove_all(many);
+  const SlabInfo info81 = DefaultSlabInfo(9, 9, 5, 40);
+  WriteTruthSlab(DefaultScene().luminaire, info81, many.string(), 2);
+  const SceneSetup setup81 = MakeSceneSetup("crypt", info81);
+  auto render81 = [&](const RenderOptions& options, const std::vector<double>& yaws) {
+    Renderer r81(info81, 96, 96, options);
+    r81.SetScene(setup81.mesh);
+    r81.SetPose(setup81.pose);
+    for (const auto& [i, j] : ScanSlabPositions(many.string(), info81))
+      r81.SetPosition(i, j, ReadIntensity(many.string(), info81, i, j));
+    SceneSetup view = setup81;
+    for (double yaw : yaws) {
+      view.camera_yaw_deg = setup81.camera_yaw_deg + yaw;
+      r81.SetCamera(OrbitCamera(view, 1.0));
+      r81.Render();
+    }
+    return r81.Read();
+  };
+  RenderOptions both = reuse;
+  both.coarse_tolerance = 0.1;
+  const ImageF exact81 = render81({}, {2});
+  RenderOptions coarse;
+  coarse.coarse_tolerance = 0.1;
+  const double coarse81 = RelativeDifference(render81(coarse, {2}), exact81);
+  const double reused81 = RelativeDifference(render81(reuse, {0, 2}), exact81);
+  const double error81 = RelativeDifference(render81(both, {0, 2}), exact81);
+  std::printf(
+      "81 positions: relative L2 coarse shading %.3f %%, reprojection %.3f %%, both %.3f %%\n",
+      100 * coarse81, 100 * reused81, 100 * error81);
+  // A batch lost or counted twice moves the image by 17/81 or 64/81. Coarse shading's own error
+  // is larger on this 96 x 96 image of a 9 x 9 grid (1.8-2.1 %, nearly the same at tolerance
+  // 0.01: the penumbrae's steps, one per position, are finer than two pixels here; 0.3-0.6 % on
+  // the bench's 400 x 400 rooms).
+  EXPECT_GT(coarse81, 0);
+  EXPECT_LE(coarse81, 0.03);
+  EXPECT_GT(reused81, 0);
+  EXPECT_LE(reused81, 0.01);
+  EXPECT_LE(error81, 0.03);
+  std::filesystem::remove_all(many);
+}
+
 // --view false-colour maps the irradiance before the materials: with every albedo 0.5 the normal
 // view is 0.5 / pi of the unit-albedo one, pixel for pixel.
 TEST_F(PreviewSlabFiles, UnitAlbedoIsTheIrradianceBeforeTheMaterials) {

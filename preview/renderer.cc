@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -439,15 +441,16 @@ GLuint Compile(GLenum type, const std::string& source) {
   return shader;
 }
 
-GLuint Link(const std::string& vertex, const std::string& fragment) {
+// Compiles and links one program from (stage, source) pairs.
+GLuint LinkStages(std::initializer_list<std::pair<GLenum, const std::string*>> stages) {
   const GLuint program = glCreateProgram();
-  const GLuint vs = Compile(GL_VERTEX_SHADER, vertex);
-  const GLuint fs = Compile(GL_FRAGMENT_SHADER, fragment);
-  glAttachShader(program, vs);
-  glAttachShader(program, fs);
+  std::vector<GLuint> shaders;
+  for (const auto& [stage, source] : stages) {
+    shaders.push_back(Compile(stage, *source));
+    glAttachShader(program, shaders.back());
+  }
   glLinkProgram(program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
+  for (GLuint shader : shaders) glDeleteShader(shader);
   GLint ok = 0;
   glGetProgramiv(program, GL_LINK_STATUS, &ok);
   if (!ok) {
@@ -458,20 +461,12 @@ GLuint Link(const std::string& vertex, const std::string& fragment) {
   return program;
 }
 
+GLuint Link(const std::string& vertex, const std::string& fragment) {
+  return LinkStages({{GL_VERTEX_SHADER, &vertex}, {GL_FRAGMENT_SHADER, &fragment}});
+}
+
 GLuint LinkCompute(const std::string& compute) {
-  const GLuint program = glCreateProgram();
-  const GLuint cs = Compile(GL_COMPUTE_SHADER, compute);
-  glAttachShader(program, cs);
-  glLinkProgram(program);
-  glDeleteShader(cs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
-    throw Failure(std::string("GLSL link error: ") + log);
-  }
-  return program;
+  return LinkStages({{GL_COMPUTE_SHADER, &compute}});
 }
 
 GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
@@ -1225,6 +1220,20 @@ void Renderer::DrawLightPass(Shading shading) {
   }
 }
 
+// The light passes that add `lights`: with the shortcuts, FastPasses; otherwise batches of
+// kLightsPerPass.
+void Renderer::LightPasses(const std::vector<int>& lights) {
+  if (lights.empty()) return;
+  if (Fast()) {
+    FastPasses(lights);
+    return;
+  }
+  for (size_t start = 0; start < lights.size(); start += kLightsPerPass) {
+    const size_t end = std::min(lights.size(), start + kLightsPerPass);
+    LightPass(std::vector<int>(lights.begin() + start, lights.begin() + end));
+  }
+}
+
 // Reprojection: each pixel takes the source view's sums where its point lies between four source
 // pixels of its own surface whose sums agree (Reused in kLightFragment); the pixels it lists are
 // shaded by the source's lights. A source whose reuse listed over a quarter of the pixels (the
@@ -1244,14 +1253,7 @@ void Renderer::Reproject() {
     explicit ListOnly(bool& f) : flag(f) { flag = true; }
     ~ListOnly() { flag = false; }
   } list_only(list_only_);
-  if (Fast()) {
-    FastPasses(lights);
-  } else {
-    for (size_t start = 0; start < lights.size(); start += kLightsPerPass) {
-      const size_t end = std::min(lights.size(), start + kLightsPerPass);
-      LightPass(std::vector<int>(lights.begin() + start, lights.begin() + end));
-    }
-  }
+  LightPasses(lights);
   state_.reprojected_exact = double(exact_listed_) / (double(width_) * height_);
   reproject_next_ = state_.reprojected_exact <= 0.25;
   accumulated_ = source_lights_;
@@ -1352,14 +1354,7 @@ int Renderer::Render() {
     }
     lap(&times_.shadow_ms);
   }
-  if (!Fast()) {
-    for (size_t start = 0; start < todo.size(); start += kLightsPerPass) {
-      const size_t end = std::min(todo.size(), start + kLightsPerPass);
-      LightPass(std::vector<int>(todo.begin() + start, todo.begin() + end));
-    }
-  } else if (!todo.empty()) {
-    FastPasses(todo);
-  }
+  LightPasses(todo);
   for (int l : todo) accumulated_[l] = true;
   if (reprojected || !todo.empty()) lap(&times_.light_ms);
   glFinish();

@@ -147,6 +147,7 @@ class Renderer {
   unsigned LightProgram(bool fast, Shading shading = Shading::kExact);
   void DrawLightPass(Shading shading);
   void FastPasses(const std::vector<int>& todo);
+  void LightPasses(const std::vector<int>& lights);
   void Reproject();
   void AllocateTargets();
 

@@ -162,7 +162,7 @@ int Run(int argc, char** argv) {
         const ImageDifference error = CompareImages(on.Read(), off.Read());
 
         struct Times {
-          std::vector<double> cached, full, c_light, f_shadow, f_light;
+          std::vector<double> cached, full, c_depth, c_light, f_shadow, f_light;
         } times[2];
         SceneSetup moving = setup;
         for (int f = 0; f < frames; ++f) {
@@ -175,6 +175,7 @@ int Run(int argc, char** argv) {
             auto start = Clock::now();
             r.Render();
             times[k].cached.push_back(Seconds(start));
+            times[k].c_depth.push_back(r.phase_times().depth_ms);
             times[k].c_light.push_back(r.phase_times().light_ms);
             moving.camera_yaw_deg = setup.camera_yaw_deg + step + 2;
             r.SetCamera(OrbitCamera(moving, 1.0));
@@ -202,10 +203,10 @@ int Run(int argc, char** argv) {
                       on.shortcuts().z_max);
           for (int k = 0; k < 2; ++k) {
             std::printf(
-                "  %s phases (ms): camera move: light %.1f; full: shadow maps %.1f "
+                "  %s phases (ms): camera move: G-buffer %.1f light %.1f; full: shadow maps %.1f "
                 "light %.1f\n",
-                k ? "on " : "off", Median(times[k].c_light), Median(times[k].f_shadow),
-                Median(times[k].f_light));
+                k ? "on " : "off", Median(times[k].c_depth), Median(times[k].c_light),
+                Median(times[k].f_shadow), Median(times[k].f_light));
           }
         }
         const ShortcutState& state = on.shortcuts();

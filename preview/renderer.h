@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,11 @@ struct RenderOptions {
   // surface and their sums spread by at most this fraction of their peak; the others are shaded
   // exactly (0: off).
   double reproject_tolerance = 0;
+  // Each position's shadow map is drawn (and cleared) only over the rectangle its lookups can
+  // reach: where its E' is not zero, widened by the texture filter's and the normal offset's
+  // reach. Exact (a lookup outside multiplies an E' of 0); off only to check that it is exact.
+  // Maps shared or merged (the shortcuts above) are drawn whole.
+  bool shadow_scissor = true;
   // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
   bool time_phases = false;
 };
@@ -115,6 +121,8 @@ class Renderer {
   int Render();
   // Shadow maps rendered since construction (to show they are cached).
   int ShadowMapRenders() const { return shadow_renders_; }
+  // Shadow-map texels drawn so far (the scissor rectangles' areas).
+  long long ShadowTexelsDrawn() const { return shadow_texels_; }
   const PhaseTimes& phase_times() const { return times_; }
   const ShortcutState& shortcuts() const { return state_; }
   // The accumulated image (radiance or irradiance, W/m^2 [/sr]), 3 channels, row 0 on top.
@@ -130,8 +138,16 @@ class Renderer {
     int span_begin = -1, span_count = 1;  // merged: its members' entries (shadows averaged)
   };
   bool Fast() const { return options_.shadow_share_texels > 0 || options_.merge_group > 1; }
-  void RenderShadowMap(int light);
-  void RenderShadowMapAt(int layer, const Eigen::Vector2d& centre);
+  // One shadow map: its layer, seen from centre (a position's, or a shared map's block mean).
+  struct ShadowJob {
+    int layer = 0;
+    Eigen::Vector2d centre;
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the map texels drawn: [x0, x1) x [y0, y1)
+  };
+  // The job for position l's own map: the whole map, or its rectangle (shadow_scissor).
+  ShadowJob OwnShadowJob(int l) const;
+  // Clears and draws the maps (shadow_valid_ is the caller's).
+  void RenderShadowMaps(const std::vector<ShadowJob>& jobs);
   void ChooseShadowGroups();
   void MergedTexture(int group);
   void LightPass(const std::vector<int>& lights);
@@ -158,6 +174,9 @@ class Renderer {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   int vertex_count_ = 0;
   std::vector<bool> present_, shadow_valid_, accumulated_;
+  // Per position, the slab texels where its E' is not zero: [x0, x1) x [y0, y1) (empty: x0 >= x1);
+  // per layer, the map texels its map was drawn over (ShadowJob's rectangle).
+  std::vector<std::array<int, 4>> support_, shadow_rect_;
   bool view_valid_ = false;
   // Reprojection (RenderOptions::reproject_tolerance): the view drawn now and whether every pixel
   // of it was shaded (the sums can be reused); the source view, its lights; whether the next
@@ -169,6 +188,7 @@ class Renderer {
   bool list_only_ = false;
   unsigned exact_listed_ = 0;  // pixels the last RESOLVE or REPROJECT pass listed
   int shadow_renders_ = 0;
+  long long shadow_texels_ = 0;
   int ping_ = 0;  // sRGBE: which of the two targets holds the current sum
   PhaseTimes times_;
   // Shortcuts: CPU copies of E' (merged textures are built from them), per position the layer

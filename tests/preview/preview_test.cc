@@ -323,6 +323,64 @@ TEST_F(PreviewSlabFiles, ShadowCullKeepsTheImage) {
   EXPECT_FALSE(MakeRenderOptions(config, MakeSceneSetup("crypt", info_)).shadow_cull);
 }
 
+// Shadow maps drawn only where each position's E' is not zero (RenderOptions::shadow_scissor):
+// the same image, bit for bit, with the cubic filter and PCF (the widest lookups) and in sRGBE,
+// over two views; fewer map texels drawn; a position replaced by one with a wider E' gets its
+// map redrawn, and the image equals a fresh render.
+TEST_F(PreviewSlabFiles, ShadowScissorKeepsTheImageBitForBit) {
+  const SceneSetup setup = MakeSceneSetup("crypt", info_);
+  const auto positions = ScanSlabPositions(dir_.string(), info_);
+  for (bool srgbe : {false, true}) {
+    RenderOptions on;
+    on.shadow_cull = true;
+    on.shadow_pcf = true;
+    on.srgbe = srgbe;
+    on.texture_filter = TextureFilter::kCubic;
+    RenderOptions off = on;
+    off.shadow_scissor = false;
+    auto scissored = MakeRenderer(on), whole = MakeRenderer(off);
+    SceneSetup view = setup;
+    for (double yaw : {0.0, 8.0}) {
+      view.camera_yaw_deg = setup.camera_yaw_deg + yaw;
+      for (Renderer* r : {scissored.get(), whole.get()}) {
+        if (r->PositionCount() == 0) Upload(*r, positions);
+        r->SetCamera(OrbitCamera(view, 1.0));
+        r->Render();
+      }
+      const ImageF a = scissored->Read(), b = whole->Read();
+      double norm = 0;
+      for (float v : b.data) norm += v;
+      EXPECT_GT(norm, 0);
+      EXPECT_EQ(a.data, b.data) << "sRGBE " << srgbe << ", yaw " << yaw;
+    }
+    std::printf("shadow scissor: %lld of %lld map texels drawn\n", scissored->ShadowTexelsDrawn(),
+                whole->ShadowTexelsDrawn());
+    EXPECT_LT(scissored->ShadowTexelsDrawn(), 0.8 * whole->ShadowTexelsDrawn());
+  }
+  // A position first uploaded with E' only in a small patch, then replaced by its full E'.
+  RenderOptions options;
+  options.shadow_cull = true;
+  auto live = MakeRenderer(options), fresh = MakeRenderer(options);
+  Upload(*live, positions);
+  const int i = info_.grid.nu / 2, j = info_.grid.nv / 2;
+  const ImageF full = ReadIntensity(dir_.string(), info_, i, j);
+  ImageF patch(full.width, full.height, 3);
+  for (int y = full.height / 2; y < full.height / 2 + 3; ++y) {
+    for (int x = full.width / 2; x < full.width / 2 + 3; ++x) {
+      for (int c = 0; c < 3; ++c) patch.at(x, y, c) = full.at(x, y, c);
+    }
+  }
+  live->SetPosition(i, j, patch);
+  live->Render();
+  const int renders = live->ShadowMapRenders();
+  live->SetPosition(i, j, full);
+  live->Render();
+  EXPECT_EQ(live->ShadowMapRenders(), renders + 1);  // that map, wider
+  Upload(*fresh, positions);
+  fresh->Render();
+  EXPECT_EQ(live->Read().data, fresh->Read().data);
+}
+
 // Coarse shading and reprojection (docs/design.md §4.2, "Faster frames") against the full
 // per-position render of the same view: within 1 %, not identical (they really interpolate), the
 // tolerance matters, and reprojection never reuses sums that a pose, a scene or a replaced

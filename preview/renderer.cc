@@ -553,8 +553,9 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   GLint viewports = 0;
   glGetIntegerv(GL_MAX_VIEWPORTS, &viewports);
   gl_->shadow_batch = std::min(kShadowBatch, int(viewports));
-  gl_->layered_shadows =
-      HasExtension("GL_ARB_shader_viewport_layer_array") && gl_->shadow_batch >= 1;
+  gl_->layered_shadows = options_.layered_shadow_maps &&
+                         HasExtension("GL_ARB_shader_viewport_layer_array") &&
+                         gl_->shadow_batch >= 1;
   gl_->shadow_program = Link(ShadowVertex(gl_->layered_shadows), kEmptyFragment);
   gl_->display_program = Link(kQuadVertex, kDisplayFragment);
   glGenVertexArrays(1, &gl_->vao);
@@ -716,8 +717,9 @@ void Renderer::SetCamera(const Eigen::Matrix4f& view_projection) {
 }
 
 void Renderer::SetOptions(const RenderOptions& options) {
-  if (options.shadow_size != options_.shadow_size) {
-    throw BadInput("the shadow-map size is fixed when the renderer is created");
+  if (options.shadow_size != options_.shadow_size ||
+      options.layered_shadow_maps != options_.layered_shadow_maps) {
+    throw BadInput("the shadow-map size and layering are fixed when the renderer is created");
   }
   if (options.merge_group < 1 || !(options.merge_error > 0) ||
       !(options.shadow_share_texels >= 0) || !(options.coarse_tolerance >= 0) ||

@@ -70,6 +70,10 @@ struct RenderOptions {
   // reach. Exact (a lookup outside multiplies an E' of 0); off only to check that it is exact.
   // Maps shared or merged (the shortcuts above) are drawn whole.
   bool shadow_scissor = true;
+  // A frame's shadow maps in one instanced draw where the driver has
+  // ARB_shader_viewport_layer_array (false: one draw per map, as without it). Fixed when the
+  // renderer is created.
+  bool layered_shadow_maps = true;
   // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
   bool time_phases = false;
 };

@@ -96,12 +96,7 @@ OpenCvStart CalibrateWithOpenCv(const std::vector<Detection>& detections,
 
 // Unit normal of the board (its z axis) in the camera frame.
 Eigen::Vector3d BoardNormal(const Vector6d& pose) {
-  const Eigen::Vector3d r = pose.head<3>();
-  const double angle = r.norm();
-  const Eigen::Matrix3d rotation = angle > 0
-                                       ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix()
-                                       : Eigen::Matrix3d::Identity();
-  return rotation.col(2);
+  return RotationFromVector(pose.head<3>()).col(2);
 }
 
 double TiltDeg(const Vector6d& pose) {

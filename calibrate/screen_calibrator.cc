@@ -11,6 +11,7 @@
 #include "calibrate/camera_refiner.h"
 #include "calibrate/gray_stretch.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/log.h"
 #include "lib/photo/photo_io.h"
 
@@ -216,10 +217,7 @@ void SolveScreenPose(const BoardCorners& corners, const CameraModel& camera,
   if (!(pose.pose[5] > 0))
     throw BadInput(photo_name + ": degenerate view (the screen's pose puts it behind the camera)");
   // Camera point of screen point (x, y): R (x, y, 0) + t = [r1 r2 t] (x, y, 1).
-  const double angle = pose.pose.head<3>().norm();
-  const Eigen::Matrix3d r = angle > 0
-                                ? Eigen::AngleAxisd(angle, pose.pose.head<3>() / angle).matrix()
-                                : Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d r = RotationFromVector(pose.pose.head<3>());
   Eigen::Matrix3d plane;
   plane.col(0) = r.col(0);
   plane.col(1) = r.col(1);

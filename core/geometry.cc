@@ -39,6 +39,12 @@ Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees) {
       .toRotationMatrix();
 }
 
+Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& r) {
+  const double angle = r.norm();
+  return angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix()
+                   : Eigen::Matrix3d::Identity();
+}
+
 Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
                                 double z_plane) {
   const double t = (z_plane - p.z()) / (q.z() - p.z());

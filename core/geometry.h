@@ -15,11 +15,15 @@ double ShiftInvariantGeometry(double d, const Eigen::Vector2d& c, double s, doub
 // w (support width / d) seen from M at angle theta0 (radians) — paper Fig. 3.
 double ShiftInvariantError(double theta0, double relative_width);
 
-// Where the line from point p (luminaire frame, mm) through q crosses the plane z = z_plane.
 // The rotation Rz(z) Ry(y) Rx(x) of angles in degrees (x about X first, then y about Y, z about
 // Z, all about the fixed axes): how scene files, emitters and --luminaire-pose give orientations.
 Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees);
 
+// The rotation of a rotation vector (axis times angle in radians: OpenCV's rvec, what Rodrigues'
+// formula takes; the calibrations' poses); the identity for the zero vector.
+Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& r);
+
+// Where the line from point p (luminaire frame, mm) through q crosses the plane z = z_plane.
 Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q, double z_plane);
 
 }  // namespace lumislab

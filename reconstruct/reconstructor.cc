@@ -15,19 +15,38 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The brightest stored code of the photos above their black level, in code steps, when every
-// photo is an integer one read through a linear transfer (so that a code step is the near-black
-// floor's unit, docs/design.md §3.5.1); -1 otherwise.
-double BrightestCodes(const std::vector<DecodedPhoto>& photos) {
-  double brightest = -1;
+// The largest of row y's stored codes (every channel): a plain loop that vectorises.
+template <typename T>
+T RowMaxCode(const cv::Mat& pixels, int y) {
+  const T* row = pixels.ptr<T>(y);
+  const size_t n = size_t(pixels.cols) * pixels.channels();
+  T m = 0;
+  for (size_t k = 0; k < n; ++k) m = std::max(m, row[k]);
+  return m;
+}
+
+// Where every photo is an integer one read through a linear transfer (so that a code step is the
+// near-black floor's unit, docs/design.md §3.5.1): the brightest stored code of the photos above
+// their black level, in code steps, if it lies below `floor`; else the first row maximum met at
+// or above `floor` (the scan stops there: a lit position is told after a row or a few, where
+// the whole scan read ~860 MB for six 16-bit 6000 x 4000 photos, ~0.5 s). -1 for other photos.
+double BrightestCodesBelow(const std::vector<DecodedPhoto>& photos, double floor) {
   for (const auto& p : photos) {
     const int depth = p.photo.pixels.depth();
     if ((depth != CV_8U && depth != CV_16U) || p.photo.fractional_codes ||
         p.photo.transfer != Transfer::kLinear)
       return -1;
-    double lo = 0, hi = 0;
-    cv::minMaxLoc(p.photo.pixels.reshape(1), &lo, &hi);
-    brightest = std::max(brightest, hi - p.photo.spec.black_level * p.photo.CodeMax());
+  }
+  double brightest = -1;
+  for (const auto& p : photos) {
+    const cv::Mat& m = p.photo.pixels;
+    const double black = p.photo.spec.black_level * p.photo.CodeMax();
+    for (int y = 0; y < m.rows; ++y) {
+      const double hi = m.depth() == CV_8U ? double(RowMaxCode<uint8_t>(m, y))
+                                           : double(RowMaxCode<uint16_t>(m, y));
+      brightest = std::max(brightest, hi - black);
+      if (brightest >= floor) return brightest;
+    }
   }
   return brightest;
 }
@@ -162,7 +181,7 @@ SlabPosition ReconstructDecoded(const Dataset& dataset, const ScreenCalibration&
       for (int ch = 0; ch < 3; ++ch)
         moved += std::abs(c[k * 3 + ch] - data[k * 3 + ch]), total += std::abs(data[k * 3 + ch]);
   r.bell_correction = total > 0 ? moved / total : 0;
-  r.brightest_codes = BrightestCodes(photos);
+  r.brightest_codes = BrightestCodesBelow(photos, options.merge.near_black_codes);
   r.no_light =
       total == 0 || (r.brightest_codes >= 0 && r.brightest_codes < options.merge.near_black_codes);
   SlabPosition out;

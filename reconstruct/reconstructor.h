@@ -58,7 +58,10 @@ struct PositionReport {
   // Nothing measured: every seen texel is 0, or the brightest stored code of the position's
   // (linear, integer) photos lies below the near-black floor (MergeOptions::near_black_codes).
   bool no_light = false;
-  double brightest_codes = -1;  // that code above black; -1 for float or curved photos
+  // That code above black where it lies below the floor; else a code at or above the floor (the
+  // first row maximum met: a lit position is told without reading every photo); -1 for float or
+  // curved photos.
+  double brightest_codes = -1;
   // Seconds per stage.
   double decode_s = 0, rectify_s = 0, fit_s = 0, write_s = 0;
   // rectify_s split: building the map, merging the photos, remap + area average.

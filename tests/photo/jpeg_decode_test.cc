@@ -171,5 +171,42 @@ TEST(NewPhotoImage, ReleasedLargeBufferServesTheNextImageOfItsSize) {
   EXPECT_NE(d.data, b.data);
 }
 
+// PNG, TIFF and grey JPEG photos are OpenCV's decode (cv::imdecode of the file's bytes): the same
+// pixels as cv::imread, bit for bit (an alpha channel dropped), and a large photo lies in
+// NewPhotoImage's buffers: released, its buffer serves the next photo of its size. A truncated
+// TIFF is refused naming the file.
+TEST(NewPhotoImage, OpenCvPhotosAsImreadInKeptBuffers) {
+  const std::string dir = ScratchDir();
+  cv::Mat big(1000, 1100, CV_16UC3);  // 6.6 MB: a kept buffer
+  cv::randu(big, 0, 65536);
+  cv::Mat bgra(40, 50, CV_8UC4), gray;
+  cv::randu(bgra, 0, 256);
+  cv::cvtColor(Picture(), gray, cv::COLOR_BGR2GRAY);
+  const std::vector<std::pair<std::string, cv::Mat>> files = {{dir + "/big.tif", big},
+                                                              {dir + "/big.png", big},
+                                                              {dir + "/a.png", bgra},
+                                                              {dir + "/g.jpg", gray}};
+  for (const auto& [path, image] : files) {
+    ASSERT_TRUE(cv::imwrite(path, image)) << path;
+    cv::Mat expected = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+    if (expected.channels() == 4) cv::cvtColor(expected, expected, cv::COLOR_BGRA2BGR);
+    Photo photo = DecodePhoto(path);
+    ASSERT_EQ(photo.pixels.type(), expected.type()) << path;
+    ASSERT_EQ(photo.pixels.size(), expected.size()) << path;
+    EXPECT_EQ(cv::norm(photo.pixels, expected, cv::NORM_INF), 0) << path;
+    if (path.find("big") == std::string::npos) continue;
+    const uchar* data = photo.pixels.data;
+    photo = Photo();
+    EXPECT_EQ(DecodePhoto(path).pixels.data, data) << path;
+  }
+  const std::string truncated = dir + "/t.tif";
+  std::filesystem::copy_file(dir + "/big.tif", truncated,
+                             std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::resize_file(truncated, std::filesystem::file_size(truncated) / 2);
+  std::string message;
+  EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(truncated); }, truncated, &message))
+      << message;
+}
+
 }  // namespace
 }  // namespace lumislab

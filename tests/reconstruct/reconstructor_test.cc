@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <thread>
 
 #include "core/error.h"
@@ -285,6 +287,45 @@ TEST(Reconstruct, NoiseWithinThePredictedFloor) {
                 r.samples_per_texel, rms, predicted, rms / predicted);
     EXPECT_LE(rms, 1.5 * predicted);
     EXPECT_GE(rms, 0.5 * predicted);
+  }
+}
+
+// No light: 16-bit photos whose brightest code lies below the near-black floor (4 codes) are
+// reported as such, with that code exactly (the largest stored code minus black over the
+// position's photos, from the decoded pixels); lit photos are not, and the code reported for
+// them is at least the floor (the check stops at the first row that reaches it). The dim
+// photos: the synthetic ones (at most ~40600 codes) divided by 20000.
+TEST(Reconstruct, NoLightBelowTheNearBlackFloor) {
+  SyntheticOptions o;
+  o.ext = ".png";
+  const SyntheticDataset s = MakeSyntheticDataset(FreshTestDir("no_light"), o);
+  const SlabInfo info = SlabInfo::FromDataset(s.dataset, kRes);
+  ReconstructOptions options;
+  options.resolution = kRes;
+  const double floor = options.merge.near_black_codes;
+  for (const int divisor : {1, 20000}) {
+    std::vector<DecodedPhoto> photos = DecodePosition(s.dataset, s.calibration, 0, 0);
+    double brightest = -1;
+    for (DecodedPhoto& p : photos) {
+      ASSERT_EQ(p.photo.pixels.depth(), CV_16U);
+      p.photo.pixels /= divisor;
+      double lo = 0, hi = 0;
+      cv::minMaxLoc(p.photo.pixels.reshape(1), &lo, &hi);
+      brightest = std::max(brightest, hi - p.photo.spec.black_level * p.photo.CodeMax());
+    }
+    ASSERT_EQ(brightest<floor, divisor> 1);  // the photos are as dim as meant
+    PositionReport r;
+    ReconstructDecoded(s.dataset, s.calibration, info, 0, 0, photos, options, &r);
+    std::printf("photos / %d: brightest %.0f codes above black, reported %.0f, no light %d\n",
+                divisor, brightest, r.brightest_codes, int(r.no_light));
+    if (brightest < floor) {
+      EXPECT_TRUE(r.no_light);
+      EXPECT_EQ(r.brightest_codes, brightest);
+    } else {
+      EXPECT_FALSE(r.no_light);
+      EXPECT_GE(r.brightest_codes, floor);
+      EXPECT_LE(r.brightest_codes, brightest);
+    }
   }
 }
 

@@ -148,8 +148,9 @@ class Renderer {
     Eigen::Vector2d centre;
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the map texels drawn: [x0, x1) x [y0, y1)
   };
-  // The job for position l's own map: the whole map, or its rectangle (shadow_scissor).
-  ShadowJob OwnShadowJob(int l) const;
+  // The map position l's light reads (its own, or with sharing its block's, in the layer
+  // shadow_layer_ names): whole, or without the shortcuts its rectangle (shadow_scissor).
+  ShadowJob ShadowJobFor(int l) const;
   // Clears and draws the maps (shadow_valid_ is the caller's).
   void RenderShadowMaps(const std::vector<ShadowJob>& jobs);
   void ChooseShadowGroups();

@@ -15,16 +15,6 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The largest of row y's stored codes (every channel): a plain loop that vectorises.
-template <typename T>
-T RowMaxCode(const cv::Mat& pixels, int y) {
-  const T* row = pixels.ptr<T>(y);
-  const size_t n = size_t(pixels.cols) * pixels.channels();
-  T m = 0;
-  for (size_t k = 0; k < n; ++k) m = std::max(m, row[k]);
-  return m;
-}
-
 // Where every photo is an integer one read through a linear transfer (so that a code step is the
 // near-black floor's unit, docs/design.md §3.5.1): the brightest stored code of the photos above
 // their black level, in code steps, if it lies below `floor`; else the first row maximum met at
@@ -42,8 +32,8 @@ double BrightestCodesBelow(const std::vector<DecodedPhoto>& photos, double floor
     const cv::Mat& m = p.photo.pixels;
     const double black = p.photo.spec.black_level * p.photo.CodeMax();
     for (int y = 0; y < m.rows; ++y) {
-      const double hi = m.depth() == CV_8U ? double(RowMaxCode<uint8_t>(m, y))
-                                           : double(RowMaxCode<uint16_t>(m, y));
+      double hi = 0;
+      cv::minMaxLoc(m.row(y).reshape(1), nullptr, &hi);
       brightest = std::max(brightest, hi - black);
       if (brightest >= floor) return brightest;
     }

@@ -199,8 +199,9 @@ int Run(int argc, char** argv) {
           move_error = std::max(move_error, CompareImages(on.Read(), off.Read()).relative_l2);
         }
         if (profile) {
-          std::printf("  on: depth range of the maps %.0f .. %.0f mm\n", on.shortcuts().z_min,
-                      on.shortcuts().z_max);
+          std::printf(
+              "  on: depth range of the maps %.0f .. %.0f mm; tiles list %.0f %% of the lights\n",
+              on.shortcuts().z_min, on.shortcuts().z_max, 100 * on.ListedLightFraction());
           for (int k = 0; k < 2; ++k) {
             std::printf(
                 "  %s phases (ms): camera move: G-buffer %.1f light %.1f; full: shadow maps %.1f "

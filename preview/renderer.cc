@@ -190,6 +190,14 @@ layout(location = 2) out vec4 o_irradiance;  // the sum alone (before albedo), r
 layout(std430, binding = 0) buffer ExactCount { uint count; };
 layout(std430, binding = 1) buffer ExactList { uint exact_pixels[]; };
 #endif
+#if TILED
+// Light culling by tiles of kTile x kTile pixels (TileLists below): per tile, this pass's lights
+// whose E' can be non-zero at one of its pixels, [near count, far count, near ..., far ...] from
+// tile_lists[u_tile_stride * tile]; the far list is empty without the shortcuts.
+layout(std430, binding = 2) readonly buffer TileLightLists { uint tile_lists[]; };
+uniform int u_tiles_x;
+uniform int u_tile_stride;
+#endif
 #if EXACT_LIST
 layout(local_size_x = 64) in;
 layout(rgba32f, binding = 0) uniform image2D u_accumulation;  // float mode
@@ -238,49 +246,72 @@ bool Dark(vec3 x) {
   return x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
 }
 
-// The sum over this pass's lights at surface point x (normal n), luminaire frame.
-vec3 ShadeLights(vec3 x, vec3 n) {
+// The sum over this pass's lights at surface point x (normal n), luminaire frame. Every c_ij
+// lies at z = 0, so what depends on x alone is computed once: rel.z = x.z for every light, the
+// point's projection through the window st = c + (x.xy - c) d / z = x.xy d / z + c (1 - d / z)
+// is linear in c, and cos_emit cos_recv / delta^2 = z (n . (c - x)) / delta^4 needs no root.
+vec3 ShadeLights(vec3 x, vec3 n, ivec2 pixel) {
   vec3 sum = vec3(0.0);
+  if (x.z <= 0.0) return sum;  // behind S: no light reaches it
+  const float s = u_d / x.z;
+  const vec2 uv_x = vec2(0.5, 0.5) + x.xy * s / vec2(u_window.x, -u_window.y);
+  const vec2 uv_c = (1.0 - s) / vec2(u_window.x, -u_window.y);  // per mm of c
+  const float n_dot_x = dot(n, x);
+  const float z2 = x.z * x.z;
+  const float z_scaled = x.z * 1.0e6;
 #if FAST
   const bool far = x.z >= u_z_far;
+#endif
+#if TILED
+  // The loop runs over the tile's list: the same count for the pixels shaded side by side (a
+  // skipped light would add E' = 0, so the sum is the same bit for bit).
+  const int base = ((pixel.y / TILE) * u_tiles_x + pixel.x / TILE) * u_tile_stride;
+  const int near_count = int(tile_lists[base]);
+#if FAST
+  const int first = base + 2 + (far ? near_count : 0);
+  const int last = first + (far ? int(tile_lists[base + 1]) : near_count);
+#else
+  const int first = base + 2, last = first + near_count;
+#endif
+  for (int i = first; i < last; ++i) {
+    const int k = int(tile_lists[i]);
+#elif FAST
   const int first = far ? u_far_begin : 0;
   const int last = far ? u_count : u_near_end;
   for (int k = first; k < last; ++k) {
 #else
   for (int k = 0; k < u_count; ++k) {
 #endif
-    vec3 rel = x - vec3(u_centres[k], 0.0);
-    if (rel.z <= 0.0) continue;
-    float delta = length(rel);
-    float cos_emit = rel.z / delta;
-    float cos_recv = -dot(n, rel) / delta;
-    if (cos_recv <= 0.0) continue;
-    vec2 st = u_centres[k] + rel.xy * (u_d / rel.z);
-    if (abs(st.x) > 0.5 * u_window.x || abs(st.y) > 0.5 * u_window.y) continue;
-    vec2 uv = vec2(st.x / u_window.x + 0.5, 0.5 - st.y / u_window.y);
+    const vec2 c = u_centres[k];
+    const float recv = dot(n.xy, c) - n_dot_x;  // -n . rel, rel = x - c: delta cos_recv
+    if (recv <= 0.0) continue;
+    const vec2 uv = uv_x + c * uv_c;
+    if (any(greaterThan(abs(uv - 0.5), vec2(0.5)))) continue;
+    const vec2 rxy = x.xy - c;
+    const float delta2 = dot(rxy, rxy) + z2;
     float visible = 1.0;
 #if SHADOWS
     {
+      // The map's coordinates of the offset point p, linear in the map's centre as uv above.
+      const vec3 p = x + n * (u_offset_scale * sqrt(delta2));
+      const float inverse_z = 1.0 / p.z;
+      const vec2 map_p = vec2(0.5, 0.5) + p.xy * (u_d * inverse_z) / vec2(u_window.x, -u_window.y);
+      const vec2 map_c = (1.0 - u_d * inverse_z) / vec2(u_window.x, -u_window.y);
+      const float depth = 0.5 * (u_depth.x + u_depth.y * inverse_z) + 0.5;
 #if FAST
       visible = 0.0;
       const int begin = u_shadow_span[k].x, end = begin + u_shadow_span[k].y;
-      for (int m = begin; m < end; ++m) {
-        vec4 clip = LightClip(x + n * (u_offset_scale * delta), u_shadow_centres[m]);
-        vec3 ndc = clip.xyz / clip.w;
-        visible += texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_shadow_layers[m]),
-                                          0.5 * ndc.z + 0.5));
-      }
+      for (int m = begin; m < end; ++m)
+        visible += texture(u_shadow, vec4(map_p + u_shadow_centres[m] * map_c,
+                                          float(u_shadow_layers[m]), depth));
       if (u_shadow_span[k].y > 1) visible /= float(u_shadow_span[k].y);
 #else
-      vec4 clip = LightClip(x + n * (u_offset_scale * delta), u_centres[k]);
-      vec3 ndc = clip.xyz / clip.w;
-      visible = texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_layers[k]),
-                                       0.5 * ndc.z + 0.5));
+      visible = texture(u_shadow, vec4(map_p + c * map_c, float(u_layers[k]), depth));
 #endif
     }
 #endif
     vec3 intensity = SampleIntensity(uv, u_layers[k]);
-    sum += visible * intensity * (cos_emit * cos_recv / (delta * delta) * 1.0e6);
+    sum += visible * intensity * (z_scaled * recv / (delta2 * delta2));
   }
   return sum;
 }
@@ -347,7 +378,7 @@ void main() {
   if (k >= count) return;
   const ivec2 pixel = ivec2(exact_pixels[k] & 0xffffu, exact_pixels[k] >> 16);
   const vec3 sum = ShadeLights(texelFetch(u_gbuffer_position, pixel, 0).xyz,
-                               texelFetch(u_gbuffer_normal, pixel, 0).xyz);
+                               texelFetch(u_gbuffer_normal, pixel, 0).xyz, pixel);
   imageStore(u_irradiance, pixel, imageLoad(u_irradiance, pixel) + vec4(sum, 0.0));
   const vec3 radiance = Radiance(sum, pixel);
 #if SRGBE
@@ -367,7 +398,8 @@ void main() {
     o_coarse = vec4(0.0);
     return;
   }
-  o_coarse = vec4(ShadeLights(surface.xyz, texelFetch(u_gbuffer_normal, pixel, 0).xyz), 1.0);
+  o_coarse =
+      vec4(ShadeLights(surface.xyz, texelFetch(u_gbuffer_normal, pixel, 0).xyz, pixel), 1.0);
 #else
   const ivec2 pixel = ivec2(gl_FragCoord.xy);
   const vec4 surface = texelFetch(u_gbuffer_position, pixel, 0);
@@ -395,7 +427,7 @@ void main() {
     sum = vec3(0.0);  // sRGBE: the previous sum is carried, the compute pass adds to it
   }
 #else
-  sum = ShadeLights(x, n);
+  sum = ShadeLights(x, n, pixel);
 #endif
   const vec3 radiance = Radiance(sum, pixel);
   o_float = vec4(radiance, 1.0);
@@ -409,6 +441,79 @@ void main() {
 #endif
 }
 #endif
+)";
+
+// Light culling by tiles (RenderOptions::tiled_lights). A point x (z > 0) is seen from centre c
+// through the window at st = c + (x.xy - c) d / z = a + c t, with a = x.xy d / z and
+// t = 1 - d / z; TileBounds keeps, per tile of the G-buffer, the ranges of a and t over its
+// points (once per view), and TileLists, per light pass, lists the lights whose E' support can
+// meet a + c t over those ranges. llvmpipe runs a branch's both sides masked, so a light is
+// saved only by leaving it out of the loop; a tile's pixels share one list.
+constexpr int kTile = 16;
+const std::string kTileBoundsCompute = R"(#version 450 core
+layout(local_size_x = 64) in;
+uniform sampler2D u_gbuffer_position;
+uniform float u_d;
+uniform ivec2 u_tiles;
+// Per tile: (a.x, a.y, t) smallest, then largest; smallest > largest where no point has z > 0.
+layout(std430, binding = 3) writeonly buffer TileBounds { vec4 tile_bounds[]; };
+void main() {
+  const int tile = int(gl_GlobalInvocationID.x);
+  if (tile >= u_tiles.x * u_tiles.y) return;
+  const ivec2 origin = TILE * ivec2(tile % u_tiles.x, tile / u_tiles.x);
+  const ivec2 last = textureSize(u_gbuffer_position, 0) - 1;
+  vec3 lo = vec3(3.0e38), hi = vec3(-3.0e38);
+  for (int y = 0; y < TILE; ++y)
+    for (int x = 0; x < TILE; ++x) {
+      // Clamped to the image: an edge tile repeats its own last pixels.
+      const vec4 p = texelFetch(u_gbuffer_position, min(origin + ivec2(x, y), last), 0);
+      if (p.w == 0.0 || p.z <= 0.0) continue;
+      const float s = u_d / p.z;
+      const vec3 v = vec3(p.xy * s, 1.0 - s);
+      lo = min(lo, v);
+      hi = max(hi, v);
+    }
+  tile_bounds[2 * tile] = vec4(lo, 0.0);
+  tile_bounds[2 * tile + 1] = vec4(hi, 0.0);
+}
+)";
+const std::string kTileListsCompute = R"(#version 450 core
+layout(local_size_x = 64) in;
+uniform int u_tile_count;
+uniform int u_tile_stride;
+uniform int u_count;
+uniform int u_near_end;   // lights [0, u_near_end) go to the near list
+uniform int u_far_begin;  // lights [u_far_begin, u_count) to the far list
+uniform vec2 u_centres[LIGHTS_PER_PASS];
+// Where each light's E' may be non-zero, in window coordinates (mm): st.x in [x, z], st.y in
+// [y, w] (the support widened by the filter's reach and a margin for rounding).
+uniform vec4 u_support[LIGHTS_PER_PASS];
+layout(std430, binding = 3) readonly buffer TileBounds { vec4 tile_bounds[]; };
+layout(std430, binding = 2) writeonly buffer TileLightLists { uint tile_lists[]; };
+bool Reaches(int k, vec3 lo, vec3 hi) {
+  const vec2 c_lo = u_centres[k] * lo.z, c_hi = u_centres[k] * hi.z;  // c t at the ends of t
+  const vec2 st_lo = lo.xy + min(c_lo, c_hi), st_hi = hi.xy + max(c_lo, c_hi);
+  return all(lessThanEqual(st_lo, u_support[k].zw)) &&
+         all(greaterThanEqual(st_hi, u_support[k].xy));
+}
+void main() {
+  const int tile = int(gl_GlobalInvocationID.x);
+  if (tile >= u_tile_count) return;
+  const vec3 lo = tile_bounds[2 * tile].xyz, hi = tile_bounds[2 * tile + 1].xyz;
+  const int base = tile * u_tile_stride;
+  int n = 0;
+  if (lo.z <= hi.z) {
+    for (int k = 0; k < u_near_end; ++k)
+      if (Reaches(k, lo, hi)) tile_lists[base + 2 + n++] = uint(k);
+  }
+  const int near_count = n;
+  if (lo.z <= hi.z) {
+    for (int k = u_far_begin; k < u_count; ++k)
+      if (Reaches(k, lo, hi)) tile_lists[base + 2 + n++] = uint(k);
+  }
+  tile_lists[base] = uint(near_count);
+  tile_lists[base + 1] = uint(n - near_count);
+}
 )";
 
 // The G-buffer: what each pixel sees, in the luminaire frame (redrawn when the view, the scene or
@@ -500,10 +605,13 @@ GLint Loc(GLuint program, const char* name) { return glGetUniformLocation(progra
 // The light pass's fragment shader, its options compiled in: llvmpipe runs both sides of a
 // branch on a uniform, masked, so a run-time switch costs its untaken side in every light
 // iteration (the cubic filter's 16 texel reads: a third of the light pass, measured).
-std::string LightFragment(const std::string& defines) {
-  std::string f = kLightFragment;
+std::string WithDefines(const std::string& source, const std::string& defines) {
+  std::string f = source;
   f.insert(f.find('\n') + 1, defines);
   return f;
+}
+std::string LightFragment(const std::string& defines) {
+  return WithDefines(kLightFragment, defines);
 }
 
 }  // namespace
@@ -525,6 +633,10 @@ struct Renderer::Gl {
   // The lights' sum before albedo (o_irradiance) of the present view, and the last view shaded
   // in full: its sums, positions and normals (what reprojection reuses).
   GLuint irradiance = 0, source[3] = {0, 0, 0};
+  // Light culling by tiles: the tiles' bounds (per view) and light lists (per light pass), and
+  // the programs that make them (the lists' by lights per pass).
+  GLuint tile_bounds = 0, tile_lists = 0, tile_bounds_program = 0;
+  std::map<int, GLuint> tile_list_programs;
 };
 
 Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options)
@@ -595,6 +707,8 @@ Renderer::~Renderer() {
   glDeleteFramebuffers(1, &gl_->coarse_fbo);
   glDeleteBuffers(1, &gl_->exact_count);
   glDeleteBuffers(1, &gl_->exact_list);
+  glDeleteBuffers(1, &gl_->tile_bounds);
+  glDeleteBuffers(1, &gl_->tile_lists);
   GLuint textures[] = {gl_->intensity,  gl_->shadow,   gl_->colour,     gl_->packed[0],
                        gl_->packed[1],  gl_->depth,    gl_->gbuffer[0], gl_->gbuffer[1],
                        gl_->gbuffer[2], gl_->coarse,   gl_->irradiance, gl_->source[0],
@@ -604,7 +718,9 @@ Renderer::~Renderer() {
   glDeleteVertexArrays(1, &gl_->vao);
   glDeleteVertexArrays(1, &gl_->quad_vao);
   for (const auto& [defines, program] : gl_->light_programs) glDeleteProgram(program);
-  for (GLuint p : {gl_->geometry_program, gl_->shadow_program, gl_->display_program}) {
+  for (const auto& [lights, program] : gl_->tile_list_programs) glDeleteProgram(program);
+  for (GLuint p : {gl_->geometry_program, gl_->shadow_program, gl_->display_program,
+                   gl_->tile_bounds_program}) {
     glDeleteProgram(p);
   }
   delete gl_;
@@ -616,6 +732,8 @@ void Renderer::AllocateTargets() {
     glDeleteFramebuffers(1, &gl_->gbuffer_fbo);
     glDeleteFramebuffers(1, &gl_->coarse_fbo);
     glDeleteBuffers(1, &gl_->exact_list);
+    glDeleteBuffers(1, &gl_->tile_bounds);
+    glDeleteBuffers(1, &gl_->tile_lists);
     GLuint textures[] = {gl_->colour,     gl_->packed[0],  gl_->packed[1],  gl_->depth,
                          gl_->gbuffer[0], gl_->gbuffer[1], gl_->gbuffer[2], gl_->coarse,
                          gl_->irradiance, gl_->source[0],  gl_->source[1],  gl_->source[2]};
@@ -661,6 +779,14 @@ void Renderer::AllocateTargets() {
   reproject_next_ = true;
   glCreateBuffers(1, &gl_->exact_list);
   glNamedBufferStorage(gl_->exact_list, GLsizeiptr(width_) * height_ * sizeof(GLuint), nullptr, 0);
+  const GLsizeiptr tiles =
+      GLsizeiptr((width_ + kTile - 1) / kTile) * ((height_ + kTile - 1) / kTile);
+  glCreateBuffers(1, &gl_->tile_bounds);
+  glNamedBufferStorage(gl_->tile_bounds, tiles * 8 * sizeof(GLfloat), nullptr, 0);
+  glCreateBuffers(1, &gl_->tile_lists);
+  glNamedBufferStorage(gl_->tile_lists, tiles * (2 + 2 * kFastLightsPerPass) * sizeof(GLuint),
+                       nullptr, 0);
+  tile_bounds_valid_ = false;
   glGenFramebuffers(2, gl_->fbo);
   for (int k = 0; k < 2; ++k) {
     glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo[k]);
@@ -1073,6 +1199,7 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
     e.layer = l;
     e.shadow_centre = shadow_centre_[l];
     e.shadow_layer = shadow_layer_[l];
+    e.support = support_[l];
     return e;
   };
   std::vector<LightEntry> near_only, both, far_only;
@@ -1110,6 +1237,14 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
         e.shadow_layer = shadow_layer_[nearest];
         e.span_begin = int(near_only.size());  // the members follow at this index
         e.span_count = int(members.size());
+        // The summed texture's support: the members' (their rectangles' bounding box).
+        e.support = {info_.layout.res_x, info_.layout.res_y, 0, 0};
+        for (int l : members) {
+          const std::array<int, 4>& m = support_[l];
+          if (m[0] >= m[2] || m[1] >= m[3]) continue;
+          e.support = {std::min(e.support[0], m[0]), std::min(e.support[1], m[1]),
+                       std::max(e.support[2], m[2]), std::max(e.support[3], m[3])};
+        }
         far_only.push_back(e);
         z_far = std::max(z_far, merged_z_[group] / options_.merge_error);
         for (int l : members) {
@@ -1143,6 +1278,78 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
   }
 }
 
+void Renderer::TileLists(int lights_per_pass, const float* centres,
+                         const std::vector<std::array<int, 4>>& supports, int near_end,
+                         int far_begin) {
+  const int tiles_x = (width_ + kTile - 1) / kTile, tiles_y = (height_ + kTile - 1) / kTile;
+  const int count = int(supports.size());
+  if (!tile_bounds_valid_) {
+    if (!gl_->tile_bounds_program) {
+      gl_->tile_bounds_program = LinkCompute(
+          WithDefines(kTileBoundsCompute, "#define TILE " + std::to_string(kTile) + "\n"));
+    }
+    const GLuint p = gl_->tile_bounds_program;
+    glUseProgram(p);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, gl_->gbuffer[0]);
+    glUniform1i(Loc(p, "u_gbuffer_position"), 3);
+    glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
+    glUniform2i(Loc(p, "u_tiles"), tiles_x, tiles_y);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, gl_->tile_bounds);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);  // the G-buffer drawn before
+    glDispatchCompute(GLuint(tiles_x * tiles_y + 63) / 64, 1, 1);
+    glActiveTexture(GL_TEXTURE0);
+    tile_bounds_valid_ = true;
+  }
+  GLuint& p = gl_->tile_list_programs[lights_per_pass];
+  if (!p) {
+    p = LinkCompute(WithDefines(
+        kTileListsCompute, "#define LIGHTS_PER_PASS " + std::to_string(lights_per_pass) + "\n"));
+  }
+  // Each light's support in window coordinates (mm), widened by 3 texels: the cubic filter
+  // reads 2 texels beyond a point, the bilinear 1, and 1 more for rounding. A light whose E' is
+  // 0 everywhere is in no list.
+  const double w = info_.layout.window_w_mm, h = info_.layout.window_h_mm;
+  const double rx = info_.layout.res_x, ry = info_.layout.res_y, pad = 3;
+  std::vector<float> windows;
+  for (const std::array<int, 4>& s : supports) {
+    if (s[0] >= s[2] || s[1] >= s[3]) {
+      windows.insert(windows.end(), {1, 1, -1, -1});
+      continue;
+    }
+    windows.insert(windows.end(),
+                   {float(((s[0] - pad) / rx - 0.5) * w), float((0.5 - (s[3] + pad) / ry) * h),
+                    float(((s[2] + pad) / rx - 0.5) * w), float((0.5 - (s[1] - pad) / ry) * h)});
+  }
+  tile_stride_ = 2 + near_end + (count - far_begin);
+  tile_list_lights_ = tile_stride_ - 2;
+  glUseProgram(p);
+  glUniform1i(Loc(p, "u_tile_count"), tiles_x * tiles_y);
+  glUniform1i(Loc(p, "u_tile_stride"), tile_stride_);
+  glUniform1i(Loc(p, "u_count"), count);
+  glUniform1i(Loc(p, "u_near_end"), near_end);
+  glUniform1i(Loc(p, "u_far_begin"), far_begin);
+  glUniform2fv(Loc(p, "u_centres"), count, centres);
+  glUniform4fv(Loc(p, "u_support"), count, windows.data());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, gl_->tile_bounds);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, gl_->tile_lists);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  glDispatchCompute(GLuint(tiles_x * tiles_y + 63) / 64, 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+double Renderer::ListedLightFraction() const {
+  if (!options_.tiled_lights || tile_list_lights_ == 0) return 1;
+  const int tiles = ((width_ + kTile - 1) / kTile) * ((height_ + kTile - 1) / kTile);
+  std::vector<GLuint> lists(size_t(tiles) * tile_stride_);
+  glGetNamedBufferSubData(gl_->tile_lists, 0, GLsizeiptr(lists.size() * sizeof(GLuint)),
+                          lists.data());
+  double listed = 0;
+  for (int t = 0; t < tiles; ++t)
+    listed += lists[size_t(t) * tile_stride_] + lists[size_t(t) * tile_stride_ + 1];
+  return listed / (double(tiles) * tile_list_lights_);
+}
+
 // Everything of a light pass but the lights: target, uniforms, textures.
 void Renderer::SetCommonUniforms(unsigned program, Shading shading) {
   const GLuint p = program;
@@ -1160,6 +1367,11 @@ void Renderer::SetCommonUniforms(unsigned program, Shading shading) {
   glUniform2f(Loc(p, "u_depth"), float(kShadowDepthA), float(kShadowDepthB));
   glUniform1f(Loc(p, "u_radiance_scale"), float(options_.radiance_scale));
   glUniform1i(Loc(p, "u_unit_albedo"), options_.unit_albedo ? 1 : 0);
+  if (options_.tiled_lights) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, gl_->tile_lists);
+    glUniform1i(Loc(p, "u_tiles_x"), (width_ + kTile - 1) / kTile);
+    glUniform1i(Loc(p, "u_tile_stride"), tile_stride_);
+  }
   const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);
   glUniform2f(Loc(p, "u_grid_half"), float(corner.x()), float(corner.y()));
   // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.
@@ -1224,7 +1436,8 @@ unsigned Renderer::LightProgram(bool fast, Shading shading) {
       "\n#define COARSE " + std::to_string(shading == Shading::kCoarse) + "\n#define RESOLVE " +
       std::to_string(shading == Shading::kResolve) + "\n#define EXACT_LIST " +
       std::to_string(shading == Shading::kExactList) + "\n#define REPROJECT " +
-      std::to_string(shading == Shading::kReproject) + "\n";
+      std::to_string(shading == Shading::kReproject) + "\n#define TILED " +
+      std::to_string(options_.tiled_lights) + "\n#define TILE " + std::to_string(kTile) + "\n";
   GLuint& program = gl_->light_programs[defines];
   if (!program) {
     program = shading == Shading::kExactList ? LinkCompute(LightFragment(defines))
@@ -1236,13 +1449,17 @@ unsigned Renderer::LightProgram(bool fast, Shading shading) {
 void Renderer::LightPass(const std::vector<int>& lights) {
   float centres[2 * kLightsPerPass];
   int layers[kLightsPerPass];
+  std::vector<std::array<int, 4>> supports;
   for (size_t k = 0; k < lights.size(); ++k) {
     const int l = lights[k];
     const Eigen::Vector2d c = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
     centres[2 * k] = float(c.x());
     centres[2 * k + 1] = float(c.y());
     layers[k] = l;
+    supports.push_back(support_[l]);
   }
+  const int n = int(lights.size());
+  if (options_.tiled_lights) TileLists(kLightsPerPass, centres, supports, n, n);
   for (Shading shading : ShadingPasses(int(lights.size()))) {
     const GLuint p = LightProgram(false, shading);
     SetCommonUniforms(p, shading);
@@ -1259,8 +1476,10 @@ void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_en
   int layers[kFastLightsPerPass], shadow_layers[kFastLightsPerPass];
   int spans[2 * kFastLightsPerPass];
   const GLsizei n = GLsizei(entries.size());
+  std::vector<std::array<int, 4>> supports;
   for (size_t k = 0; k < entries.size(); ++k) {
     const LightEntry& e = entries[k];
+    supports.push_back(e.support);
     centres[2 * k] = float(e.centre.x());
     centres[2 * k + 1] = float(e.centre.y());
     shadow_centres[2 * k] = float(e.shadow_centre.x());
@@ -1270,6 +1489,7 @@ void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_en
     spans[2 * k] = e.span_begin < 0 ? int(k) : e.span_begin;
     spans[2 * k + 1] = e.span_count;
   }
+  if (options_.tiled_lights) TileLists(kFastLightsPerPass, centres, supports, near_end, far_begin);
   for (Shading shading : ShadingPasses(n)) {
     const GLuint p = LightProgram(true, shading);
     SetCommonUniforms(p, shading);
@@ -1451,6 +1671,7 @@ int Renderer::Render() {
     drawn_view_projection_ = view_projection_;
     accumulated_.assign(accumulated_.size(), false);
     view_valid_ = true;
+    tile_bounds_valid_ = false;
     lap(&times_.depth_ms);
     const bool source_lit =
         std::find(source_lights_.begin(), source_lights_.end(), true) != source_lights_.end();

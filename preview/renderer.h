@@ -74,6 +74,10 @@ struct RenderOptions {
   // ARB_shader_viewport_layer_array (false: one draw per map, as without it). Fixed when the
   // renderer is created.
   bool layered_shadow_maps = true;
+  // Light culling by tiles: each tile of 16 x 16 pixels shades only the lights whose E' can be
+  // non-zero at one of its pixels (a light left out adds E' = 0: the same image bit for bit). Off
+  // only to check that.
+  bool tiled_lights = true;
   // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
   bool time_phases = false;
 };
@@ -128,6 +132,9 @@ class Renderer {
   // Shadow-map texels drawn so far (the scissor rectangles' areas).
   long long ShadowTexelsDrawn() const { return shadow_texels_; }
   const PhaseTimes& phase_times() const { return times_; }
+  // The last light pass with tiled_lights: the lights listed per tile, as a fraction of the
+  // pass's lights times the tiles (1 without tiled_lights).
+  double ListedLightFraction() const;
   const ShortcutState& shortcuts() const { return state_; }
   // The accumulated image (radiance or irradiance, W/m^2 [/sr]), 3 channels, row 0 on top.
   ImageF Read() const;
@@ -139,7 +146,8 @@ class Renderer {
   struct LightEntry {
     Eigen::Vector2d centre, shadow_centre;
     int layer = 0, shadow_layer = 0;
-    int span_begin = -1, span_count = 1;  // merged: its members' entries (shadows averaged)
+    int span_begin = -1, span_count = 1;     // merged: its members' entries (shadows averaged)
+    std::array<int, 4> support{0, 0, 0, 0};  // slab texels where its E' is not 0 (support_)
   };
   bool Fast() const { return options_.shadow_share_texels > 0 || options_.merge_group > 1; }
   // One shadow map: its layer, seen from centre (a position's, or a shared map's block mean).
@@ -164,6 +172,10 @@ class Renderer {
   // The passes that shade `lights` lights at the present options.
   std::vector<Shading> ShadingPasses(int lights) const;
   void SetCommonUniforms(unsigned program, Shading shading);
+  // The light lists of the tiles for one pass's lights (centres: x, y per light; near_end and
+  // far_begin as FastLightPass's), after the tiles' bounds if the G-buffer changed.
+  void TileLists(int lights_per_pass, const float* centres,
+                 const std::vector<std::array<int, 4>>& supports, int near_end, int far_begin);
   // The light program for the present options (fast: the shortcuts'), linked when first used.
   unsigned LightProgram(bool fast, Shading shading = Shading::kExact);
   void DrawLightPass(Shading shading);
@@ -191,7 +203,10 @@ class Renderer {
   std::vector<bool> source_lights_;
   bool view_shaded_in_full_ = false, source_valid_ = false, reproject_next_ = true;
   bool list_only_ = false;
-  unsigned exact_listed_ = 0;  // pixels the last RESOLVE or REPROJECT pass listed
+  unsigned exact_listed_ = 0;       // pixels the last RESOLVE or REPROJECT pass listed
+  bool tile_bounds_valid_ = false;  // the tiles' bounds are of the present G-buffer
+  int tile_stride_ = 0;             // uints per tile in the light lists
+  int tile_list_lights_ = 0;        // the last lists' lights (near and far)
   int shadow_renders_ = 0;
   long long shadow_texels_ = 0;
   int ping_ = 0;  // sRGBE: which of the two targets holds the current sum

@@ -138,6 +138,31 @@ class PreviewSlabFiles : public ::testing::Test {
       r.SetPosition(i, j, ReadIntensity(dir_.string(), info_, i, j));
     }
   }
+  // Renders one view with both renderers (uploading the positions into one still empty) and
+  // expects their images equal bit for bit and not black.
+  void ExpectSameImage(Renderer& a, Renderer& b, const SceneSetup& view,
+                       const std::vector<std::pair<int, int>>& positions, const std::string& what) {
+    for (Renderer* r : {&a, &b}) {
+      if (r->PositionCount() == 0) Upload(*r, positions);
+      r->SetCamera(OrbitCamera(view, 1.0));
+      r->Render();
+    }
+    const ImageF image_a = a.Read(), image_b = b.Read();
+    double norm = 0;
+    for (float v : image_b.data) norm += v;
+    EXPECT_GT(norm, 0) << what;
+    EXPECT_EQ(image_a.data, image_b.data) << what;
+  }
+  // E' with only a 3 x 3 patch at the centre of the texture left of `full` (a narrower support).
+  static ImageF CentrePatch(const ImageF& full) {
+    ImageF patch(full.width, full.height, 3);
+    for (int y = full.height / 2; y < full.height / 2 + 3; ++y) {
+      for (int x = full.width / 2; x < full.width / 2 + 3; ++x) {
+        for (int c = 0; c < 3; ++c) patch.at(x, y, c) = full.at(x, y, c);
+      }
+    }
+    return patch;
+  }
   static double RelativeDifference(const ImageF& a, const ImageF& b) {
     double diff2 = 0, norm2 = 0;
     for (size_t k = 0; k < a.data.size(); ++k) {
@@ -345,16 +370,8 @@ TEST_F(PreviewSlabFiles, ShadowScissorKeepsTheImageBitForBit) {
     SceneSetup view = setup;
     for (double yaw : {0.0, 8.0}) {
       view.camera_yaw_deg = setup.camera_yaw_deg + yaw;
-      for (Renderer* r : {scissored.get(), whole.get()}) {
-        if (r->PositionCount() == 0) Upload(*r, positions);
-        r->SetCamera(OrbitCamera(view, 1.0));
-        r->Render();
-      }
-      const ImageF a = scissored->Read(), b = whole->Read();
-      double norm = 0;
-      for (float v : b.data) norm += v;
-      EXPECT_GT(norm, 0);
-      EXPECT_EQ(a.data, b.data) << "sRGBE " << srgbe << ", yaw " << yaw;
+      ExpectSameImage(*scissored, *whole, view, positions,
+                      "sRGBE " + std::to_string(srgbe) + ", yaw " + std::to_string(yaw));
     }
     std::printf("shadow scissor: %lld of %lld map texels drawn\n", scissored->ShadowTexelsDrawn(),
                 whole->ShadowTexelsDrawn());
@@ -367,18 +384,71 @@ TEST_F(PreviewSlabFiles, ShadowScissorKeepsTheImageBitForBit) {
   Upload(*live, positions);
   const int i = info_.grid.nu / 2, j = info_.grid.nv / 2;
   const ImageF full = ReadIntensity(dir_.string(), info_, i, j);
-  ImageF patch(full.width, full.height, 3);
-  for (int y = full.height / 2; y < full.height / 2 + 3; ++y) {
-    for (int x = full.width / 2; x < full.width / 2 + 3; ++x) {
-      for (int c = 0; c < 3; ++c) patch.at(x, y, c) = full.at(x, y, c);
-    }
-  }
+  const ImageF patch = CentrePatch(full);
   live->SetPosition(i, j, patch);
   live->Render();
   const int renders = live->ShadowMapRenders();
   live->SetPosition(i, j, full);
   live->Render();
   EXPECT_EQ(live->ShadowMapRenders(), renders + 1);  // that map, wider
+  Upload(*fresh, positions);
+  fresh->Render();
+  EXPECT_EQ(live->Read().data, fresh->Read().data);
+}
+
+// Light culling by tiles leaves a light out only where its E' is 0: the same image bit for bit,
+// with every shortcut (merged lights have their own lists, coarse shading and reprojection shade
+// their listed pixels through the tiles' lists) and without, in float and sRGBE.
+TEST_F(PreviewSlabFiles, TiledLightsKeepTheImageBitForBit) {
+  const SceneSetup setup = MakeSceneSetup("crypt", info_);
+  const auto positions = ScanSlabPositions(dir_.string(), info_);
+  for (bool fast : {false, true}) {
+    for (bool srgbe : {false, true}) {
+      RenderOptions on;
+      on.shadow_cull = true;
+      on.shadow_pcf = true;
+      on.srgbe = srgbe;
+      on.texture_filter = srgbe ? TextureFilter::kCubic : TextureFilter::kBilinear;
+      if (fast) {
+        on.merge_group = 2;
+        on.merge_error = 0.05;
+        on.shadows = srgbe;  // merged lights with and without their members' shadows
+        on.coarse_tolerance = 0.1;
+        on.reproject_tolerance = 0.1;
+      }
+      RenderOptions off = on;
+      off.tiled_lights = false;
+      auto tiled = MakeRenderer(on), untiled = MakeRenderer(off);
+      SceneSetup view = setup;
+      for (double yaw : {0.0, 3.0, 6.0}) {  // the later views reproject with the shortcuts
+        view.camera_yaw_deg = setup.camera_yaw_deg + yaw;
+        ExpectSameImage(*tiled, *untiled, view, positions,
+                        "shortcuts " + std::to_string(fast) + ", sRGBE " + std::to_string(srgbe) +
+                            ", yaw " + std::to_string(yaw));
+      }
+      if (fast) {
+        EXPECT_GT(tiled->shortcuts().merged_lights, 0);
+      }
+      // Culled: the crypt's tiles list ~60 % of the lights (corner positions light a corner).
+      const double listed = tiled->ListedLightFraction();
+      std::printf("tiled lights: %.1f %% of the lights listed per tile\n", 100 * listed);
+      EXPECT_GT(listed, 0.05);
+      EXPECT_LT(listed, 0.9);
+      EXPECT_EQ(untiled->ListedLightFraction(), 1);
+    }
+  }
+  // A position live: its lists follow its support when it is replaced by a wider E'.
+  RenderOptions options;
+  auto live = MakeRenderer(options), fresh = MakeRenderer(options);
+  Upload(*live, positions);
+  live->Render();
+  const int i = 0, j = 0;
+  const ImageF full = ReadIntensity(dir_.string(), info_, i, j);
+  const ImageF patch = CentrePatch(full);
+  live->SetPosition(i, j, patch);
+  live->Render();
+  live->SetPosition(i, j, full);
+  live->Render();
   Upload(*fresh, positions);
   fresh->Render();
   EXPECT_EQ(live->Read().data, fresh->Read().data);

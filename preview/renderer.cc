@@ -1546,8 +1546,10 @@ void Renderer::DrawLightPass(Shading shading) {
     glEnablei(GL_BLEND, 0);
     glBlendFunci(0, GL_ONE, GL_ONE);
   }
-  // The sums alone, kept only where reprojection reuses them.
-  const GLboolean keep = options_.reproject_tolerance > 0 ? GL_TRUE : GL_FALSE;
+  // The sums alone, kept only where reprojection will reuse them: in a view being shaded in full
+  // (a reprojected one never becomes a source).
+  const GLboolean keep =
+      options_.reproject_tolerance > 0 && view_shaded_in_full_ ? GL_TRUE : GL_FALSE;
   glColorMaski(2, keep, keep, keep, keep);
   glEnablei(GL_BLEND, 2);
   glBlendFunci(2, GL_ONE, GL_ONE);

@@ -399,6 +399,20 @@ void ReadPixels(const Exposure& e, int y, int x0, int pixels, float* __restrict 
   }
 }
 
+// `pixels` pixels of row y from x0 into uk through the exposure's reader above.
+void ReadRow(const Exposure& e, int y, int x0, int pixels, float* __restrict uk) {
+  if (e.linear_codes && e.source->pixels.depth() == CV_16U)
+    ReadLinear<uint16_t>(e, y, x0, pixels, uk);
+  else if (e.linear_codes)
+    ReadLinear<float>(e, y, x0, pixels, uk);
+  else if (!e.code_u.empty() && e.source->fractional_codes)
+    ReadFractionalCodes(e, y, x0, pixels, uk);
+  else if (!e.code_u.empty())
+    ReadCodes(e, y, x0, pixels, uk);
+  else
+    ReadPixels(e, y, x0, pixels, uk);
+}
+
 // The k-th smallest of n non-negative floats (k < n), the value std::nth_element would put at
 // k: their bit patterns order as unsigned integers, so two counting passes, over the upper 16
 // bits and then the lower 16 bits of the values in the upper bits' bin, find it (cheaper than
@@ -444,21 +458,8 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
     std::vector<float> u(order.size() * 3);  // NaN where clipped
     for (int y = stride / 2; y < h; y += stride)
       for (int x = stride / 2; x < w; x += stride) {
-        for (size_t k = 0; k < order.size(); ++k) {
-          const Exposure& e = exposures[order[k]];
-          float* uk = &u[k * 3];
-          if (!e.code_u.empty()) {  // the reader's values (all finite) through its table
-            if (e.source->fractional_codes)
-              ReadFractionalCodes(e, y, x, 1, uk);
-            else
-              ReadCodes(e, y, x, 1, uk);
-            continue;
-          }
-          float v[3];
-          bool c[3];
-          e.reader.Read(y, x, v, c);
-          for (int ch = 0; ch < 3; ++ch) uk[ch] = c[ch] ? kClipped : v[ch] * e.recorded;
-        }
+        for (size_t k = 0; k < order.size(); ++k)
+          ReadRow(exposures[order[k]], y, x, 1, &u[k * 3]);  // the values the merge reads
         for (size_t k = 0; k + 1 < order.size(); ++k)
           for (int ch = 0; ch < 3; ++ch) {
             // Well exposed in both (not clipped: NaN fails the tests), and well above the
@@ -976,17 +977,7 @@ struct MergeRows {
       const int pixels = std::min(kChunk / 3, xb - x0), m = 3 * pixels;
       for (size_t k = 0; k < exposures.size(); ++k) {
         const Exposure& e = exposures[k];
-        float* uk = u.data() + size_t(slot_of[k]) * kChunk;
-        if (e.linear_codes && e.source->pixels.depth() == CV_16U)
-          ReadLinear<uint16_t>(e, y, x0, pixels, uk);
-        else if (e.linear_codes)
-          ReadLinear<float>(e, y, x0, pixels, uk);
-        else if (!e.code_u.empty() && e.source->fractional_codes)
-          ReadFractionalCodes(e, y, x0, pixels, uk);
-        else if (!e.code_u.empty())
-          ReadCodes(e, y, x0, pixels, uk);
-        else
-          ReadPixels(e, y, x0, pixels, uk);
+        ReadRow(e, y, x0, pixels, u.data() + size_t(slot_of[k]) * kChunk);
       }
       for (int s = 0; s < 2; ++s) {
         const float* us = u.data() + size_t(first_slot[s]) * kChunk;

@@ -138,17 +138,18 @@ uniform sampler2D u_gbuffer_albedo;
 uniform sampler2DArray u_intensity;
 uniform sampler2DArrayShadow u_shadow;
 uniform int u_count;
-uniform vec2 u_centres[LIGHTS_PER_PASS];
-uniform int u_layers[LIGHTS_PER_PASS];
+// Light k of this pass: u_lights[k].xy its centre c, .zw the centre its shadow map was rendered
+// from; u_light_layers[k].x its E' layer, .y its shadow map's layer, .z and .w its shadow span
+// (below). Packed in vec4s: an array of vec2 or int may take a vec4 slot per element, and a
+// driver's uniform limit for compute shaders can be 2048 components (128 lights: 1024 here).
+uniform vec4 u_lights[LIGHTS_PER_PASS];
+uniform ivec4 u_light_layers[LIGHTS_PER_PASS];
 #if FAST
 // Shortcuts: each light's shadow map (a shared map lies in another layer and was rendered from
 // its block's centre); lights [0, u_near_end) shade receivers nearer than u_z_far, lights
 // [u_far_begin, u_count) the others (the merged lights replace their members there).
-// A merged light's visibility is the mean of its members' (entries u_shadow_span[k].x ..
-// + .y - 1; a single light: its own entry).
-uniform vec2 u_shadow_centres[LIGHTS_PER_PASS];
-uniform int u_shadow_layers[LIGHTS_PER_PASS];
-uniform ivec2 u_shadow_span[LIGHTS_PER_PASS];
+// A merged light's visibility is the mean of its members' (entries u_light_layers[k].z ..
+// + .w - 1; a single light: its own entry).
 uniform int u_near_end;
 uniform int u_far_begin;
 uniform float u_z_far;
@@ -282,7 +283,7 @@ vec3 ShadeLights(vec3 x, vec3 n, ivec2 pixel) {
 #else
   for (int k = 0; k < u_count; ++k) {
 #endif
-    const vec2 c = u_centres[k];
+    const vec2 c = u_lights[k].xy;
     const float recv = dot(n.xy, c) - n_dot_x;  // -n . rel, rel = x - c: delta cos_recv
     if (recv <= 0.0) continue;
     const vec2 uv = uv_x + c * uv_c;
@@ -300,17 +301,17 @@ vec3 ShadeLights(vec3 x, vec3 n, ivec2 pixel) {
       const float depth = 0.5 * (u_depth.x + u_depth.y * inverse_z) + 0.5;
 #if FAST
       visible = 0.0;
-      const int begin = u_shadow_span[k].x, end = begin + u_shadow_span[k].y;
+      const int begin = u_light_layers[k].z, end = begin + u_light_layers[k].w;
       for (int m = begin; m < end; ++m)
-        visible += texture(u_shadow, vec4(map_p + u_shadow_centres[m] * map_c,
-                                          float(u_shadow_layers[m]), depth));
-      if (u_shadow_span[k].y > 1) visible /= float(u_shadow_span[k].y);
+        visible += texture(u_shadow, vec4(map_p + u_lights[m].zw * map_c,
+                                          float(u_light_layers[m].y), depth));
+      if (u_light_layers[k].w > 1) visible /= float(u_light_layers[k].w);
 #else
-      visible = texture(u_shadow, vec4(map_p + c * map_c, float(u_layers[k]), depth));
+      visible = texture(u_shadow, vec4(map_p + c * map_c, float(u_light_layers[k].x), depth));
 #endif
     }
 #endif
-    vec3 intensity = SampleIntensity(uv, u_layers[k]);
+    vec3 intensity = SampleIntensity(uv, u_light_layers[k].x);
     sum += visible * intensity * (z_scaled * recv / (delta2 * delta2));
   }
   return sum;
@@ -484,14 +485,14 @@ uniform int u_tile_stride;
 uniform int u_count;
 uniform int u_near_end;   // lights [0, u_near_end) go to the near list
 uniform int u_far_begin;  // lights [u_far_begin, u_count) to the far list
-uniform vec2 u_centres[LIGHTS_PER_PASS];
+uniform vec4 u_lights[LIGHTS_PER_PASS];  // xy: the light's centre (as the light pass's)
 // Where each light's E' may be non-zero, in window coordinates (mm): st.x in [x, z], st.y in
 // [y, w] (the support widened by the filter's reach and a margin for rounding).
 uniform vec4 u_support[LIGHTS_PER_PASS];
 layout(std430, binding = 3) readonly buffer TileBounds { vec4 tile_bounds[]; };
 layout(std430, binding = 2) writeonly buffer TileLightLists { uint tile_lists[]; };
 bool Reaches(int k, vec3 lo, vec3 hi) {
-  const vec2 c_lo = u_centres[k] * lo.z, c_hi = u_centres[k] * hi.z;  // c t at the ends of t
+  const vec2 c_lo = u_lights[k].xy * lo.z, c_hi = u_lights[k].xy * hi.z;  // c t at t's ends
   const vec2 st_lo = lo.xy + min(c_lo, c_hi), st_hi = hi.xy + max(c_lo, c_hi);
   return all(lessThanEqual(st_lo, u_support[k].zw)) &&
          all(greaterThanEqual(st_hi, u_support[k].xy));
@@ -1278,7 +1279,7 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
   }
 }
 
-void Renderer::TileLists(int lights_per_pass, const float* centres,
+void Renderer::TileLists(int lights_per_pass, const float* lights,
                          const std::vector<std::array<int, 4>>& supports, int near_end,
                          int far_begin) {
   const int tiles_x = (width_ + kTile - 1) / kTile, tiles_y = (height_ + kTile - 1) / kTile;
@@ -1329,7 +1330,7 @@ void Renderer::TileLists(int lights_per_pass, const float* centres,
   glUniform1i(Loc(p, "u_count"), count);
   glUniform1i(Loc(p, "u_near_end"), near_end);
   glUniform1i(Loc(p, "u_far_begin"), far_begin);
-  glUniform2fv(Loc(p, "u_centres"), count, centres);
+  glUniform4fv(Loc(p, "u_lights"), count, lights);
   glUniform4fv(Loc(p, "u_support"), count, windows.data());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, gl_->tile_bounds);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, gl_->tile_lists);
@@ -1447,58 +1448,63 @@ unsigned Renderer::LightProgram(bool fast, Shading shading) {
 }
 
 void Renderer::LightPass(const std::vector<int>& lights) {
-  float centres[2 * kLightsPerPass];
-  int layers[kLightsPerPass];
-  std::vector<std::array<int, 4>> supports;
-  for (size_t k = 0; k < lights.size(); ++k) {
-    const int l = lights[k];
-    const Eigen::Vector2d c = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
-    centres[2 * k] = float(c.x());
-    centres[2 * k + 1] = float(c.y());
-    layers[k] = l;
-    supports.push_back(support_[l]);
+  std::vector<LightEntry> entries;
+  for (int l : lights) {
+    LightEntry e;
+    e.centre = e.shadow_centre = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
+    e.layer = e.shadow_layer = l;
+    e.support = support_[l];
+    entries.push_back(e);
   }
-  const int n = int(lights.size());
-  if (options_.tiled_lights) TileLists(kLightsPerPass, centres, supports, n, n);
-  for (Shading shading : ShadingPasses(int(lights.size()))) {
+  const int n = int(entries.size());
+  std::vector<float> packed;
+  std::vector<int> layers;
+  PackLights(entries, &packed, &layers);
+  if (options_.tiled_lights) TileLists(kLightsPerPass, packed.data(), Supports(entries), n, n);
+  for (Shading shading : ShadingPasses(n)) {
     const GLuint p = LightProgram(false, shading);
     SetCommonUniforms(p, shading);
-    glUniform1i(Loc(p, "u_count"), int(lights.size()));
-    glUniform2fv(Loc(p, "u_centres"), GLsizei(lights.size()), centres);
-    glUniform1iv(Loc(p, "u_layers"), GLsizei(lights.size()), layers);
+    glUniform1i(Loc(p, "u_count"), n);
+    glUniform4fv(Loc(p, "u_lights"), n, packed.data());
+    glUniform4iv(Loc(p, "u_light_layers"), n, layers.data());
     DrawLightPass(shading);
   }
 }
 
-void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
-                             double z_far) {
-  float centres[2 * kFastLightsPerPass], shadow_centres[2 * kFastLightsPerPass];
-  int layers[kFastLightsPerPass], shadow_layers[kFastLightsPerPass];
-  int spans[2 * kFastLightsPerPass];
-  const GLsizei n = GLsizei(entries.size());
-  std::vector<std::array<int, 4>> supports;
+// The pass's lights as the shaders' u_lights (centre, shadow centre) and u_light_layers (E'
+// layer, shadow layer, shadow span: a single light's is its own entry).
+void Renderer::PackLights(const std::vector<LightEntry>& entries, std::vector<float>* lights,
+                          std::vector<int>* layers) {
   for (size_t k = 0; k < entries.size(); ++k) {
     const LightEntry& e = entries[k];
-    supports.push_back(e.support);
-    centres[2 * k] = float(e.centre.x());
-    centres[2 * k + 1] = float(e.centre.y());
-    shadow_centres[2 * k] = float(e.shadow_centre.x());
-    shadow_centres[2 * k + 1] = float(e.shadow_centre.y());
-    layers[k] = e.layer;
-    shadow_layers[k] = e.shadow_layer;
-    spans[2 * k] = e.span_begin < 0 ? int(k) : e.span_begin;
-    spans[2 * k + 1] = e.span_count;
+    lights->insert(lights->end(), {float(e.centre.x()), float(e.centre.y()),
+                                   float(e.shadow_centre.x()), float(e.shadow_centre.y())});
+    layers->insert(layers->end(), {e.layer, e.shadow_layer,
+                                   e.span_begin < 0 ? int(k) : e.span_begin, e.span_count});
   }
-  if (options_.tiled_lights) TileLists(kFastLightsPerPass, centres, supports, near_end, far_begin);
+}
+
+std::vector<std::array<int, 4>> Renderer::Supports(const std::vector<LightEntry>& entries) {
+  std::vector<std::array<int, 4>> supports;
+  for (const LightEntry& e : entries) supports.push_back(e.support);
+  return supports;
+}
+
+void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
+                             double z_far) {
+  const GLsizei n = GLsizei(entries.size());
+  std::vector<float> packed;
+  std::vector<int> layers;
+  PackLights(entries, &packed, &layers);
+  if (options_.tiled_lights) {
+    TileLists(kFastLightsPerPass, packed.data(), Supports(entries), near_end, far_begin);
+  }
   for (Shading shading : ShadingPasses(n)) {
     const GLuint p = LightProgram(true, shading);
     SetCommonUniforms(p, shading);
     glUniform1i(Loc(p, "u_count"), n);
-    glUniform2fv(Loc(p, "u_centres"), n, centres);
-    glUniform1iv(Loc(p, "u_layers"), n, layers);
-    glUniform2fv(Loc(p, "u_shadow_centres"), n, shadow_centres);
-    glUniform1iv(Loc(p, "u_shadow_layers"), n, shadow_layers);
-    glUniform2iv(Loc(p, "u_shadow_span"), n, spans);
+    glUniform4fv(Loc(p, "u_lights"), n, packed.data());
+    glUniform4iv(Loc(p, "u_light_layers"), n, layers.data());
     glUniform1i(Loc(p, "u_near_end"), near_end);
     glUniform1i(Loc(p, "u_far_begin"), far_begin);
     glUniform1f(Loc(p, "u_z_far"), float(std::min(z_far, 3.0e38)));

@@ -164,6 +164,9 @@ class Renderer {
   void ChooseShadowGroups();
   void MergedTexture(int group);
   void LightPass(const std::vector<int>& lights);
+  static void PackLights(const std::vector<LightEntry>& entries, std::vector<float>* lights,
+                         std::vector<int>* layers);
+  static std::vector<std::array<int, 4>> Supports(const std::vector<LightEntry>& entries);
   void FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
                      double z_far);
   // How a light pass shades: every pixel exactly; coarse shading's samples, their resolve and the
@@ -172,9 +175,10 @@ class Renderer {
   // The passes that shade `lights` lights at the present options.
   std::vector<Shading> ShadingPasses(int lights) const;
   void SetCommonUniforms(unsigned program, Shading shading);
-  // The light lists of the tiles for one pass's lights (centres: x, y per light; near_end and
-  // far_begin as FastLightPass's), after the tiles' bounds if the G-buffer changed.
-  void TileLists(int lights_per_pass, const float* centres,
+  // The light lists of the tiles for one pass's lights (lights: PackLights', 4 floats per
+  // light; near_end and far_begin as FastLightPass's), after the tiles' bounds if the G-buffer
+  // changed.
+  void TileLists(int lights_per_pass, const float* lights,
                  const std::vector<std::array<int, 4>>& supports, int near_end, int far_begin);
   // The light program for the present options (fast: the shortcuts'), linked when first used.
   unsigned LightProgram(bool fast, Shading shading = Shading::kExact);

@@ -1265,7 +1265,7 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
     std::vector<LightEntry> entries = near_only;
     entries.insert(entries.end(), both.begin(), both.end());
     entries.insert(entries.end(), far_only.begin(), far_only.end());
-    FastLightPass(entries, int(near_only.size() + both.size()), int(near_only.size()), z_far);
+    EntriesPass(entries, true, int(near_only.size() + both.size()), int(near_only.size()), z_far);
     return;
   }
   // Too many for one pass: every position on its own, in passes of kFastLightsPerPass.
@@ -1274,16 +1274,15 @@ void Renderer::FastPasses(const std::vector<int>& todo) {
     const size_t end = std::min(todo.size(), start + kFastLightsPerPass);
     std::vector<LightEntry> entries;
     for (size_t k = start; k < end; ++k) entries.push_back(entry(todo[k]));
-    FastLightPass(entries, int(entries.size()), int(entries.size()),
-                  std::numeric_limits<double>::infinity());
+    EntriesPass(entries, true, int(entries.size()), int(entries.size()),
+                std::numeric_limits<double>::infinity());
   }
 }
 
 void Renderer::TileLists(int lights_per_pass, const float* lights,
-                         const std::vector<std::array<int, 4>>& supports, int near_end,
-                         int far_begin) {
+                         const std::vector<LightEntry>& entries, int near_end, int far_begin) {
   const int tiles_x = (width_ + kTile - 1) / kTile, tiles_y = (height_ + kTile - 1) / kTile;
-  const int count = int(supports.size());
+  const int count = int(entries.size());
   if (!tile_bounds_valid_) {
     if (!gl_->tile_bounds_program) {
       gl_->tile_bounds_program = LinkCompute(
@@ -1313,7 +1312,8 @@ void Renderer::TileLists(int lights_per_pass, const float* lights,
   const double w = info_.layout.window_w_mm, h = info_.layout.window_h_mm;
   const double rx = info_.layout.res_x, ry = info_.layout.res_y, pad = 3;
   std::vector<float> windows;
-  for (const std::array<int, 4>& s : supports) {
+  for (const LightEntry& e : entries) {
+    const std::array<int, 4>& s = e.support;
     if (s[0] >= s[2] || s[1] >= s[3]) {
       windows.insert(windows.end(), {1, 1, -1, -1});
       continue;
@@ -1457,18 +1457,7 @@ void Renderer::LightPass(const std::vector<int>& lights) {
     entries.push_back(e);
   }
   const int n = int(entries.size());
-  std::vector<float> packed;
-  std::vector<int> layers;
-  PackLights(entries, &packed, &layers);
-  if (options_.tiled_lights) TileLists(kLightsPerPass, packed.data(), Supports(entries), n, n);
-  for (Shading shading : ShadingPasses(n)) {
-    const GLuint p = LightProgram(false, shading);
-    SetCommonUniforms(p, shading);
-    glUniform1i(Loc(p, "u_count"), n);
-    glUniform4fv(Loc(p, "u_lights"), n, packed.data());
-    glUniform4iv(Loc(p, "u_light_layers"), n, layers.data());
-    DrawLightPass(shading);
-  }
+  EntriesPass(entries, false, n, n, std::numeric_limits<double>::infinity());
 }
 
 // The pass's lights as the shaders' u_lights (centre, shadow centre) and u_light_layers (E'
@@ -1484,27 +1473,23 @@ void Renderer::PackLights(const std::vector<LightEntry>& entries, std::vector<fl
   }
 }
 
-std::vector<std::array<int, 4>> Renderer::Supports(const std::vector<LightEntry>& entries) {
-  std::vector<std::array<int, 4>> supports;
-  for (const LightEntry& e : entries) supports.push_back(e.support);
-  return supports;
-}
-
-void Renderer::FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
-                             double z_far) {
+void Renderer::EntriesPass(const std::vector<LightEntry>& entries, bool fast, int near_end,
+                           int far_begin, double z_far) {
   const GLsizei n = GLsizei(entries.size());
   std::vector<float> packed;
   std::vector<int> layers;
   PackLights(entries, &packed, &layers);
   if (options_.tiled_lights) {
-    TileLists(kFastLightsPerPass, packed.data(), Supports(entries), near_end, far_begin);
+    TileLists(fast ? kFastLightsPerPass : kLightsPerPass, packed.data(), entries, near_end,
+              far_begin);
   }
   for (Shading shading : ShadingPasses(n)) {
-    const GLuint p = LightProgram(true, shading);
+    const GLuint p = LightProgram(fast, shading);
     SetCommonUniforms(p, shading);
     glUniform1i(Loc(p, "u_count"), n);
     glUniform4fv(Loc(p, "u_lights"), n, packed.data());
     glUniform4iv(Loc(p, "u_light_layers"), n, layers.data());
+    // The shortcuts' near and far lists (absent from the plain program: location -1, ignored).
     glUniform1i(Loc(p, "u_near_end"), near_end);
     glUniform1i(Loc(p, "u_far_begin"), far_begin);
     glUniform1f(Loc(p, "u_z_far"), float(std::min(z_far, 3.0e38)));

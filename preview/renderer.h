@@ -166,20 +166,21 @@ class Renderer {
   void LightPass(const std::vector<int>& lights);
   static void PackLights(const std::vector<LightEntry>& entries, std::vector<float>* lights,
                          std::vector<int>* layers);
-  static std::vector<std::array<int, 4>> Supports(const std::vector<LightEntry>& entries);
-  void FastLightPass(const std::vector<LightEntry>& entries, int near_end, int far_begin,
-                     double z_far);
+  // One light pass over `entries` (fast: the shortcuts' program, whose lights [0, near_end)
+  // shade receivers nearer than z_far and [far_begin, size) the others).
+  void EntriesPass(const std::vector<LightEntry>& entries, bool fast, int near_end, int far_begin,
+                   double z_far);
   // How a light pass shades: every pixel exactly; coarse shading's samples, their resolve and the
   // compute pass over the pixels listed; reprojection's pass (it lists for kExactList too).
   enum class Shading { kExact, kCoarse, kResolve, kExactList, kReproject };
   // The passes that shade `lights` lights at the present options.
   std::vector<Shading> ShadingPasses(int lights) const;
   void SetCommonUniforms(unsigned program, Shading shading);
-  // The light lists of the tiles for one pass's lights (lights: PackLights', 4 floats per
-  // light; near_end and far_begin as FastLightPass's), after the tiles' bounds if the G-buffer
+  // The light lists of the tiles for one pass's entries (lights: their PackLights, 4 floats
+  // each; near_end and far_begin as EntriesPass's), after the tiles' bounds if the G-buffer
   // changed.
-  void TileLists(int lights_per_pass, const float* lights,
-                 const std::vector<std::array<int, 4>>& supports, int near_end, int far_begin);
+  void TileLists(int lights_per_pass, const float* lights, const std::vector<LightEntry>& entries,
+                 int near_end, int far_begin);
   // The light program for the present options (fast: the shortcuts'), linked when first used.
   unsigned LightProgram(bool fast, Shading shading = Shading::kExact);
   void DrawLightPass(Shading shading);

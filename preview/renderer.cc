@@ -293,21 +293,23 @@ vec3 ShadeLights(vec3 x, vec3 n, ivec2 pixel) {
     float visible = 1.0;
 #if SHADOWS
     {
-      // The map's coordinates of the offset point p, linear in the map's centre as uv above.
+      // The map's coordinates of the offset point, as the maps were drawn (LightClip).
       const vec3 p = x + n * (u_offset_scale * sqrt(delta2));
-      const float inverse_z = 1.0 / p.z;
-      const vec2 map_p = vec2(0.5, 0.5) + p.xy * (u_d * inverse_z) / vec2(u_window.x, -u_window.y);
-      const vec2 map_c = (1.0 - u_d * inverse_z) / vec2(u_window.x, -u_window.y);
-      const float depth = 0.5 * (u_depth.x + u_depth.y * inverse_z) + 0.5;
 #if FAST
       visible = 0.0;
       const int begin = u_light_layers[k].z, end = begin + u_light_layers[k].w;
-      for (int m = begin; m < end; ++m)
-        visible += texture(u_shadow, vec4(map_p + u_lights[m].zw * map_c,
-                                          float(u_light_layers[m].y), depth));
+      for (int m = begin; m < end; ++m) {
+        const vec4 clip = LightClip(p, u_lights[m].zw);
+        const vec3 ndc = clip.xyz / clip.w;
+        visible += texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_light_layers[m].y),
+                                          0.5 * ndc.z + 0.5));
+      }
       if (u_light_layers[k].w > 1) visible /= float(u_light_layers[k].w);
 #else
-      visible = texture(u_shadow, vec4(map_p + c * map_c, float(u_light_layers[k].x), depth));
+      const vec4 clip = LightClip(p, c);
+      const vec3 ndc = clip.xyz / clip.w;
+      visible = texture(u_shadow, vec4(0.5 * ndc.xy + 0.5, float(u_light_layers[k].x),
+                                       0.5 * ndc.z + 0.5));
 #endif
     }
 #endif

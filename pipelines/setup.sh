@@ -13,9 +13,9 @@ packages=(
   libglfw3-dev libosmesa6-dev python3-glad libassimp-dev
   # lib/lightfield: the exact CPU reference's ray casting (Embree 3)
   libembree-dev
-  # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), DNG and TIFF writing (libtiff),
-  # colour JPEGs decoded with their fractional codes (libjpeg-turbo)
-  libraw-dev libexif-dev libtiff-dev libjpeg-dev
+  # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), PNG, JPEG and TIFF files (libpng,
+  # libjpeg-turbo, libtiff; colour JPEGs decoded with their fractional codes)
+  libraw-dev libexif-dev libtiff-dev libjpeg-dev libpng-dev zlib1g-dev
   # preview: the window's on-screen controls (Dear ImGui 1.86 with its GLFW and OpenGL 3 backends);
   # lib/lightfield: scene files' textures (stb_image)
   libimgui-dev libstb-dev

@@ -5,32 +5,21 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstring>
 #include <fstream>
 #include <memory>
 #include <numeric>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "lib/photo/image_codecs.h"
 
 namespace lumislab {
 namespace {
 
 // ---- DNG through libtiff ----
-
-// libtiff's error messages go into the writer's error instead of stderr.
-int CollectTiffMessage(TIFF*, void* user_data, const char* module, const char* fmt, va_list ap) {
-  char buffer[512];
-  std::vsnprintf(buffer, sizeof buffer, fmt, ap);
-  auto* message = static_cast<std::string*>(user_data);
-  if (message->empty()) *message = std::string(module ? module : "libtiff") + ": " + buffer;
-  return 1;
-}
-int IgnoreTiffMessage(TIFF*, void*, const char*, const char*, va_list) { return 1; }
 
 // Sets an array-valued tag; libtiff wants the count before the pointer only for tags of
 // variable length, and rationals as float or double depending on the tag.
@@ -79,15 +68,9 @@ uint64_t WriteExifDirectory(TIFF* tif, const PhotoExif& e) {
   return offset;
 }
 
-using TiffFile = std::unique_ptr<TIFF, void (*)(TIFF*)>;
-
 // Creates `tmp` for writing, libtiff's errors going into `error` (closed when the handle goes).
 TiffFile CreateTiff(const std::string& tmp, std::string& error) {
-  std::unique_ptr<TIFFOpenOptions, void (*)(TIFFOpenOptions*)> options(TIFFOpenOptionsAlloc(),
-                                                                       TIFFOpenOptionsFree);
-  TIFFOpenOptionsSetErrorHandlerExtR(options.get(), &CollectTiffMessage, &error);
-  TIFFOpenOptionsSetWarningHandlerExtR(options.get(), &IgnoreTiffMessage, nullptr);
-  TiffFile file(TIFFOpenExt(tmp.c_str(), "w", options.get()), TIFFClose);
+  TiffFile file = OpenTiff(tmp, "w", error);
   if (!file) throw IoError(tmp, "cannot create the file: " + error);
   return file;
 }
@@ -155,7 +138,11 @@ void WriteTiffFile(const std::string& tmp, const cv::Mat& image, const PhotoExif
   Set(tif, TIFFTAG_BITSPERSAMPLE, int(image.elemSize1() * 8));
   Set(tif, TIFFTAG_SAMPLESPERPIXEL, channels);
   Set(tif, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
-  Set(tif, TIFFTAG_PHOTOMETRIC, channels == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
+  Set(tif, TIFFTAG_PHOTOMETRIC, channels >= 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
+  if (channels == 4) {
+    const uint16_t alpha[1] = {EXTRASAMPLE_UNASSALPHA};
+    Set(tif, TIFFTAG_EXTRASAMPLES, uint16_t(1), alpha);
+  }
   Set(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
   Set(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
   Set(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
@@ -163,6 +150,8 @@ void WriteTiffFile(const std::string& tmp, const cv::Mat& image, const PhotoExif
   cv::Mat rgb;  // TIFF stores R, G, B (a new buffer: the caller's image stays as it is)
   if (channels == 3)
     cv::cvtColor(image, rgb, cv::COLOR_BGR2RGB);
+  else if (channels == 4)
+    cv::cvtColor(image, rgb, cv::COLOR_BGRA2RGBA);
   else
     rgb = image;
   for (int y = 0; y < rgb.rows; ++y)
@@ -254,8 +243,9 @@ void WriteDng(const std::string& path, const cv::Mat& mosaic, const DngInfo& inf
 
 void WriteTiff(const std::string& path, const cv::Mat& image, const PhotoExif& exif) {
   LUMISLAB_CHECK((image.depth() == CV_8U || image.depth() == CV_16U) &&
-                     (image.channels() == 1 || image.channels() == 3) && !image.empty(),
-                 "WriteTiff: an 8-bit or 16-bit image of 1 or 3 channels");
+                     (image.channels() == 1 || image.channels() == 3 || image.channels() == 4) &&
+                     !image.empty(),
+                 "WriteTiff: an 8-bit or 16-bit image of 1, 3 or 4 channels");
   WriteAtomically(path, [&](const std::string& tmp) {
     std::string error;
     WriteTiffFile(tmp, image, exif, error);
@@ -266,16 +256,10 @@ void WriteTiff(const std::string& path, const cv::Mat& image, const PhotoExif& e
 void WriteJpeg(const std::string& path, const cv::Mat& bgr8, int quality, const PhotoExif& exif) {
   LUMISLAB_CHECK(bgr8.type() == CV_8UC3 || bgr8.type() == CV_8UC1, "WriteJpeg: an 8-bit image");
   LUMISLAB_CHECK(quality >= 1 && quality <= 100, "WriteJpeg: quality in [1, 100]");
-  std::vector<unsigned char> jpeg;
-  try {
-    if (!cv::imencode(".jpg", bgr8, jpeg, {cv::IMWRITE_JPEG_QUALITY, quality}))
-      throw IoError(path, "cannot encode the JPEG");
-  } catch (const cv::Exception& e) {
-    throw IoError(path, std::string("cannot encode the JPEG: ") + e.what());
-  }
+  const std::vector<unsigned char> jpeg = EncodeJpeg(bgr8, quality);
   LUMISLAB_CHECK(jpeg.size() > 4 && jpeg[0] == 0xff && jpeg[1] == 0xd8, "WriteJpeg: no SOI");
   // A camera writes SOI, then APP1 EXIF; libjpeg's JFIF APP0 segment is dropped. Without a field
-  // to write, the JPEG is written as OpenCV encoded it (an empty EXIF block reads as corrupt).
+  // to write, the JPEG is written as libjpeg encoded it (an empty EXIF block reads as corrupt).
   const bool any = exif.exposure_time || exif.f_number || exif.iso || exif.make || exif.model ||
                    exif.lens_model || exif.date_time;
   if (!any) {

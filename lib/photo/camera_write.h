@@ -27,12 +27,12 @@ struct DngInfo {
 // AsShotNeutral and the EXIF.
 void WriteDng(const std::string& path, const cv::Mat& mosaic, const DngInfo& info);
 
-// Writes an 8-bit or 16-bit image (1 or 3 channels, OpenCV's BGR order) as an uncompressed TIFF
-// with make, model and date-time in IFD0 and the rest of `exif` in an EXIF directory, as a
-// camera's TIFF output (read back by DecodePhoto through OpenCV).
+// Writes an 8-bit or 16-bit image (1, 3 or 4 channels, OpenCV's B, G, R (A) order; the fourth as
+// unassociated alpha) as an uncompressed TIFF with make, model and date-time in IFD0 and the rest
+// of `exif` in an EXIF directory, as a camera's TIFF output.
 void WriteTiff(const std::string& path, const cv::Mat& image, const PhotoExif& exif);
 
-// Writes an 8-bit BGR image (CV_8UC3) as a JPEG at `quality` (1 .. 100) through OpenCV, with an
+// Writes an 8-bit BGR image (CV_8UC3) as a JPEG at `quality` (1 .. 100) through libjpeg, with an
 // EXIF APP1 segment (exposure time, f-number, ISO, make, model, lens, date-time; the fields
 // present) built with libexif and placed right after SOI, where cameras put it; no EXIF block
 // when no field is present.

@@ -18,7 +18,7 @@ namespace lumislab {
 namespace {
 
 // libjpeg reports a fatal error through error_exit, which must not return: it jumps back to
-// DecodeJpegFractional with the message, which becomes BadInput there (no C++ object with a
+// DecodeJpeg with the message, which becomes BadInput there (no C++ object with a
 // destructor lives between the setjmp and the libjpeg calls that may jump).
 struct ErrorManager {
   jpeg_error_mgr base;
@@ -94,7 +94,7 @@ struct FileCloser {
 
 }  // namespace
 
-cv::Mat DecodeJpegFractional(const std::string& path) {
+DecodedJpeg DecodeJpeg(const std::string& path) {
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
   if (!file) throw BadInput(path + ": cannot open the photo");
   jpeg_decompress_struct info;
@@ -102,7 +102,7 @@ cv::Mat DecodeJpegFractional(const std::string& path) {
   info.err = jpeg_std_error(&error.base);
   error.base.error_exit = ErrorExit;
   error.base.emit_message = EmitMessage;
-  cv::Mat out;  // allocated before the setjmp: a jump back leaves it to its destructor
+  DecodedJpeg out;  // created before the setjmp: a jump back leaves them to their destructors
   std::vector<JSAMPLE> row;
   if (setjmp(error.jump)) {
     jpeg_destroy_decompress(&info);
@@ -112,9 +112,14 @@ cv::Mat DecodeJpegFractional(const std::string& path) {
   jpeg_stdio_src(&info, file.get());
   jpeg_save_markers(&info, JPEG_APP0 + 1, 0xffff);
   jpeg_read_header(&info, TRUE);
-  if (info.num_components != 3 || info.jpeg_color_space != JCS_YCbCr) {
+  const J_COLOR_SPACE space = info.jpeg_color_space;
+  const bool ycbcr = info.num_components == 3 && space == JCS_YCbCr;
+  const bool grey = info.num_components == 1 && space == JCS_GRAYSCALE;
+  const bool rgb = info.num_components == 3 && space == JCS_RGB;
+  if (!ycbcr && !grey && !rgb) {
+    const std::string got = space == JCS_CMYK ? "CMYK" : space == JCS_YCCK ? "YCCK" : "other";
     jpeg_destroy_decompress(&info);
-    return cv::Mat();
+    throw InputError(path, "colour space", "YCbCr, RGB or grey", got);
   }
   if (uint64_t(info.image_width) * info.image_height > uint64_t(kMaxPhotoPixels)) {
     const std::string size =
@@ -124,32 +129,36 @@ cv::Mat DecodeJpegFractional(const std::string& path) {
                      "an image of 1 .. " + std::to_string(kMaxPhotoPixels) + " pixels", size);
   }
   const int orientation = Orientation(&info);
-  info.out_color_space = JCS_YCbCr;  // libjpeg's inverse DCT and upsampling, no conversion
+  // Y, Cb, Cr: libjpeg's inverse DCT and upsampling, no conversion (that is done below). Grey
+  // and RGB: the codes as stored, RGB in OpenCV's order.
+  info.out_color_space = ycbcr ? JCS_YCbCr : grey ? JCS_GRAYSCALE : JCS_EXT_BGR;
   jpeg_start_decompress(&info);
   const int w = int(info.output_width), h = int(info.output_height);
-  out = NewPhotoImage(h, w, CV_16UC3);
-  row.resize(size_t(w) * 3);
+  out.fractional = ycbcr;
+  out.pixels = NewPhotoImage(h, w, ycbcr ? CV_16UC3 : grey ? CV_8UC1 : CV_8UC3);
+  if (ycbcr) row.resize(size_t(w) * 3);
   // Code x 256, rounded: the fixed point of Photo::fractional_codes.
   const float one = float(kFractionalCodeOne), top = 255.f * one;
   auto fixed = [&](float code) {
     return uint16_t(std::min(top, std::max(0.f, code * one)) + 0.5f);
   };
   while (info.output_scanline < info.output_height) {
-    JSAMPLE* rows[1] = {row.data()};
     const int y = int(info.output_scanline);
+    JSAMPLE* rows[1] = {ycbcr ? row.data() : out.pixels.ptr<JSAMPLE>(y)};
     jpeg_read_scanlines(&info, rows, 1);
-    uint16_t* rgb = out.ptr<uint16_t>(y);
+    if (!ycbcr) continue;
+    uint16_t* rgb_row = out.pixels.ptr<uint16_t>(y);
     // JFIF's conversion (ITU-R BT.601 full range), which libjpeg's integer tables round.
     for (int x = 0; x < w; ++x) {
       const float luma = row[3 * x], cb = row[3 * x + 1] - 128.f, cr = row[3 * x + 2] - 128.f;
-      rgb[3 * x] = fixed(luma + 1.402f * cr);
-      rgb[3 * x + 1] = fixed(luma - 0.34413629f * cb - 0.71413629f * cr);
-      rgb[3 * x + 2] = fixed(luma + 1.772f * cb);
+      rgb_row[3 * x] = fixed(luma + 1.402f * cr);
+      rgb_row[3 * x + 1] = fixed(luma - 0.34413629f * cb - 0.71413629f * cr);
+      rgb_row[3 * x + 2] = fixed(luma + 1.772f * cb);
     }
   }
   jpeg_finish_decompress(&info);
   jpeg_destroy_decompress(&info);
-  Orient(orientation, out);
+  Orient(orientation, out.pixels);
   return out;
 }
 

@@ -12,12 +12,17 @@
 
 namespace lumislab {
 
-// Decodes a baseline or progressive JPEG whose components are YCbCr (JFIF, or EXIF without an
-// Adobe transform) into CV_16UC3 in RGB order holding codes in [0, 255] with their fractions
-// (Photo::fractional_codes: code x kFractionalCodeOne, rounded to 1/256 code), in the orientation
-// its EXIF Orientation tag gives (as OpenCV's imread shows it). Returns an empty Mat for a JPEG of
-// any other colour space (grayscale, CMYK, RGB): those store codes directly and go through OpenCV.
-// A corrupt or truncated file, or one larger than kMaxPhotoPixels, is BadInput naming the file.
-cv::Mat DecodeJpegFractional(const std::string& path);
+// Decodes a baseline or progressive JPEG, in the orientation its EXIF Orientation tag gives (as
+// OpenCV's imread shows it). Components Y, Cb, Cr (JFIF, or EXIF without an Adobe transform) give
+// CV_16UC3 in RGB order holding codes in [0, 255] with their fractions (Photo::fractional_codes:
+// code x kFractionalCodeOne, rounded to 1/256 code), and `fractional` true. A grey JPEG gives its
+// codes as CV_8UC1, one stored as RGB (Adobe) CV_8UC3 in B, G, R order, both as stored, and
+// `fractional` false. Any other colour space (CMYK, YCCK) is InputError naming the file; a
+// corrupt or truncated file, or one larger than kMaxPhotoPixels, is BadInput naming it.
+struct DecodedJpeg {
+  cv::Mat pixels;
+  bool fractional = false;
+};
+DecodedJpeg DecodeJpeg(const std::string& path);
 
 }  // namespace lumislab

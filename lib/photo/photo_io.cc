@@ -11,13 +11,14 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/input_file.h"
+#include "lib/photo/camera_write.h"
+#include "lib/photo/image_codecs.h"
 #include "lib/photo/jpeg_decode.h"
 #include "lib/photo/raw_decode.h"
 
@@ -141,54 +142,9 @@ cv::MatAllocator* PhotoAllocator() {
   return allocator;
 }
 
-// PNG, TIFF and grey JPEG photos through OpenCV: the file is read into memory and decoded with
-// cv::imdecode into an image of PhotoAllocator (imdecode creates its output with the allocator
-// of the Mat it is given; cv::imread has no such Mat), so that the photo lies in huge pages,
-// kept for the next photo of its size, as NewPhotoImage's. The same decoder and flags as
-// cv::imread, so the same pixels. With imread's fresh 4 kB pages the six 16-bit 6000 x 4000
-// TIFFs of a position took ~2.8 s CPU to decode and ~0.8 s to merge on the development VM
-// (first-touch page faults, then the page walks of streaming 864 MB of 4 kB pages); in kept
-// huge pages ~0.56 s and ~0.22 s (docs/design.md 8.3).
-cv::Mat DecodeWithOpenCv(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  const std::streamoff size = in ? std::streamoff(in.tellg()) : -1;
-  if (size <= 0) throw BadInput(path + ": cannot read the photo (empty or unreadable file)");
-  // (Beyond 2 GB no photo of at most kMaxPhotoPixels pixels; cv::Mat sizes are int.)
-  if (size > std::numeric_limits<int>::max())
-    throw InputError(path, "file size", "at most 2 GB", std::to_string(size) + " bytes");
-  cv::Mat file = NewPhotoImage(1, int(size), CV_8U);
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(file.data), size))
-    throw BadInput(path + ": cannot read the photo (read error)");
-  in.close();
-  cv::Mat pixels;
-  pixels.allocator = PhotoAllocator();
-  try {
-    cv::imdecode(file, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR, &pixels);
-  } catch (const cv::Exception& e) {
-    throw BadInput(path + ": cannot decode the photo: " + e.what());
-  }
-  pixels.allocator = nullptr;  // as NewPhotoImage: only the buffer is ours
-  file.release();
-  if (pixels.empty()) throw BadInput(path + ": cannot decode the photo (corrupt file)");
-  const int depth = pixels.depth(), channels = pixels.channels();
-  if (depth != CV_8U && depth != CV_16U)
-    throw InputError(path, "pixel format", "8 or 16 bits per channel",
-                     std::to_string(pixels.elemSize1() * 8) + "-bit samples");
-  if (channels == 4) {  // alpha carries nothing we measure
-    cv::Mat bgr;
-    cv::cvtColor(pixels, bgr, cv::COLOR_BGRA2BGR);
-    pixels = bgr;
-  } else if (channels != 1 && channels != 3) {
-    throw InputError(path, "channels", "1, 3 or 4", std::to_string(channels));
-  }
-  return pixels;
-}
-
-// Checks a PNG's chunk structure before OpenCV decodes it (libpng prints its own "libpng error"
-// lines and OpenCV then only says it failed): the size in IHDR (refused beyond kMaxPhotoPixels,
-// which the decoder would allocate first) and a chunk sequence that ends in IEND within the
-// file (a truncated copy does not). Walks the chunk headers only.
+// Checks a PNG's chunk structure before libpng decodes it: the size in IHDR (refused beyond
+// kMaxPhotoPixels, which the decoder would allocate first) and a chunk sequence that ends in IEND
+// within the file (a truncated copy does not). Walks the chunk headers only.
 void CheckPng(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   auto be32 = [](const unsigned char* b) {
@@ -401,12 +357,15 @@ Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
     if (spec.raw_white_balance == RawWhiteBalance::kAsShot)
       photo.white_balance = raw.as_shot_white_balance;
   } else {
-    if (photo.format == PhotoFormat::kPng) CheckPng(path);
-    if (photo.format == PhotoFormat::kJpeg) photo.pixels = DecodeJpegFractional(path);
-    if (!photo.pixels.empty()) {
-      photo.fractional_codes = photo.rgb_order = true;
-    } else {  // not a colour JPEG: its codes as stored
-      photo.pixels = DecodeWithOpenCv(path);
+    if (photo.format == PhotoFormat::kJpeg) {
+      DecodedJpeg jpeg = DecodeJpeg(path);
+      photo.pixels = jpeg.pixels;
+      photo.fractional_codes = photo.rgb_order = jpeg.fractional;
+    } else if (photo.format == PhotoFormat::kPng) {
+      CheckPng(path);
+      photo.pixels = DecodePng(path);
+    } else {
+      photo.pixels = DecodeTiff(path);
     }
   }
   photo.transfer = spec.transfer != Transfer::kAuto ? spec.transfer
@@ -551,15 +510,20 @@ cv::Mat LinearGray(const Photo& photo) {
   return gray;
 }
 
-void WriteImageFile(const std::string& path, const cv::Mat& image, const std::vector<int>& params) {
+void WriteImageFile(const std::string& path, const cv::Mat& image, int jpeg_quality) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".tif" || ext == ".tiff") return WriteTiff(path, image, PhotoExif{});
+  LUMISLAB_CHECK(ext == ".png" || ext == ".jpg" || ext == ".jpeg",
+                 "WriteImageFile: a .png, .jpg or .tif path, got " + path);
   WriteAtomically(path, [&](const std::string& tmp) {
-    bool ok = false;
-    try {
-      ok = cv::imwrite(tmp, image, params);
-    } catch (const cv::Exception& e) {
-      throw IoError(path, std::string("cannot encode the image: ") + e.what());
-    }
-    if (!ok) throw IoError(path, "cannot encode the image");
+    if (ext == ".png") return EncodePng(tmp, image, path);
+    const std::vector<unsigned char> jpeg = EncodeJpeg(image, jpeg_quality);
+    std::ofstream file(tmp, std::ios::binary);
+    file.write(reinterpret_cast<const char*>(jpeg.data()), std::streamsize(jpeg.size()));
+    file.close();
+    if (!file) throw IoError(path, "cannot write the JPEG");
   });
 }
 
@@ -614,10 +578,7 @@ void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding enc
   }
   const cv::Mat out = PhotoCodes(linear, encoding);
   const bool jpeg = encoding == PhotoEncoding::kCurve8Jpeg;
-  if (jpeg)
-    WriteImageFile(path, out, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
-  else
-    WriteImageFile(path, out);
+  WriteImageFile(path, out, jpeg ? jpeg_quality : 95);
 }
 
 }  // namespace lumislab

@@ -28,8 +28,8 @@ namespace lumislab {
 
 // kRaw: a camera RAW or DNG (LibRaw). A TIFF container is a DNG when its first IFD holds the
 // DNGVersion tag; a TIFF without it is a camera RAW (NEF, ARW, PEF, ...) when it names a camera
-// maker and LibRaw identifies a Bayer mosaic in it, since OpenCV's TIFF reader would decode
-// only its small preview. Anything else in a TIFF container is a plain TIFF for OpenCV.
+// maker and LibRaw identifies a Bayer mosaic in it, since a plain TIFF reader would decode
+// only its small preview. Anything else in a TIFF container is a plain TIFF (libtiff).
 enum class PhotoFormat { kPng, kJpeg, kTiff, kExr, kRaw };
 // Largest photo decoded (pixels; a 100-megapixel camera fits), checked from the header.
 constexpr long long kMaxPhotoPixels = 1LL << 27;
@@ -63,7 +63,7 @@ struct PhotoSpec {
 struct Photo {
   std::string path;
   PhotoFormat format = PhotoFormat::kPng;
-  // As stored: CV_8U or CV_16U with 1 or 3 channels (BGR order, as OpenCV decodes), or CV_32FC3
+  // As stored: CV_8U or CV_16U with 1 or 3 channels (BGR order, OpenCV's convention), or CV_32FC3
   // in RGB order (EXR channels R, G, B; camera RAW with white level 1), or a colour JPEG's codes
   // with their fractions (fractional_codes: CV_16UC3 in RGB order, code x kFractionalCodeOne).
   cv::Mat pixels;
@@ -170,11 +170,11 @@ cv::Mat Codes8(const Photo& photo);
 // value is not finite.
 cv::Mat LinearGray(const Photo& photo);
 
-// Writes `image` (8-bit or 16-bit, 1 or 3 channels in OpenCV's BGR order) as PNG (or any format
-// OpenCV writes, by extension) under a temporary name, then renames it into place. `params` are
-// cv::imwrite's (e.g. IMWRITE_JPEG_QUALITY, q).
-void WriteImageFile(const std::string& path, const cv::Mat& image,
-                    const std::vector<int>& params = {});
+// Writes `image` (8-bit or 16-bit, 1, 3 or 4 channels in OpenCV's B, G, R (A) order) under a
+// temporary name, then renames it into place, as PNG, JPEG (8-bit, 1 or 3 channels, at
+// `jpeg_quality`) or uncompressed TIFF by the path's extension (.png, .jpg/.jpeg, .tif/.tiff;
+// lib/photo/image_codecs.h).
+void WriteImageFile(const std::string& path, const cv::Mat& image, int jpeg_quality = 95);
 // 8-bit RGB (width * height * 3 bytes, RGB interleaved, row 0 on top: lib/lightfield's Rgb8Image
 // and the preview's tone-mapped frames) through WriteImageFile (PNG by the path's ending).
 void WriteRgb8File(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);

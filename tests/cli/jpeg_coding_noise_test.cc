@@ -54,7 +54,7 @@ Measured EncodeDecode(const ImageF& codes, double sigma, int quality, const std:
         bgr.at<cv::Vec3b>(y, x)[2 - c] = cv::saturate_cast<uint8_t>(
             std::lround(codes.at(x, y, c) + (sigma > 0 ? normal(rng) : 0.0)));
   EXPECT_TRUE(cv::imwrite(path, bgr, {cv::IMWRITE_JPEG_QUALITY, quality}));
-  const cv::Mat decoded = DecodeJpegFractional(path);  // RGB, code x 256
+  const cv::Mat decoded = DecodeJpeg(path).pixels;  // RGB, code x 256
   Measured m;
   ImageF error(codes.width, codes.height, 3);
   for (int y = 0; y < codes.height; ++y)

@@ -43,7 +43,9 @@ cv::Mat Picture() {
 TEST(JpegDecode, OpenCvsPictureWithTheConversionsFractions) {
   const std::string path = ScratchDir() + "/p.jpg";
   ASSERT_TRUE(cv::imwrite(path, Picture(), {cv::IMWRITE_JPEG_QUALITY, 95}));
-  const cv::Mat fixed = DecodeJpegFractional(path);
+  const DecodedJpeg decoded = DecodeJpeg(path);
+  ASSERT_TRUE(decoded.fractional);
+  const cv::Mat& fixed = decoded.pixels;
   ASSERT_EQ(fixed.type(), CV_16UC3);  // code x 256
   cv::Mat ours;
   fixed.convertTo(ours, CV_32F, 1.0 / kFractionalCodeOne);
@@ -92,15 +94,18 @@ TEST(JpegDecode, OpenCvsPictureWithTheConversionsFractions) {
   }
 }
 
-TEST(JpegDecode, GrayJpegIsLeftToOpenCv) {
+// A grey JPEG's codes are stored as such: they come back as OpenCV's decoder gives them.
+TEST(JpegDecode, GrayJpegGivesItsCodesAsStored) {
   const std::string path = ScratchDir() + "/g.jpg";
   cv::Mat gray;
   cv::cvtColor(Picture(), gray, cv::COLOR_BGR2GRAY);
   ASSERT_TRUE(cv::imwrite(path, gray));
-  EXPECT_TRUE(DecodeJpegFractional(path).empty());
+  const DecodedJpeg decoded = DecodeJpeg(path);
+  EXPECT_FALSE(decoded.fractional);
   const Photo photo = DecodePhoto(path);
   EXPECT_FALSE(photo.fractional_codes);
-  EXPECT_EQ(photo.pixels.type(), CV_8UC1);
+  ASSERT_EQ(photo.pixels.type(), CV_8UC1);
+  EXPECT_EQ(cv::norm(photo.pixels, cv::imread(path, cv::IMREAD_UNCHANGED), cv::NORM_INF), 0);
 }
 
 TEST(JpegDecode, TruncatedJpegIsRefusedNamingIt) {

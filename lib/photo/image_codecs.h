@@ -1,0 +1,48 @@
+// PNG and TIFF decoding and PNG, JPEG and TIFF encoding through libpng, libtiff and libjpeg
+// directly, for lib/photo's decoder (photo_io.cc) and writers. Not through OpenCV's imgcodecs:
+// Debian's libopencv_imgcodecs links GDAL and GDCM, and with them ~110 more shared libraries that
+// every process loads at start, ~0.1 s of CPU per process on the development VM (a tool's --help
+// took 0.12 s with it, a program without it 0.012 s). The tests start the tools thousands of
+// times; a lab's batch conversion once per stage and dataset.
+//
+// Images are cv::Mat in OpenCV's conventions, so that the rest of lumislab sees what imread gave:
+// 8-bit or 16-bit codes, 1 or 3 channels, colour in B, G, R order, 16-bit samples in the host's
+// byte order. Decoded images are allocated with NewPhotoImage (huge pages, kept for the next
+// photo of the same size).
+#pragma once
+
+#include <tiffio.h>
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace lumislab {
+
+// A PNG of any colour type and bit depth as stored codes: grey (1 .. 16 bits; below 8 bits
+// scaled to 8) as 1 channel; RGB and palette as 3 (B, G, R); alpha dropped; no gamma applied.
+// A corrupt or truncated file is BadInput naming it and libpng's reason.
+cv::Mat DecodePng(const std::string& path);
+
+// A TIFF's first image of 8-bit or 16-bit unsigned samples, grey (MinIsBlack) as 1 channel or
+// RGB as 3 (B, G, R); extra samples (alpha) dropped; strips or tiles, contiguous or planar, any
+// compression libtiff decodes. Another sample format, bit depth or photometric interpretation is
+// InputError naming the file and the TIFF field; a corrupt file is BadInput with libtiff's reason.
+cv::Mat DecodeTiff(const std::string& path);
+
+// Writes an 8-bit or 16-bit image of 1, 3 or 4 channels (B, G, R, A) to `file` as PNG (grey, RGB
+// or RGBA), compressed for speed (OpenCV's defaults: the Sub filter, zlib level 1, RLE). IoError
+// naming `path` when it cannot.
+void EncodePng(const std::string& file, const cv::Mat& image, const std::string& path);
+
+// An 8-bit image of 1 or 3 channels (B, G, R) as a baseline JFIF JPEG at `quality` (1 .. 100),
+// with libjpeg's defaults (4:2:0 chroma, the islow DCT): the bytes OpenCV's imencode wrote.
+std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality);
+
+// A libtiff handle whose error messages go into `error` (the first one) instead of stderr, and
+// whose warnings are dropped. nullptr when libtiff cannot open the file; closed with the pointer.
+using TiffFile = std::unique_ptr<TIFF, void (*)(TIFF*)>;
+TiffFile OpenTiff(const std::string& path, const char* mode, std::string& error);
+
+}  // namespace lumislab

@@ -1,0 +1,333 @@
+// lib/photo's PNG, TIFF and JPEG codecs (lib/photo/image_codecs.h: libpng, libtiff and libjpeg,
+// not OpenCV's imgcodecs): every layout a camera or an image tool writes decodes to the pixels
+// that were written, in OpenCV's conventions (B, G, R; host byte order), as OpenCV's own decoder
+// gives them; the writers' files read back through OpenCV; the JPEG encoder writes OpenCV's
+// bytes; what lumislab does not read is refused naming the file and the field.
+#include "lib/photo/image_codecs.h"
+
+#include <gtest/gtest.h>
+#include <png.h>
+#include <tiffio.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "lib/photo/photo_io.h"
+#include "photo_test_util.h"
+
+namespace lumislab {
+namespace {
+
+using testing::ScratchDir;
+using testing::ThrowsBadInputNaming;
+
+// A picture whose every sample differs from its neighbours' (rows, columns and channels are told
+// apart), of `type` (8 or 16 bits, 1, 3 or 4 channels, B, G, R, A); 16-bit samples use both bytes.
+cv::Mat Picture(int type, int rows = 37, int cols = 53) {
+  cv::Mat m(rows, cols, type);
+  const int channels = m.channels();
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < cols; ++x)
+      for (int c = 0; c < channels; ++c) {
+        const int v = (x * 7 + y * 131 + c * 61) % 256;
+        if (m.depth() == CV_8U)
+          m.ptr<uint8_t>(y)[x * channels + c] = uint8_t(v);
+        else
+          m.ptr<uint16_t>(y)[x * channels + c] = uint16_t(v * 257 + (x + c) % 200);
+      }
+  return m;
+}
+
+// The first 1 or 3 channels (what the decoder keeps of an image with alpha).
+cv::Mat WithoutAlpha(const cv::Mat& m) {
+  if (m.channels() != 4 && m.channels() != 2) return m;
+  cv::Mat out;
+  std::vector<cv::Mat> planes;
+  cv::split(m, planes);
+  planes.pop_back();
+  cv::merge(planes, out);
+  return out;
+}
+
+::testing::AssertionResult SameImage(const cv::Mat& a, const cv::Mat& b) {
+  if (a.type() != b.type() || a.size() != b.size())
+    return ::testing::AssertionFailure()
+           << "type " << a.type() << " vs " << b.type() << ", " << a.cols << "x" << a.rows << " vs "
+           << b.cols << "x" << b.rows;
+  const double d = cv::norm(a, b, cv::NORM_INF);
+  if (d != 0) return ::testing::AssertionFailure() << "largest difference " << d;
+  return ::testing::AssertionSuccess();
+}
+
+// Writes `bgr` (8 or 16 bits, 1 or 3 channels) with libtiff in a layout OpenCV's writer does not
+// make: tiled or strips, contiguous or planar, in the byte order of `mode` ("w" little, "wb"
+// big-endian), with `extra` alpha samples of 0.
+void WriteTiffLayout(const std::string& path, const cv::Mat& bgr, const char* mode, bool tiled,
+                     bool planar, int extra = 0, uint16_t compression = COMPRESSION_NONE) {
+  TIFF* tif = TIFFOpen(path.c_str(), mode);
+  ASSERT_NE(tif, nullptr);
+  const int channels = bgr.channels(), samples = channels + extra;
+  const int bytes = int(bgr.elemSize1());
+  TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, uint32_t(bgr.cols));
+  TIFFSetField(tif, TIFFTAG_IMAGELENGTH, uint32_t(bgr.rows));
+  TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, bytes * 8);
+  TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, samples);
+  TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, channels == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
+  TIFFSetField(tif, TIFFTAG_PLANARCONFIG, planar ? PLANARCONFIG_SEPARATE : PLANARCONFIG_CONTIG);
+  TIFFSetField(tif, TIFFTAG_COMPRESSION, compression);
+  if (extra) {
+    const uint16_t kinds[1] = {EXTRASAMPLE_UNASSALPHA};
+    TIFFSetField(tif, TIFFTAG_EXTRASAMPLES, uint16_t(1), kinds);
+  }
+  // The value of sample s (R, G, B order in the file) of pixel (x, y).
+  auto sample = [&](int y, int x, int s) -> uint32_t {
+    if (s >= channels) return 0;
+    const int c = channels == 3 ? 2 - s : s;
+    return bytes == 1 ? bgr.ptr<uint8_t>(y)[x * channels + c]
+                      : bgr.ptr<uint16_t>(y)[x * channels + c];
+  };
+  auto put = [&](std::vector<uint8_t>& buf, size_t at, uint32_t v) {
+    if (bytes == 1)
+      buf[at] = uint8_t(v);
+    else
+      std::memcpy(&buf[at * 2], &v, 2);  // host order: libtiff swaps for a big-endian file
+  };
+  const int planes = planar ? samples : 1, stride = planar ? 1 : samples;
+  if (tiled) {
+    const uint32_t tw = 16, th = 16;
+    TIFFSetField(tif, TIFFTAG_TILEWIDTH, tw);
+    TIFFSetField(tif, TIFFTAG_TILELENGTH, th);
+    std::vector<uint8_t> tile(size_t(tw) * th * stride * bytes);
+    for (int p = 0; p < planes; ++p)
+      for (uint32_t ty = 0; ty < uint32_t(bgr.rows); ty += th)
+        for (uint32_t tx = 0; tx < uint32_t(bgr.cols); tx += tw) {
+          std::fill(tile.begin(), tile.end(), 0);
+          for (uint32_t y = 0; y < th && ty + y < uint32_t(bgr.rows); ++y)
+            for (uint32_t x = 0; x < tw && tx + x < uint32_t(bgr.cols); ++x)
+              for (int s = 0; s < stride; ++s)
+                put(tile, (size_t(y) * tw + x) * stride + s,
+                    sample(int(ty + y), int(tx + x), planar ? p : s));
+          ASSERT_GE(TIFFWriteEncodedTile(tif, TIFFComputeTile(tif, tx, ty, 0, uint16_t(p)),
+                                         tile.data(), tmsize_t(tile.size())),
+                    0);
+        }
+  } else {
+    TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, 5);
+    std::vector<uint8_t> line(size_t(bgr.cols) * stride * bytes);
+    for (int p = 0; p < planes; ++p)
+      for (int y = 0; y < bgr.rows; ++y) {
+        for (int x = 0; x < bgr.cols; ++x)
+          for (int s = 0; s < stride; ++s)
+            put(line, size_t(x) * stride + s, sample(y, x, planar ? p : s));
+        ASSERT_EQ(TIFFWriteScanline(tif, line.data(), uint32_t(y), uint16_t(p)), 1);
+      }
+  }
+  TIFFClose(tif);
+}
+
+TEST(ImageCodecs, PngOfEveryDepthAndChannelCountDecodesToItsPixels) {
+  const std::string dir = ScratchDir();
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4}) {
+    const cv::Mat picture = Picture(type);
+    const std::string path = dir + "/p" + std::to_string(type) + ".png";
+    ASSERT_TRUE(cv::imwrite(path, picture));
+    const Photo photo = DecodePhoto(path);
+    EXPECT_TRUE(SameImage(photo.pixels, WithoutAlpha(picture))) << type;
+    EXPECT_TRUE(
+        SameImage(photo.pixels, cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR)))
+        << type;
+  }
+}
+
+// A palette PNG, an interlaced one and a 1-bit grey one (no OpenCV writer makes the first two),
+// through libpng: the codes as OpenCV's decoder expands them.
+TEST(ImageCodecs, PalettedInterlacedAndOneBitPngsAreExpanded) {
+  const std::string dir = ScratchDir();
+  struct Case {
+    const char* name;
+    int colour_type, bit_depth, interlace;
+  };
+  for (const Case& c : {Case{"palette", PNG_COLOR_TYPE_PALETTE, 8, PNG_INTERLACE_NONE},
+                        Case{"adam7", PNG_COLOR_TYPE_RGB, 16, PNG_INTERLACE_ADAM7},
+                        Case{"bilevel", PNG_COLOR_TYPE_GRAY, 1, PNG_INTERLACE_NONE}}) {
+    const std::string path = dir + "/" + c.name + ".png";
+    const int w = 21, h = 13;
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png_create_info_struct(png);
+    png_init_io(png, f);
+    png_set_IHDR(png, info, w, h, c.bit_depth, c.colour_type, c.interlace,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    std::vector<png_color> palette(16);
+    for (int k = 0; k < 16; ++k)
+      palette[k] = {png_byte(k * 16), png_byte(255 - k * 16), png_byte(k * 5)};
+    if (c.colour_type == PNG_COLOR_TYPE_PALETTE)
+      png_set_PLTE(png, info, palette.data(), int(palette.size()));
+    png_write_info(png, info);
+    const int row_bytes = int(png_get_rowbytes(png, info));
+    std::vector<std::vector<png_byte>> rows(h, std::vector<png_byte>(size_t(row_bytes)));
+    cv::Mat expect(h, w,
+                   c.colour_type == PNG_COLOR_TYPE_GRAY ? CV_8UC1
+                   : c.bit_depth == 16                  ? CV_16UC3
+                                                        : CV_8UC3);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (c.colour_type == PNG_COLOR_TYPE_PALETTE) {
+          const int k = (x + 3 * y) % 16;
+          rows[y][x] = png_byte(k);
+          expect.at<cv::Vec3b>(y, x) = {palette[k].blue, palette[k].green, palette[k].red};
+        } else if (c.bit_depth == 1) {
+          const bool on = (x * y + x) % 3 == 0;
+          if (on) rows[y][x / 8] |= png_byte(0x80 >> (x % 8));
+          expect.at<uint8_t>(y, x) = on ? 255 : 0;
+        } else {
+          for (int s = 0; s < 3; ++s) {
+            const uint16_t v = uint16_t(x * 3001 + y * 17 + s * 20011);
+            rows[y][(x * 3 + s) * 2] = png_byte(v >> 8);  // PNG: big-endian
+            rows[y][(x * 3 + s) * 2 + 1] = png_byte(v & 255);
+            expect.at<cv::Vec3w>(y, x)[2 - s] = v;
+          }
+        }
+      }
+    std::vector<png_bytep> pointers;
+    for (auto& r : rows) pointers.push_back(r.data());
+    png_write_image(png, pointers.data());
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+    const Photo photo = DecodePhoto(path);
+    EXPECT_TRUE(SameImage(photo.pixels, expect)) << c.name;
+    EXPECT_TRUE(
+        SameImage(photo.pixels, cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR)))
+        << c.name;
+  }
+}
+
+TEST(ImageCodecs, TiffOfEveryLayoutDecodesToItsPixels) {
+  const std::string dir = ScratchDir();
+  int n = 0;
+  // OpenCV's writer: uncompressed, LZW and Deflate; grey, RGB and RGBA; 8 and 16 bits.
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4})
+    for (int compression : {COMPRESSION_NONE, COMPRESSION_LZW, COMPRESSION_ADOBE_DEFLATE}) {
+      const cv::Mat picture = Picture(type);
+      const std::string path = dir + "/t" + std::to_string(n++) + ".tif";
+      ASSERT_TRUE(cv::imwrite(path, picture, {cv::IMWRITE_TIFF_COMPRESSION, compression}));
+      EXPECT_TRUE(SameImage(DecodePhoto(path).pixels, WithoutAlpha(picture)))
+          << type << " compression " << compression;
+    }
+  // libtiff: tiles, planar (separate) samples, big-endian files, an extra sample, compression.
+  struct Layout {
+    const char* mode;
+    bool tiled, planar;
+    int extra;
+    uint16_t compression;
+  };
+  for (int type : {CV_8UC1, CV_8UC3, CV_16UC1, CV_16UC3})
+    for (const Layout& l : {Layout{"w", true, false, 0, COMPRESSION_NONE},
+                            Layout{"wb", false, false, 0, COMPRESSION_NONE},
+                            Layout{"wb", true, true, 0, COMPRESSION_ADOBE_DEFLATE},
+                            Layout{"w", false, true, 1, COMPRESSION_LZW},
+                            Layout{"wb", false, false, 1, COMPRESSION_NONE}}) {
+      const cv::Mat picture = Picture(type, 41, 35);  // not a whole number of tiles or strips
+      const std::string path = dir + "/t" + std::to_string(n++) + ".tif";
+      WriteTiffLayout(path, picture, l.mode, l.tiled, l.planar, l.extra, l.compression);
+      EXPECT_TRUE(SameImage(DecodePhoto(path).pixels, picture))
+          << type << " " << l.mode << (l.tiled ? " tiled" : " strips")
+          << (l.planar ? " planar" : " contiguous") << " extra " << l.extra;
+    }
+}
+
+TEST(ImageCodecs, WritersFilesReadBackThroughOpenCv) {
+  const std::string dir = ScratchDir();
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4})
+    for (const char* ext : {".png", ".tif"}) {
+      const cv::Mat picture = Picture(type);
+      const std::string path = dir + "/w" + std::to_string(type) + ext;
+      WriteImageFile(path, picture);
+      // (OpenCV reads an 8-bit RGBA TIFF through libtiff's RGBA interface, which premultiplies
+      // the alpha: that one is not compared.)
+      if (!(type == CV_8UC4 && std::string(ext) == ".tif")) {
+        EXPECT_TRUE(SameImage(cv::imread(path, cv::IMREAD_UNCHANGED), picture)) << type << ext;
+      }
+      EXPECT_TRUE(SameImage(DecodePhoto(path).pixels, WithoutAlpha(picture))) << type << ext;
+    }
+}
+
+// The same encoder settings as OpenCV's (libjpeg's defaults at the quality): the same bytes, so
+// the synthetic camera's JPEG photos did not change when the writer did.
+TEST(ImageCodecs, JpegEncoderWritesOpenCvsBytes) {
+  for (int type : {CV_8UC1, CV_8UC3})
+    for (int quality : {40, 75, 95, 100}) {
+      const cv::Mat picture = Picture(type, 67, 91);
+      std::vector<unsigned char> opencv;
+      ASSERT_TRUE(cv::imencode(".jpg", picture, opencv, {cv::IMWRITE_JPEG_QUALITY, quality}));
+      EXPECT_TRUE(EncodeJpeg(picture, quality) == opencv) << type << " quality " << quality;
+    }
+  const std::string path = ScratchDir() + "/q.jpg";
+  WriteImageFile(path, Picture(CV_8UC3), 80);
+  std::vector<unsigned char> opencv;
+  ASSERT_TRUE(cv::imencode(".jpg", Picture(CV_8UC3), opencv, {cv::IMWRITE_JPEG_QUALITY, 80}));
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<unsigned char> file((std::istreambuf_iterator<char>(in)),
+                                        std::istreambuf_iterator<char>());
+  EXPECT_TRUE(file == opencv);
+}
+
+// What lumislab does not read is refused before any pixel is used, naming the file and the TIFF
+// field; a damaged file names the file and what the library found.
+TEST(ImageCodecs, UnreadableTiffsAndDamagedPngsAreRefusedNamingTheFileAndField) {
+  const std::string dir = ScratchDir();
+  auto refused = [&](const std::string& path, const std::string& field) {
+    std::string message;
+    EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(path); }, path, &message)) << path;
+    EXPECT_NE(message.find(field), std::string::npos) << message;
+  };
+  const std::string float_tiff = dir + "/float.tif";
+  ASSERT_TRUE(cv::imwrite(float_tiff, cv::Mat(8, 8, CV_32FC1, cv::Scalar(0.5))));
+  refused(float_tiff, "SampleFormat");
+  const std::string palette_tiff = dir + "/palette.tif";
+  {
+    TIFF* tif = TIFFOpen(palette_tiff.c_str(), "w");
+    ASSERT_NE(tif, nullptr);
+    TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, 4u);
+    TIFFSetField(tif, TIFFTAG_IMAGELENGTH, 2u);
+    TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 8);
+    TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 1);
+    TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_PALETTE);
+    std::vector<uint16_t> map(256, 1000);
+    TIFFSetField(tif, TIFFTAG_COLORMAP, map.data(), map.data(), map.data());
+    uint8_t row[4] = {0, 1, 2, 3};
+    for (uint32_t y = 0; y < 2; ++y) TIFFWriteScanline(tif, row, y, 0);
+    TIFFClose(tif);
+  }
+  refused(palette_tiff, "PhotometricInterpretation");
+  const std::string bilevel_tiff = dir + "/bilevel.tif";
+  ASSERT_TRUE(cv::imwrite(bilevel_tiff, Picture(CV_8UC3), {cv::IMWRITE_TIFF_COMPRESSION, 5}));
+  {
+    // The same file cut short: libtiff's message, the file named.
+    const auto size = std::filesystem::file_size(bilevel_tiff);
+    std::filesystem::resize_file(bilevel_tiff, size / 2);
+  }
+  refused(bilevel_tiff, "TIFF");
+  const std::string damaged_png = dir + "/damaged.png";
+  ASSERT_TRUE(cv::imwrite(damaged_png, Picture(CV_16UC3)));
+  {
+    // One byte of the image data changed: the chunk's CRC no longer matches.
+    std::fstream f(damaged_png, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(60);
+    f.put(char(0x5a));
+  }
+  refused(damaged_png, "PNG");
+}
+
+}  // namespace
+}  // namespace lumislab

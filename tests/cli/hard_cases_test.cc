@@ -892,7 +892,9 @@ TEST(HardCases, SrgbeAtItsEdges) {
       EXPECT_LE(bound, std::max(std::ldexp(1.0f, -136), 32 * x / 127.5f));
       for (int c = 0; c < 3; ++c) {
         EXPECT_LE(std::abs(out[c] - in[c]), bound) << "2^" << k << " channel " << c;
-        if (out[c] != 0) EXPECT_EQ(std::signbit(out[c]), std::signbit(in[c])) << "2^" << k;
+        if (out[c] != 0) {
+          EXPECT_EQ(std::signbit(out[c]), std::signbit(in[c])) << "2^" << k;
+        }
       }
     }
     if (k < -136) {

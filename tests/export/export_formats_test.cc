@@ -313,8 +313,8 @@ TEST_P(MeasuredEmitterCapture, RoundTripsThroughACapture) {
 
 INSTANTIATE_TEST_SUITE_P(RealIesFiles, MeasuredEmitterCapture,
                          ::testing::Values("1.ies", "3.ies", "5.ies", "7.ies"),
-                         [](const ::testing::TestParamInfo<const char*>& info) {
-                           return "file" + std::string(info.param).substr(0, 1);
+                         [](const ::testing::TestParamInfo<const char*>& file) {
+                           return "file" + std::string(file.param).substr(0, 1);
                          });
 
 }  // namespace

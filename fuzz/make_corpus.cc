@@ -6,11 +6,14 @@
 // the reference is truth/reference.json's form); fuzz_camera_calibration's seed is
 // lumislab-calibrate camera's output on tests/data/chessboard-opencv-left, photo folder
 // stripped). Rerun it when a file format changes.
+#include <tiffio.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/dataset.h"
@@ -198,6 +201,51 @@ void Calibrations(const std::string& scratch) {
   Take(scratch + "/screen.json", "fuzz_screen_calibration", "camera_pose.json");
 }
 
+// A 16-bit RGB TIFF in a layout lumislab's writer does not make (libtiff directly): tiled or
+// strips of 2 rows, planar (one plane per sample) or contiguous, compressed: the decoder's other
+// read paths (lib/photo/image_codecs.cc).
+void LayoutTiff(const std::string& path, bool tiled, bool planar, uint16_t compression) {
+  TIFF* tif = TIFFOpen(path.c_str(), "wb");  // big-endian: the samples are swapped on reading
+  if (!tif) throw IoError(path, "cannot create the file");
+  const uint32_t w = 20, h = 6, tile = 16;
+  TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, w);
+  TIFFSetField(tif, TIFFTAG_IMAGELENGTH, h);
+  TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 16);
+  TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 3);
+  TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_RGB);
+  TIFFSetField(tif, TIFFTAG_PLANARCONFIG, planar ? PLANARCONFIG_SEPARATE : PLANARCONFIG_CONTIG);
+  TIFFSetField(tif, TIFFTAG_COMPRESSION, compression);
+  const int stride = planar ? 1 : 3;
+  auto value = [](uint32_t x, uint32_t y, int s) {
+    return uint16_t(x * 3000 + y * 700 + s * 9000);
+  };
+  if (tiled) {
+    TIFFSetField(tif, TIFFTAG_TILEWIDTH, tile);
+    TIFFSetField(tif, TIFFTAG_TILELENGTH, tile);
+    std::vector<uint16_t> buf(size_t(tile) * tile * stride, 0);
+    for (int p = 0; p < (planar ? 3 : 1); ++p)
+      for (uint32_t tx = 0; tx < w; tx += tile) {
+        for (uint32_t y = 0; y < tile; ++y)
+          for (uint32_t x = 0; x < tile; ++x)
+            for (int s = 0; s < stride; ++s)
+              buf[(size_t(y) * tile + x) * stride + s] = value(tx + x, y, planar ? p : s);
+        TIFFWriteEncodedTile(tif, TIFFComputeTile(tif, tx, 0, 0, uint16_t(p)), buf.data(),
+                             tmsize_t(buf.size() * 2));
+      }
+  } else {
+    TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, 2);
+    std::vector<uint16_t> row(size_t(w) * stride);
+    for (int p = 0; p < (planar ? 3 : 1); ++p)
+      for (uint32_t y = 0; y < h; ++y) {
+        for (uint32_t x = 0; x < w; ++x)
+          for (int s = 0; s < stride; ++s)
+            row[size_t(x) * stride + s] = value(x, y, planar ? p : s);
+        TIFFWriteScanline(tif, row.data(), y, uint16_t(p));
+      }
+  }
+  TIFFClose(tif);
+}
+
 void Photos() {
   const std::string d = Dir("fuzz_photo");
   const ImageF rgb = Gradient(8, 6, 3), gray = Gradient(8, 6, 1);
@@ -216,6 +264,9 @@ void Photos() {
   WriteImageFile(d + "/bgra8.png", bgra);
   WriteImageFile(d + "/gray8.jpg", g8);
   WriteImageFile(d + "/bgra8.tif", bgra);
+  WritePhoto(d + "/curve8.jpg", rgb, PhotoEncoding::kCurve8Jpeg, 90);
+  LayoutTiff(d + "/tiled_planar_deflate16.tif", true, true, COMPRESSION_ADOBE_DEFLATE);
+  LayoutTiff(d + "/strips_lzw16.tif", false, false, COMPRESSION_LZW);
 }
 
 void SlabPositions(const std::string& scratch) {

@@ -15,6 +15,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "lib/photo/image_codecs.h"
+#include "lib/photo/jpeg_decode.h"
 
 namespace lumislab {
 namespace {

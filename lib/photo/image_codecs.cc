@@ -1,6 +1,5 @@
 #include "lib/photo/image_codecs.h"
 
-#include <jpeglib.h>
 #include <png.h>
 #include <zlib.h>
 
@@ -67,19 +66,6 @@ void CopySamples(const uint8_t* in, int samples, int channels, int bytes, int pi
 template <typename T>
 void SwapRedBlue(T* rgb, uint32_t pixels) {
   for (uint32_t x = 0; x < pixels; ++x) std::swap(rgb[3 * size_t(x)], rgb[3 * size_t(x) + 2]);
-}
-
-// ---- JPEG ----
-
-struct JpegErrorManager {
-  jpeg_error_mgr base;
-  std::jmp_buf jump;
-  char message[JMSG_LENGTH_MAX];
-};
-void JpegErrorExit(j_common_ptr info) {
-  auto* error = reinterpret_cast<JpegErrorManager*>(info->err);
-  info->err->format_message(info, error->message);
-  std::longjmp(error->jump, 1);
 }
 
 }  // namespace
@@ -262,41 +248,6 @@ cv::Mat DecodeTiff(const std::string& path) {
         }
       }
   }
-  return out;
-}
-
-std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality) {
-  LUMISLAB_CHECK((image.type() == CV_8UC3 || image.type() == CV_8UC1) && !image.empty(),
-                 "EncodeJpeg: an 8-bit image of 1 or 3 channels");
-  LUMISLAB_CHECK(quality >= 1 && quality <= 100, "EncodeJpeg: quality in [1, 100]");
-  jpeg_compress_struct info;
-  JpegErrorManager error;
-  info.err = jpeg_std_error(&error.base);
-  error.base.error_exit = JpegErrorExit;
-  unsigned char* buffer = nullptr;
-  unsigned long size = 0;
-  if (setjmp(error.jump)) {
-    jpeg_destroy_compress(&info);
-    std::free(buffer);
-    throw Failure(std::string("libjpeg: cannot encode the JPEG: ") + error.message);
-  }
-  jpeg_create_compress(&info);
-  jpeg_mem_dest(&info, &buffer, &size);
-  info.image_width = JDIMENSION(image.cols);
-  info.image_height = JDIMENSION(image.rows);
-  info.input_components = image.channels();
-  info.in_color_space = image.channels() == 3 ? JCS_EXT_BGR : JCS_GRAYSCALE;
-  jpeg_set_defaults(&info);
-  jpeg_set_quality(&info, quality, TRUE);
-  jpeg_start_compress(&info, TRUE);
-  while (info.next_scanline < info.image_height) {
-    JSAMPROW row = const_cast<JSAMPROW>(image.ptr(int(info.next_scanline)));
-    jpeg_write_scanlines(&info, &row, 1);
-  }
-  jpeg_finish_compress(&info);
-  std::vector<unsigned char> out(buffer, buffer + size);
-  jpeg_destroy_compress(&info);
-  std::free(buffer);
   return out;
 }
 

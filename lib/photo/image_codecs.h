@@ -1,9 +1,9 @@
-// PNG and TIFF decoding and PNG, JPEG and TIFF encoding through libpng, libtiff and libjpeg
-// directly, for lib/photo's decoder (photo_io.cc) and writers. Not through OpenCV's imgcodecs:
-// Debian's libopencv_imgcodecs links GDAL and GDCM, and with them ~110 more shared libraries that
-// every process loads at start, ~0.1 s of CPU per process on the development VM (a tool's --help
-// took 0.12 s with it, a program without it 0.012 s). The tests start the tools thousands of
-// times; a lab's batch conversion once per stage and dataset.
+// PNG and TIFF decoding and encoding through libpng and libtiff directly, for lib/photo's decoder
+// (photo_io.cc) and writers; JPEG through libjpeg is in jpeg_decode.h. Not through OpenCV's
+// imgcodecs: Debian's libopencv_imgcodecs links GDAL and GDCM, and with them ~110 more shared
+// libraries that every process loads at start, ~0.1 s of CPU per process on the development VM (a
+// tool's --help took 0.12 s with it, a program without it 0.012 s). The tests start the tools
+// thousands of times; a lab's batch conversion once per stage and dataset.
 //
 // Images are cv::Mat in OpenCV's conventions, so that the rest of lumislab sees what imread gave:
 // 8-bit or 16-bit codes, 1 or 3 channels, colour in B, G, R order, 16-bit samples in the host's
@@ -35,10 +35,6 @@ cv::Mat DecodeTiff(const std::string& path);
 // or RGBA), compressed for speed (OpenCV's defaults: the Sub filter, zlib level 1, RLE). IoError
 // naming `path` when it cannot.
 void EncodePng(const std::string& file, const cv::Mat& image, const std::string& path);
-
-// An 8-bit image of 1 or 3 channels (B, G, R) as a baseline JFIF JPEG at `quality` (1 .. 100),
-// with libjpeg's defaults (4:2:0 chroma, the islow DCT): the bytes OpenCV's imencode wrote.
-std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality);
 
 // A libtiff handle whose error messages go into `error` (the first one) instead of stderr, and
 // whose warnings are dropped. nullptr when libtiff cannot open the file; closed with the pointer.

@@ -4,6 +4,7 @@
 
 #include <csetjmp>
 #include <cstdio>
+#include <cstdlib>
 // jerror.h after jpeglib.h, which it needs
 #include <jerror.h>
 #include <libexif/exif-data.h>
@@ -159,6 +160,41 @@ DecodedJpeg DecodeJpeg(const std::string& path) {
   jpeg_finish_decompress(&info);
   jpeg_destroy_decompress(&info);
   Orient(orientation, out.pixels);
+  return out;
+}
+
+std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality) {
+  LUMISLAB_CHECK((image.type() == CV_8UC3 || image.type() == CV_8UC1) && !image.empty(),
+                 "EncodeJpeg: an 8-bit image of 1 or 3 channels");
+  LUMISLAB_CHECK(quality >= 1 && quality <= 100, "EncodeJpeg: quality in [1, 100]");
+  jpeg_compress_struct info;
+  ErrorManager error;
+  info.err = jpeg_std_error(&error.base);
+  error.base.error_exit = ErrorExit;
+  unsigned char* buffer = nullptr;
+  unsigned long size = 0;
+  if (setjmp(error.jump)) {
+    jpeg_destroy_compress(&info);
+    std::free(buffer);
+    throw Failure(std::string("libjpeg: cannot encode the JPEG: ") + error.message);
+  }
+  jpeg_create_compress(&info);
+  jpeg_mem_dest(&info, &buffer, &size);
+  info.image_width = JDIMENSION(image.cols);
+  info.image_height = JDIMENSION(image.rows);
+  info.input_components = image.channels();
+  info.in_color_space = image.channels() == 3 ? JCS_EXT_BGR : JCS_GRAYSCALE;
+  jpeg_set_defaults(&info);
+  jpeg_set_quality(&info, quality, TRUE);
+  jpeg_start_compress(&info, TRUE);
+  while (info.next_scanline < info.image_height) {
+    JSAMPROW row = const_cast<JSAMPROW>(image.ptr(int(info.next_scanline)));
+    jpeg_write_scanlines(&info, &row, 1);
+  }
+  jpeg_finish_compress(&info);
+  std::vector<unsigned char> out(buffer, buffer + size);
+  jpeg_destroy_compress(&info);
+  std::free(buffer);
   return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 namespace lumislab {
 
@@ -24,5 +25,9 @@ struct DecodedJpeg {
   bool fractional = false;
 };
 DecodedJpeg DecodeJpeg(const std::string& path);
+
+// An 8-bit image of 1 or 3 channels (B, G, R) as a baseline JFIF JPEG at `quality` (1 .. 100),
+// with libjpeg's defaults (4:2:0 chroma, the islow DCT): the bytes OpenCV's imencode wrote.
+std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality);
 
 }  // namespace lumislab

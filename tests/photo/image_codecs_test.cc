@@ -1,7 +1,7 @@
-// lib/photo's PNG, TIFF and JPEG codecs (lib/photo/image_codecs.h: libpng, libtiff and libjpeg,
-// not OpenCV's imgcodecs): every layout a camera or an image tool writes decodes to the pixels
-// that were written, in OpenCV's conventions (B, G, R; host byte order), as OpenCV's own decoder
-// gives them; the writers' files read back through OpenCV; the JPEG encoder writes OpenCV's
+// lib/photo's PNG, TIFF and JPEG codecs (lib/photo/image_codecs.h, jpeg_decode.h: libpng, libtiff
+// and libjpeg, not OpenCV's imgcodecs): every layout a camera or an image tool writes decodes to
+// the pixels that were written, in OpenCV's conventions (B, G, R; host byte order), as OpenCV's own
+// decoder gives them; the writers' files read back through OpenCV; the JPEG encoder writes OpenCV's
 // bytes; what lumislab does not read is refused naming the file and the field.
 #include "lib/photo/image_codecs.h"
 
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "lib/photo/jpeg_decode.h"
 #include "lib/photo/photo_io.h"
 #include "photo_test_util.h"
 

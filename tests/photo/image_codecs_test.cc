@@ -6,10 +6,12 @@
 #include "lib/photo/image_codecs.h"
 
 #include <gtest/gtest.h>
+#include <jpeglib.h>
 #include <png.h>
 #include <tiffio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -281,6 +283,64 @@ TEST(ImageCodecs, JpegEncoderWritesOpenCvsBytes) {
   const std::vector<unsigned char> file((std::istreambuf_iterator<char>(in)),
                                         std::istreambuf_iterator<char>());
   EXPECT_TRUE(file == opencv);
+}
+
+// Writes `pixels` (8-bit, `components` interleaved samples per pixel in the file's order) as a
+// JPEG whose components are stored in `space` (libjpeg converts nothing: in = out space).
+void WriteJpegIn(const std::string& path, const std::vector<uint8_t>& pixels, int w, int h,
+                 int components, J_COLOR_SPACE space) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr);
+  jpeg_compress_struct c;
+  jpeg_error_mgr error;
+  c.err = jpeg_std_error(&error);
+  jpeg_create_compress(&c);
+  jpeg_stdio_dest(&c, f);
+  c.image_width = JDIMENSION(w);
+  c.image_height = JDIMENSION(h);
+  c.input_components = components;
+  c.in_color_space = space;
+  jpeg_set_defaults(&c);
+  jpeg_set_colorspace(&c, space);
+  jpeg_set_quality(&c, 100, TRUE);
+  jpeg_start_compress(&c, TRUE);
+  for (int y = 0; y < h; ++y) {
+    JSAMPROW row = const_cast<JSAMPROW>(&pixels[size_t(y) * w * components]);
+    jpeg_write_scanlines(&c, &row, 1);
+  }
+  jpeg_finish_compress(&c);
+  jpeg_destroy_compress(&c);
+  std::fclose(f);
+}
+
+// A JPEG whose components are R, G, B (an Adobe-marked file) gives its codes as stored, as
+// OpenCV's decoder does; a CMYK one is refused naming the colour space.
+TEST(ImageCodecs, RgbCodedJpegGivesItsCodesAndCmykIsRefused) {
+  const std::string dir = ScratchDir();
+  const int w = 24, h = 16;
+  std::vector<uint8_t> rgb(size_t(w) * h * 3), cmyk(size_t(w) * h * 4);
+  for (int k = 0; k < w * h; ++k) {
+    for (int s = 0; s < 3; ++s) rgb[size_t(k) * 3 + s] = uint8_t(40 + 60 * s + (k % w) * 3);
+    for (int s = 0; s < 4; ++s) cmyk[size_t(k) * 4 + s] = uint8_t(20 * s + k % 50);
+  }
+  const std::string rgb_path = dir + "/rgb.jpg", cmyk_path = dir + "/cmyk.jpg";
+  WriteJpegIn(rgb_path, rgb, w, h, 3, JCS_RGB);
+  WriteJpegIn(cmyk_path, cmyk, w, h, 4, JCS_CMYK);
+  const DecodedJpeg decoded = DecodeJpeg(rgb_path);
+  EXPECT_FALSE(decoded.fractional);
+  ASSERT_EQ(decoded.pixels.type(), CV_8UC3);
+  EXPECT_TRUE(SameImage(decoded.pixels, cv::imread(rgb_path, cv::IMREAD_COLOR)));
+  // Quality 100 without chroma subsampling of R, G, B: each code within a few of the written one.
+  double worst = 0;
+  for (int k = 0; k < w * h; ++k)
+    for (int s = 0; s < 3; ++s)
+      worst = std::max(worst, std::abs(double(decoded.pixels.at<cv::Vec3b>(k / w, k % w)[2 - s]) -
+                                       rgb[size_t(k) * 3 + s]));
+  EXPECT_LE(worst, 4);
+  std::string message;
+  EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(cmyk_path); }, cmyk_path, &message));
+  EXPECT_NE(message.find("colour space"), std::string::npos) << message;
+  EXPECT_NE(message.find("CMYK"), std::string::npos) << message;
 }
 
 // What lumislab does not read is refused before any pixel is used, naming the file and the TIFF

@@ -22,6 +22,9 @@ struct CloseCodecFile {
 using CodecFile = std::unique_ptr<std::FILE, CloseCodecFile>;
 
 constexpr bool kLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+// Samples per pixel a TIFF may have (R, G, B and extra samples; libtiff allows 65535, and a
+// scanline buffer grows with them).
+constexpr int kMaxTiffSamples = 16;
 
 // ---- PNG ----
 
@@ -38,6 +41,19 @@ void PngError(png_structp png, png_const_charp message) {
   png_longjmp(png, 1);
 }
 void PngWarning(png_structp, png_const_charp) {}
+
+// libpng's structs, destroyed with the guard (also when a C++ exception leaves, e.g. from an
+// allocation): declared before the setjmp and not changed after it.
+struct PngReader {
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  ~PngReader() { png_destroy_read_struct(&png, info ? &info : nullptr, nullptr); }
+};
+struct PngWriter {
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  ~PngWriter() { png_destroy_write_struct(&png, info ? &info : nullptr); }
+};
 
 // ---- TIFF ----
 
@@ -74,44 +90,42 @@ cv::Mat DecodePng(const std::string& path) {
   CodecFile file(std::fopen(path.c_str(), "rb"));
   if (!file) throw BadInput(path + ": cannot open the photo");
   PngMessage message;
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &message, PngError, PngWarning);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!info) {
-    png_destroy_read_struct(&png, nullptr, nullptr);
-    throw Failure("libpng: out of memory");
-  }
+  PngReader reader;  // created before the setjmp and not changed after it: destroys the structs
+  reader.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &message, PngError, PngWarning);
+  reader.info = reader.png ? png_create_info_struct(reader.png) : nullptr;
+  if (!reader.info) throw Failure("libpng: out of memory");
+  png_structp png = reader.png;
+  png_infop info = reader.info;
   cv::Mat out;  // created before the setjmp: a jump back leaves them to their destructors
   std::vector<png_bytep> rows;
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_read_struct(&png, &info, nullptr);
+  if (setjmp(png_jmpbuf(png)))
     throw BadInput(path + ": cannot decode the PNG (" + message.text + ")");
-  }
   png_init_io(png, file.get());
   png_read_info(png, info);
   png_uint_32 width = 0, height = 0;
   int bit_depth = 0, colour_type = 0;
   png_get_IHDR(png, info, &width, &height, &bit_depth, &colour_type, nullptr, nullptr, nullptr);
-  if (uint64_t(width) * height > uint64_t(kMaxPhotoPixels)) {
-    png_destroy_read_struct(&png, &info, nullptr);
+  if (uint64_t(width) * height > uint64_t(kMaxPhotoPixels))
     throw InputError(path, "IHDR",
                      "an image of 1 .. " + std::to_string(kMaxPhotoPixels) + " pixels",
                      std::to_string(width) + "x" + std::to_string(height));
-  }
   if (colour_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
   if (colour_type == PNG_COLOR_TYPE_GRAY && bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
-  if (colour_type & PNG_COLOR_MASK_ALPHA) png_set_strip_alpha(png);
+  // Alpha, and the alpha a palette's transparency (tRNS) becomes when it is expanded, dropped.
+  if ((colour_type & PNG_COLOR_MASK_ALPHA) || png_get_valid(png, info, PNG_INFO_tRNS))
+    png_set_strip_alpha(png);
   if (bit_depth == 16 && kLittleEndian) png_set_swap(png);  // PNG stores big-endian samples
   if (colour_type & PNG_COLOR_MASK_COLOR) png_set_bgr(png);
   png_set_interlace_handling(png);
   png_read_update_info(png, info);
   const int channels = png_get_channels(png, info);
   const int depth = png_get_bit_depth(png, info) == 16 ? CV_16U : CV_8U;
+  if (channels != 1 && channels != 3) png_error(png, "unexpected channel count after expansion");
   out = NewPhotoImage(int(height), int(width), CV_MAKETYPE(depth, channels));
   rows.resize(height);
   for (png_uint_32 y = 0; y < height; ++y) rows[y] = out.ptr(int(y));
   png_read_image(png, rows.data());
   png_read_end(png, nullptr);  // the chunks after the image data, to IEND
-  png_destroy_read_struct(&png, &info, nullptr);
   return out;
 }
 
@@ -122,16 +136,14 @@ void EncodePng(const std::string& file_name, const cv::Mat& image, const std::st
   CodecFile file(std::fopen(file_name.c_str(), "wb"));
   if (!file) throw IoError(path, "cannot create the file");
   PngMessage message;
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, PngError, PngWarning);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!info) {
-    png_destroy_write_struct(&png, nullptr);
-    throw Failure("libpng: out of memory");
-  }
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
+  PngWriter writer;
+  writer.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, PngError, PngWarning);
+  writer.info = writer.png ? png_create_info_struct(writer.png) : nullptr;
+  if (!writer.info) throw Failure("libpng: out of memory");
+  png_structp png = writer.png;
+  png_infop info = writer.info;
+  if (setjmp(png_jmpbuf(png)))
     throw IoError(path, std::string("cannot write the PNG: ") + message.text);
-  }
   png_init_io(png, file.get());
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
   png_set_compression_level(png, Z_BEST_SPEED);
@@ -148,9 +160,9 @@ void EncodePng(const std::string& file_name, const cv::Mat& image, const std::st
   if (channels >= 3) png_set_bgr(png);
   for (int y = 0; y < image.rows; ++y) png_write_row(png, image.ptr(y));
   png_write_end(png, info);
-  png_destroy_write_struct(&png, &info);
   std::FILE* f = file.release();
-  if (std::ferror(f) || std::fclose(f) != 0) throw IoError(path, "cannot write the PNG");
+  const bool failed = std::ferror(f) != 0;
+  if (std::fclose(f) != 0 || failed) throw IoError(path, "cannot write the PNG");
 }
 
 TiffFile OpenTiff(const std::string& path, const char* mode, std::string& error) {
@@ -189,6 +201,13 @@ cv::Mat DecodeTiff(const std::string& path) {
     throw InputError(path, "SampleFormat", "unsigned integers (1)", std::to_string(format));
   if (bits != 8 && bits != 16)
     throw InputError(path, "BitsPerSample", "8 or 16", std::to_string(bits));
+  if (samples > kMaxTiffSamples)
+    throw InputError(path, "SamplesPerPixel", "1 .. " + std::to_string(kMaxTiffSamples),
+                     std::to_string(samples));
+  // A JPEG-compressed TIFF stores Y, Cb, Cr: libtiff's JPEG codec converts them to R, G, B.
+  if (photometric == PHOTOMETRIC_YCBCR && compression == COMPRESSION_JPEG && bits == 8 &&
+      samples == 3 && TIFFSetField(tif, TIFFTAG_JPEGCOLORMODE, JPEGCOLORMODE_RGB))
+    photometric = PHOTOMETRIC_RGB;
   const bool rgb = photometric == PHOTOMETRIC_RGB && samples >= 3;
   if (!rgb && !(photometric == PHOTOMETRIC_MINISBLACK && samples >= 1))
     throw InputError(
@@ -214,9 +233,14 @@ cv::Mat DecodeTiff(const std::string& path) {
   const int planes = contiguous ? 1 : channels;
   if (TIFFIsTiled(tif)) {
     uint32_t tw = 0, th = 0;
+    // A tile larger than the image (padded to whole tiles of 16) or than a few megapixels is
+    // refused before its buffer is allocated: the sizes are the file's claim.
+    const uint64_t cap = std::max<uint64_t>(uint64_t(width + 15) * (height + 15), 1 << 22);
     if (!TIFFGetField(tif, TIFFTAG_TILEWIDTH, &tw) || !TIFFGetField(tif, TIFFTAG_TILELENGTH, &th) ||
-        tw == 0 || th == 0)
-      throw InputError(path, "TileWidth, TileLength", "tile sizes > 0", "none");
+        tw == 0 || th == 0 || uint64_t(tw) * th > cap)
+      throw InputError(path, "TileWidth, TileLength",
+                       "tiles of 1 .. " + std::to_string(cap) + " pixels",
+                       std::to_string(tw) + "x" + std::to_string(th));
     const tmsize_t tile_bytes = TIFFTileSize(tif);
     if (tile_bytes <= 0 || uint64_t(tile_bytes) < uint64_t(tw) * th * stride * bytes)
       throw corrupt();
@@ -248,7 +272,41 @@ cv::Mat DecodeTiff(const std::string& path) {
         }
       }
   }
+  uint16_t orientation = ORIENTATION_TOPLEFT;
+  TIFFGetFieldDefaulted(tif, TIFFTAG_ORIENTATION, &orientation);
+  ApplyOrientation(orientation, out);
   return out;
+}
+
+void ApplyOrientation(int orientation, cv::Mat& image) {
+  switch (orientation) {
+    case 2:
+      cv::flip(image, image, 1);
+      break;
+    case 3:
+      cv::flip(image, image, -1);
+      break;
+    case 4:
+      cv::flip(image, image, 0);
+      break;
+    case 5:
+      cv::transpose(image, image);
+      break;
+    case 6:
+      cv::transpose(image, image);
+      cv::flip(image, image, 1);
+      break;
+    case 7:
+      cv::transpose(image, image);
+      cv::flip(image, image, -1);
+      break;
+    case 8:
+      cv::transpose(image, image);
+      cv::flip(image, image, 0);
+      break;
+    default:
+      break;
+  }
 }
 
 }  // namespace lumislab

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "lib/photo/image_codecs.h"
 #include "lib/photo/photo_io.h"
 
 namespace lumislab {
@@ -55,38 +56,6 @@ int Orientation(j_decompress_ptr info) {
     return orientation >= 1 && orientation <= 8 ? orientation : 1;
   }
   return 1;
-}
-
-// The orientation as OpenCV's imread applies it (modules/imgcodecs ExifTransform).
-void Orient(int orientation, cv::Mat& image) {
-  switch (orientation) {
-    case 2:
-      cv::flip(image, image, 1);
-      break;
-    case 3:
-      cv::flip(image, image, -1);
-      break;
-    case 4:
-      cv::flip(image, image, 0);
-      break;
-    case 5:
-      cv::transpose(image, image);
-      break;
-    case 6:
-      cv::transpose(image, image);
-      cv::flip(image, image, 1);
-      break;
-    case 7:
-      cv::transpose(image, image);
-      cv::flip(image, image, -1);
-      break;
-    case 8:
-      cv::transpose(image, image);
-      cv::flip(image, image, 0);
-      break;
-    default:
-      break;
-  }
 }
 
 struct FileCloser {
@@ -159,7 +128,7 @@ DecodedJpeg DecodeJpeg(const std::string& path) {
   }
   jpeg_finish_decompress(&info);
   jpeg_destroy_decompress(&info);
-  Orient(orientation, out.pixels);
+  ApplyOrientation(orientation, out.pixels);
   return out;
 }
 
@@ -171,11 +140,15 @@ std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality) {
   ErrorManager error;
   info.err = jpeg_std_error(&error.base);
   error.base.error_exit = ErrorExit;
-  unsigned char* buffer = nullptr;
-  unsigned long size = 0;
+  // libjpeg writes into `initial` (big enough for most images at once); when it needs more it
+  // allocates a buffer of its own, which it never frees, and which `buffer` names only after
+  // jpeg_finish_compress. So an error (out of memory) leaves that one, never a buffer freed
+  // twice.
+  std::vector<unsigned char> initial(size_t(image.total() * image.elemSize()) / 2 + 65536);
+  unsigned char* buffer = initial.data();
+  unsigned long size = initial.size();
   if (setjmp(error.jump)) {
     jpeg_destroy_compress(&info);
-    std::free(buffer);
     throw Failure(std::string("libjpeg: cannot encode the JPEG: ") + error.message);
   }
   jpeg_create_compress(&info);
@@ -194,7 +167,7 @@ std::vector<unsigned char> EncodeJpeg(const cv::Mat& image, int quality) {
   jpeg_finish_compress(&info);
   std::vector<unsigned char> out(buffer, buffer + size);
   jpeg_destroy_compress(&info);
-  std::free(buffer);
+  if (buffer != initial.data()) std::free(buffer);
   return out;
 }
 

@@ -74,7 +74,8 @@ cv::Mat WithoutAlpha(const cv::Mat& m) {
 // make: tiled or strips, contiguous or planar, in the byte order of `mode` ("w" little, "wb"
 // big-endian), with `extra` alpha samples of 0.
 void WriteTiffLayout(const std::string& path, const cv::Mat& bgr, const char* mode, bool tiled,
-                     bool planar, int extra = 0, uint16_t compression = COMPRESSION_NONE) {
+                     bool planar, int extra = 0, uint16_t compression = COMPRESSION_NONE,
+                     uint16_t orientation = ORIENTATION_TOPLEFT) {
   TIFF* tif = TIFFOpen(path.c_str(), mode);
   ASSERT_NE(tif, nullptr);
   const int channels = bgr.channels(), samples = channels + extra;
@@ -86,6 +87,7 @@ void WriteTiffLayout(const std::string& path, const cv::Mat& bgr, const char* mo
   TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, channels == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
   TIFFSetField(tif, TIFFTAG_PLANARCONFIG, planar ? PLANARCONFIG_SEPARATE : PLANARCONFIG_CONTIG);
   TIFFSetField(tif, TIFFTAG_COMPRESSION, compression);
+  TIFFSetField(tif, TIFFTAG_ORIENTATION, orientation);
   if (extra) {
     const uint16_t kinds[1] = {EXTRASAMPLE_UNASSALPHA};
     TIFFSetField(tif, TIFFTAG_EXTRASAMPLES, uint16_t(1), kinds);
@@ -285,6 +287,163 @@ TEST(ImageCodecs, JpegEncoderWritesOpenCvsBytes) {
   EXPECT_TRUE(file == opencv);
 }
 
+// Sets the value of the first IFD's entry for `tag` (a classic little-endian TIFF, a SHORT or
+// LONG value held in the entry) to `value`: a file whose header claims what libtiff would not
+// write.
+void PatchTiffTag(const std::string& path, uint16_t tag, uint32_t value) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  auto read = [&](std::streamoff at, int n) {
+    uint32_t v = 0;
+    f.seekg(at);
+    for (int k = 0; k < n; ++k) v |= uint32_t(uint8_t(f.get())) << (8 * k);
+    return v;
+  };
+  const uint32_t ifd = read(4, 4), count = read(ifd, 2);
+  for (uint32_t k = 0; k < count; ++k) {
+    const std::streamoff entry = ifd + 2 + 12 * k;
+    if (read(entry, 2) != tag) continue;
+    const int bytes = read(entry + 2, 2) == 3 ? 2 : 4;  // SHORT or LONG
+    f.seekp(entry + 8);
+    for (int b = 0; b < bytes; ++b) f.put(char((value >> (8 * b)) & 255));
+    return;
+  }
+  ADD_FAILURE() << "no tag " << tag << " in " << path;
+}
+
+// A palette PNG with transparency (tRNS) and grey + alpha: alpha dropped, as lumislab's photos
+// have 1 or 3 channels; grey + alpha as 1 channel where OpenCV gave 3 equal ones.
+TEST(ImageCodecs, TransparencyIsDroppedFromPaletteAndGreyPngs) {
+  const std::string dir = ScratchDir();
+  const std::string palette = dir + "/trns.png";
+  {
+    std::FILE* f = std::fopen(palette.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png_create_info_struct(png);
+    png_init_io(png, f);
+    png_set_IHDR(png, info, 4, 2, 8, PNG_COLOR_TYPE_PALETTE, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_color colours[2] = {{10, 20, 30}, {200, 100, 50}};
+    png_set_PLTE(png, info, colours, 2);
+    png_byte alpha[2] = {0, 128};
+    png_set_tRNS(png, info, alpha, 2, nullptr);
+    png_write_info(png, info);
+    png_byte row[4] = {0, 1, 1, 0};
+    for (int y = 0; y < 2; ++y) png_write_row(png, row);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+  }
+  const Photo p = DecodePhoto(palette);
+  ASSERT_EQ(p.pixels.type(), CV_8UC3);
+  EXPECT_EQ(p.pixels.at<cv::Vec3b>(1, 1), cv::Vec3b(50, 100, 200));
+  EXPECT_EQ(p.pixels.at<cv::Vec3b>(0, 0), cv::Vec3b(30, 20, 10));
+  EXPECT_TRUE(SameImage(p.pixels, cv::imread(palette, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR)));
+  for (int bits : {8, 16}) {
+    // Grey + alpha through libpng (OpenCV writes no two-channel PNG).
+    const std::string grey = dir + "/ga" + std::to_string(bits) + ".png";
+    const int w = 7, h = 5, bytes = bits / 8;
+    std::FILE* f = std::fopen(grey.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png_create_info_struct(png);
+    png_init_io(png, f);
+    png_set_IHDR(png, info, w, h, bits, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    cv::Mat expect(h, w, bits == 8 ? CV_8UC1 : CV_16UC1);
+    std::vector<png_byte> row(size_t(w) * 2 * bytes);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const int v = (1000 * x + 37 * y) % (bits == 8 ? 256 : 65536);
+        if (bits == 8) {
+          expect.at<uint8_t>(y, x) = uint8_t(v);
+          row[2 * x] = png_byte(v), row[2 * x + 1] = 77;
+        } else {
+          expect.at<uint16_t>(y, x) = uint16_t(v);
+          row[4 * x] = png_byte(v >> 8), row[4 * x + 1] = png_byte(v & 255);  // big-endian
+          row[4 * x + 2] = 0, row[4 * x + 3] = 77;
+        }
+      }
+      png_write_row(png, row.data());
+    }
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    std::fclose(f);
+    EXPECT_TRUE(SameImage(DecodePhoto(grey).pixels, expect)) << bits;
+  }
+}
+
+// The TIFF Orientation tag turns the image as OpenCV turns it; a JPEG-compressed YCbCr TIFF is
+// converted to R, G, B by libtiff.
+TEST(ImageCodecs, TiffOrientationAndJpegCompressedTiffs) {
+  const std::string dir = ScratchDir();
+  for (uint16_t orientation : {ORIENTATION_BOTRIGHT, ORIENTATION_RIGHTTOP, ORIENTATION_LEFTBOT})
+    for (int type : {CV_8UC3, CV_16UC1}) {
+      const cv::Mat picture = Picture(type, 9, 14);
+      const std::string path =
+          dir + "/o" + std::to_string(orientation) + "_" + std::to_string(type) + ".tif";
+      WriteTiffLayout(path, picture, "w", false, false, 0, COMPRESSION_NONE, orientation);
+      cv::Mat turned = picture.clone();
+      ApplyOrientation(orientation, turned);
+      const cv::Mat decoded = DecodePhoto(path).pixels;
+      EXPECT_TRUE(SameImage(decoded, turned)) << orientation << " " << type;
+      EXPECT_TRUE(SameImage(decoded, cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR)))
+          << orientation << " " << type;
+    }
+  // orientation 3 is a half turn: the first pixel is the last one written.
+  cv::Mat turned = Picture(CV_8UC3, 9, 14);
+  ApplyOrientation(3, turned);
+  EXPECT_EQ(turned.at<cv::Vec3b>(0, 0), Picture(CV_8UC3, 9, 14).at<cv::Vec3b>(8, 13));
+
+  const std::string jpeg_tiff = dir + "/jpeg.tif";
+  const int w = 48, h = 32;
+  cv::Mat smooth(h, w, CV_8UC3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      smooth.at<cv::Vec3b>(y, x) = {uint8_t(40 + 3 * x), uint8_t(60 + 2 * y), uint8_t(90 + x + y)};
+  TIFF* tif = TIFFOpen(jpeg_tiff.c_str(), "w");
+  ASSERT_NE(tif, nullptr);
+  TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, uint32_t(w));
+  TIFFSetField(tif, TIFFTAG_IMAGELENGTH, uint32_t(h));
+  TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 8);
+  TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 3);
+  TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_JPEG);
+  TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_YCBCR);
+  TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+  TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, 16);
+  TIFFSetField(tif, TIFFTAG_JPEGQUALITY, 95);
+  TIFFSetField(tif, TIFFTAG_JPEGCOLORMODE, JPEGCOLORMODE_RGB);  // we give R, G, B
+  std::vector<uint8_t> row(size_t(w) * 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x)
+      for (int s = 0; s < 3; ++s) row[size_t(x) * 3 + s] = smooth.at<cv::Vec3b>(y, x)[2 - s];
+    ASSERT_EQ(TIFFWriteScanline(tif, row.data(), uint32_t(y), 0), 1);
+  }
+  TIFFClose(tif);
+  const cv::Mat decoded = DecodePhoto(jpeg_tiff).pixels;
+  ASSERT_EQ(decoded.type(), CV_8UC3);
+  EXPECT_LE(cv::norm(decoded, smooth, cv::NORM_INF), 6);  // JPEG at quality 95, a smooth picture
+}
+
+// Sizes a TIFF claims are checked before a buffer is made for them: tiles far larger than the
+// image, thousands of samples per pixel.
+TEST(ImageCodecs, TiffClaimingHugeTilesOrSamplesIsRefusedBeforeAllocating) {
+  const std::string dir = ScratchDir();
+  const std::string tiles = dir + "/tiles.tif", samples = dir + "/samples.tif";
+  WriteTiffLayout(tiles, Picture(CV_8UC1, 16, 16), "w", true, false);
+  PatchTiffTag(tiles, TIFFTAG_TILEWIDTH, 16384);  // 256 M pixels a tile, 1.6 GB of RGB16
+  PatchTiffTag(tiles, TIFFTAG_TILELENGTH, 16384);
+  WriteTiffLayout(samples, Picture(CV_8UC1, 16, 16), "w", false, false);
+  PatchTiffTag(samples, TIFFTAG_SAMPLESPERPIXEL, 60000);
+  for (const auto& [path, field] :
+       {std::pair<std::string, std::string>{tiles, "TileWidth"}, {samples, "SamplesPerPixel"}}) {
+    std::string message;
+    EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(path); }, path, &message)) << path;
+    EXPECT_NE(message.find(field), std::string::npos) << message;
+  }
+}
+
 // Writes `pixels` (8-bit, `components` interleaved samples per pixel in the file's order) as a
 // JPEG whose components are stored in `space` (libjpeg converts nothing: in = out space).
 void WriteJpegIn(const std::string& path, const std::vector<uint8_t>& pixels, int w, int h,
@@ -374,7 +533,9 @@ TEST(ImageCodecs, UnreadableTiffsAndDamagedPngsAreRefusedNamingTheFileAndField) 
   const std::string bilevel_tiff = dir + "/bilevel.tif";
   ASSERT_TRUE(cv::imwrite(bilevel_tiff, Picture(CV_8UC3), {cv::IMWRITE_TIFF_COMPRESSION, 5}));
   {
-    // The same file cut short: libtiff's message, the file named.
+    // The same file cut short, its directory (written last) lost: libtiff's message, the file
+    // named. (Strip data cut short with the directory intact is BadInput too: an outside
+    // review of these decoders tried it.)
     const auto size = std::filesystem::file_size(bilevel_tiff);
     std::filesystem::resize_file(bilevel_tiff, size / 2);
   }

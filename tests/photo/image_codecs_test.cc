@@ -436,8 +436,11 @@ TEST(ImageCodecs, TiffClaimingHugeTilesOrSamplesIsRefusedBeforeAllocating) {
   PatchTiffTag(tiles, TIFFTAG_TILELENGTH, 16384);
   WriteTiffLayout(samples, Picture(CV_8UC1, 16, 16), "w", false, false);
   PatchTiffTag(samples, TIFFTAG_SAMPLESPERPIXEL, 60000);
-  for (const auto& [path, field] :
+  // (Not a structured binding: C++17 lambdas cannot capture one, and clang refuses it.)
+  for (const auto& c :
        {std::pair<std::string, std::string>{tiles, "TileWidth"}, {samples, "SamplesPerPixel"}}) {
+    const std::string& path = c.first;
+    const std::string& field = c.second;
     std::string message;
     EXPECT_TRUE(ThrowsBadInputNaming([&] { DecodePhoto(path); }, path, &message)) << path;
     EXPECT_NE(message.find(field), std::string::npos) << message;

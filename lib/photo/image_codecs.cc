@@ -16,11 +16,6 @@
 namespace lumislab {
 namespace {
 
-struct CloseCodecFile {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-using CodecFile = std::unique_ptr<std::FILE, CloseCodecFile>;
-
 constexpr bool kLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 // Samples per pixel a TIFF may have (R, G, B and extra samples; libtiff allows 65535, and a
 // scanline buffer grows with them).

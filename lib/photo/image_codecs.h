@@ -14,6 +14,7 @@
 
 #include <tiffio.h>
 
+#include <cstdio>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
@@ -45,6 +46,12 @@ void ApplyOrientation(int orientation, cv::Mat& image);
 // or RGBA), compressed for speed (OpenCV's defaults: the Sub filter, zlib level 1, RLE). IoError
 // naming `path` when it cannot.
 void EncodePng(const std::string& file, const cv::Mat& image, const std::string& path);
+
+// A C file the codecs read or write through (libpng, libjpeg), closed with the pointer.
+struct CloseCodecFile {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using CodecFile = std::unique_ptr<std::FILE, CloseCodecFile>;
 
 // A libtiff handle whose error messages go into `error` (the first one) instead of stderr, and
 // whose warnings are dropped. nullptr when libtiff cannot open the file; closed with the pointer.

@@ -58,14 +58,10 @@ int Orientation(j_decompress_ptr info) {
   return 1;
 }
 
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-
 }  // namespace
 
 DecodedJpeg DecodeJpeg(const std::string& path) {
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  CodecFile file(std::fopen(path.c_str(), "rb"));
   if (!file) throw BadInput(path + ": cannot open the photo");
   jpeg_decompress_struct info;
   ErrorManager error;

@@ -26,7 +26,7 @@ uniform int u_near_end;
 uniform int u_far_begin;
 uniform float u_z_far;
 #endif
-uniform float u_offset_scale;  // normal offset per mm of distance (one shadow texel)
+uniform float u_offset_scale;  // normal offset per mm of distance (1.5 shadow texels)
 uniform float u_radiance_scale;
 uniform bool u_unit_albedo;  // irradiance view (false colour): E before the materials
 uniform usampler2D u_previous;
@@ -64,7 +64,7 @@ layout(std430, binding = 0) buffer ExactCount { uint count; };
 layout(std430, binding = 1) buffer ExactList { uint exact_pixels[]; };
 #endif
 #if TILED
-// Light culling by tiles of kTile x kTile pixels (TileLists below): per tile, this pass's lights
+// Light culling by tiles of TILE x TILE pixels (tile_lists.comp): per tile, this pass's lights
 // whose E' can be non-zero at one of its pixels, [near count, far count, near ..., far ...] from
 // tile_lists[u_tile_stride * tile]; the far list is empty without the shortcuts.
 layout(std430, binding = 2) readonly buffer TileLightLists { uint tile_lists[]; };

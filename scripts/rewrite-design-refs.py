@@ -4,8 +4,9 @@ into, using docs-mapping.tsv (old section -> new file, new section, new anchor).
 
     scripts/rewrite-design-refs.py [--dry-run] [--bare] [--tsv docs-mapping.tsv] [path ...]
 
-Paths default to every file git tracks (docs/benchmarks/ is always left alone: it quotes the old
-page verbatim). Rewritten:
+Paths default to every file git tracks except docs/ and README.md, which were rewritten when
+the page was split (run it once per file: a second pass would read the new numbers as old
+ones); docs/benchmarks/ is always left alone: it quotes the old page verbatim. Rewritten:
   * prefixed references: `docs/design.md §3.5.1`, `design §5.3`, `design.md 8.3`,
     `(design §4.2)`, chains such as `design.md §5.13 - §5.16` or `design §5.17, §7.8`, also
     when a comment wraps between `design.md` and the section; a bare `docs/design.md` or
@@ -177,7 +178,7 @@ def process(path, table, anchors, args):
     in_docs = markdown and os.path.normpath(path).startswith('docs' + os.sep)
     # Skip what the first pass produced (links and "docs/x.md §N" chains).
     pieces = re.split(r'(\[[^\]]*\]\([^)]*\)|docs/[a-z]+\.md §[\d.]+'
-                      r'(?:(?:\s*(?:,|–|-|and|to)\s*)(?:docs/[a-z]+\.md )?§[\d.]+)*)', new)
+                      r'(?:(?:\s*(?:,|–|-|and|to)' + WRAP + r')(?:docs/[a-z]+\.md )?§[\d.]+)*)', new)
     if args.bare or in_docs:
         for k in range(0, len(pieces), 2):
             pieces[k] = BARE.sub(lambda m, s=pieces[k]: rw.bare_ref(s, m), pieces[k])
@@ -226,6 +227,10 @@ def main():
         files = subprocess.run(['git', 'ls-files'], capture_output=True, text=True,
                                check=True).stdout.split('\n')
     files = sorted(os.path.normpath(f) for f in files if f)
+    if not args.paths:
+        # docs/ and README.md were rewritten when the page was split: their bare § already
+        # use the new numbering, so a second pass would misread them.
+        files = [f for f in files if not f.startswith('docs' + os.sep) and f != 'README.md']
     files = [f for f in files if not f.startswith(os.path.join('docs', 'benchmarks'))
              and f != os.path.normpath(args.tsv) and not f.endswith('rewrite-design-refs.py')]
     n_ok = n_bad = n_bare = 0

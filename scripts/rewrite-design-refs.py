@@ -129,10 +129,12 @@ class Rewriter:
     def link(self, m):
         anchor = m.group('anchor')
         if anchor is None:
-            if not self.markdown:
-                return m.group(0)
-            self.resolved.append((m.group(0), self.target('docs/README.md')))
-            return self.target('docs/README.md')
+            # A link to the whole page goes to the index; a mention in prose is left for a person.
+            if self.markdown and m.string[max(0, m.start() - 2):m.start()] == '](':
+                self.resolved.append((m.group(0), self.target('docs/README.md')))
+                return self.target('docs/README.md')
+            self.unresolved.append((m.group(0), 'the page named without a section'))
+            return m.group(0)
         old = self.anchors.get(anchor)
         if old is None:
             self.unresolved.append((m.group(0), 'unknown anchor'))

@@ -15,6 +15,7 @@
 #include <numeric>
 
 #include "core/error.h"
+#include "lib/photo/photo_allocator.h"
 #include "lib/photo/radiometric_calibration.h"
 
 namespace lumislab {

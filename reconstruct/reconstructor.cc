@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "lib/photo/dataset_photo.h"
 
 namespace lumislab {
 

@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_allocator.h"
 
 namespace lumislab {
 

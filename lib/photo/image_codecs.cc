@@ -11,7 +11,8 @@
 #include <cstring>
 
 #include "core/error.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_allocator.h"
+#include "lib/photo/photo_format.h"
 
 namespace lumislab {
 namespace {

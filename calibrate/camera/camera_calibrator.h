@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "calibrate/camera_board.h"
-#include "calibrate/camera_refiner.h"
+#include "calibrate/camera/camera_board.h"
+#include "calibrate/camera/camera_refiner.h"
 #include "core/camera_calibration.h"
 
 namespace lumislab {

@@ -1,4 +1,4 @@
-#include "calibrate/screen_refiner.h"
+#include "calibrate/screen/screen_refiner.h"
 
 #include <ceres/ceres.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "calibrate/ceres_options.h"
-#include "calibrate/homography_distortion_cost.h"
+#include "calibrate/screen/homography_distortion_cost.h"
 #include "core/error.h"
 
 namespace lumislab {

@@ -2,7 +2,7 @@
 // calib/screen.json (core/screen_calibration.h). OpenCV finds the corners and a starting
 // homography. Without a calibrated camera, Ceres refines the homography and two radial
 // distortion terms (screen_refiner.h); with one (calib/camera.json), the lens is known and only
-// the screen's pose is solved: cv::solvePnP, then Ceres (camera_refiner.h RefinePose).
+// the screen's pose is solved: cv::solvePnP, then Ceres (camera/camera_refiner.h RefinePose).
 #pragma once
 
 #include <Eigen/Core>
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "calibrate/board_detector.h"
-#include "calibrate/screen_refiner.h"
+#include "calibrate/screen/board_detector.h"
+#include "calibrate/screen/screen_refiner.h"
 #include "core/camera_calibration.h"
 #include "core/dataset.h"
 #include "core/screen_calibration.h"
@@ -78,8 +78,5 @@ std::optional<CameraCalibration> LoadDatasetCamera(const Dataset& dataset, int p
 // the result is not written.
 ScreenCalibration CalibrateScreen(const Dataset& dataset, const ScreenCalibratorOptions& options,
                                   ScreenCalibrationReport* report = nullptr);
-
-// The command line: `lumislab-calibrate screen --dataset <dir> [--force] ...`.
-int RunCalibrate(int argc, char** argv);
 
 }  // namespace lumislab

@@ -1,4 +1,4 @@
-#include "calibrate/camera_board.h"
+#include "calibrate/camera/camera_board.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "calibrate/response_fit.h"
+#include "calibrate/radiometric/response_fit.h"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "calibrate/calibration_frames.h"
+#include "calibrate/radiometric/calibration_frames.h"
 #include "lib/photo/radiometric_calibration.h"
 
 namespace lumislab {

@@ -1,10 +1,10 @@
-#include "calibrate/run_radiometric.h"
+#include "calibrate/cli_radiometric.h"
 
 #include <filesystem>
 #include <sstream>
 
-#include "calibrate/calibration_frames.h"
-#include "calibrate/flat_calibrator.h"
+#include "calibrate/radiometric/calibration_frames.h"
+#include "calibrate/radiometric/flat_calibrator.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
 #include "core/error.h"

@@ -1,10 +1,10 @@
-#include "calibrate/response_calibrator.h"
+#include "calibrate/radiometric/response_calibrator.h"
 
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "calibrate/response_fit.h"
+#include "calibrate/radiometric/response_fit.h"
 #include "core/error.h"
 #include "core/log.h"
 

@@ -1,4 +1,4 @@
-#include "calibrate/camera_calibrator.h"
+#include "calibrate/camera/camera_calibrator.h"
 
 #include <glob.h>
 

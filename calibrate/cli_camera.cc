@@ -1,4 +1,4 @@
-#include "calibrate/camera_command.h"
+#include "calibrate/cli_camera.h"
 
 #include <cstdio>
 #include <filesystem>

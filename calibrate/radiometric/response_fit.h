@@ -5,7 +5,8 @@
 //   - codes are continuous (a sample's code is a local mean, not rounded): g is piecewise
 //     linear between the 256 integer codes, so a mean code carries its fraction;
 //   - each sample's ln E_i is eliminated in closed form, so the normal equations stay 256 x 256
-//     whatever the number of samples (tens of thousands, where OpenCV's dense SVD takes ~200);
+//     whatever the number of samples (tens of thousands, where OpenCV's dense SVD grows with
+//     them);
 //   - the weights follow the noise: a code's error (JPEG's and the sensor's, about constant in
 //     code units) becomes g'(z) times it in ln E, so later passes weight by 1 / g'(z)^2;
 //   - the smoothness term is on g's second derivative in ln(z + 1), which a power law (a gamma

@@ -1,4 +1,4 @@
-#include "calibrate/board_detector.h"
+#include "calibrate/screen/board_detector.h"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calibrate/saddle_refiner.h"
+#include "calibrate/screen/saddle_refiner.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/log.h"

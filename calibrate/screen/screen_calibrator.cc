@@ -1,4 +1,4 @@
-#include "calibrate/screen_calibrator.h"
+#include "calibrate/screen/screen_calibrator.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <opencv2/calib3d.hpp>
 
-#include "calibrate/camera_refiner.h"
+#include "calibrate/camera/camera_refiner.h"
 #include "calibrate/gray_stretch.h"
 #include "core/error.h"
 #include "core/geometry.h"

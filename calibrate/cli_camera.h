@@ -1,4 +1,4 @@
-// The `camera` subcommand of lumislab-calibrate: its options and its run (run_calibrate.cc
+// The `camera` subcommand of lumislab-calibrate: its options and its run (cli.cc
 // only adds it to the tool and hands over when it was chosen).
 #pragma once
 
@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "calibrate/camera_calibrator.h"
+#include "calibrate/camera/camera_calibrator.h"
 #include "core/command_line.h"
 
 namespace lumislab {

@@ -1,4 +1,4 @@
-#include "calibrate/saddle_refiner.h"
+#include "calibrate/screen/saddle_refiner.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>

@@ -1,4 +1,4 @@
-#include "calibrate/dark_calibrator.h"
+#include "calibrate/radiometric/dark_calibrator.h"
 
 #include <algorithm>
 #include <cmath>

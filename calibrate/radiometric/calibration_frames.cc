@@ -1,4 +1,4 @@
-#include "calibrate/calibration_frames.h"
+#include "calibrate/radiometric/calibration_frames.h"
 
 #include <cmath>
 #include <filesystem>

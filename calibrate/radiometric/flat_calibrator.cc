@@ -1,4 +1,4 @@
-#include "calibrate/flat_calibrator.h"
+#include "calibrate/radiometric/flat_calibrator.h"
 
 #include <algorithm>
 #include <cmath>

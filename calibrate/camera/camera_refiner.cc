@@ -1,10 +1,10 @@
-#include "calibrate/camera_refiner.h"
+#include "calibrate/camera/camera_refiner.h"
 
 #include <ceres/ceres.h>
 
 #include <cmath>
 
-#include "calibrate/camera_projection_cost.h"
+#include "calibrate/camera/camera_projection_cost.h"
 #include "calibrate/ceres_options.h"
 #include "core/error.h"
 

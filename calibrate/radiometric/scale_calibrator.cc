@@ -1,4 +1,4 @@
-#include "calibrate/scale_calibrator.h"
+#include "calibrate/radiometric/scale_calibrator.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>

@@ -1,26 +1,15 @@
-// lumislab-calibrate: command-line parsing around CalibrateScreen.
-#include <CLI/CLI.hpp>
+#include "calibrate/cli_screen.h"
+
 #include <filesystem>
-#include <opencv2/core.hpp>
 #include <sstream>
 
-#include "calibrate/camera_command.h"
-#include "calibrate/run_radiometric.h"
-#include "calibrate/screen_calibrator.h"
 #include "core/atomic_file.h"
-#include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
 
 namespace lumislab {
 
 namespace {
-
-struct ScreenCommand {
-  std::string dataset_dir;
-  bool force = false;
-  ScreenCalibratorOptions options;
-};
 
 int RunScreen(const ScreenCommand& command, int threads) {
   std::ostringstream params;
@@ -72,24 +61,17 @@ int RunScreen(const ScreenCommand& command, int threads) {
 
 }  // namespace
 
-int RunCalibrate(int argc, char** argv) {
-  CLI::App app{
-      "lumislab-calibrate: camera, screen and radiometric calibration into <dataset>/calib/ "
-      "(docs/design.md §5.5, §5.12 - §5.16). Order: response, dark, screen, flat, scale (flat "
-      "and scale need the screen); each later step decodes its frames with the earlier steps' "
-      "corrections"};
-  app.require_subcommand(1);
-  CommonOptions common;
-  AddCommonOptions(&app, &common);
-  ScreenCommand screen;
-  CLI::App* sub = app.add_subcommand(
+void AddScreenCommand(CLI::App* app, CommonOptions* common, ScreenCommand* command) {
+  ScreenCommand& screen = *command;
+  CLI::App* sub = app->add_subcommand(
       "screen",
       "photo of the checkerboard on the screen -> calib/screen.json (image -> screen mm, "
       "homography + radial distortion)");
+  screen.sub = sub;
   sub->add_option("--dataset", screen.dataset_dir, "dataset folder (with dataset.json)")
       ->required();
   sub->add_flag("--force", screen.force, "recalibrate even if calib/screen.json exists");
-  AddCommonOptions(sub, &common);
+  AddCommonOptions(sub, common);
   sub->add_option("--huber-px", screen.options.refiner.huber_px,
                   "scale of the robust (Huber) loss, pixels")
       ->check(FiniteIn(1e-3, 1e3))
@@ -106,15 +88,10 @@ int RunCalibrate(int argc, char** argv) {
                   "find corners on a copy whose long side is at most this (pixels)")
       ->check(CLI::Range(200, 100000))
       ->capture_default_str();
-  CameraCommand camera;
-  AddCameraCommand(&app, &common, &camera);
-  RadiometricCommand radiometric;
-  AddRadiometricCommands(&app, &common, &radiometric);
-  if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
-  const int threads = StartTool("calibrate", common);
-  cv::setNumThreads(threads);
-  if (camera.sub->parsed()) return RunCameraCommand(&camera, threads);
-  if (!sub->parsed()) return RunRadiometricCommand(radiometric);
+}
+
+int RunScreenCommand(ScreenCommand* command, int threads) {
+  ScreenCommand& screen = *command;
   screen.options.refiner.threads = threads;
   screen.options.Check();
   screen.dataset_dir = TrimTrailingSlashes(screen.dataset_dir);

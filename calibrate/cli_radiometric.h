@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "calibrate/dark_calibrator.h"
-#include "calibrate/response_calibrator.h"
-#include "calibrate/scale_calibrator.h"
+#include "calibrate/radiometric/dark_calibrator.h"
+#include "calibrate/radiometric/response_calibrator.h"
+#include "calibrate/radiometric/scale_calibrator.h"
 
 namespace lumislab {
 

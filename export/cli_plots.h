@@ -16,7 +16,7 @@ namespace lumislab {
 
 // Runs the subcommand of a set that was parsed, with the tool's resolved thread count; nothing
 // when none of the set's subcommands was on the command line. (The same alias as
-// export/formats_cli.h's; a repeated alias of one type is allowed.)
+// export/cli_formats.h's; a repeated alias of one type is allowed.)
 using ParsedCommand = std::function<std::optional<int>(int threads)>;
 
 // Adds irradiance and polar to `app` (each with the common options bound to `common`).

@@ -1,4 +1,4 @@
-#include "export/formats_cli.h"
+#include "export/cli_formats.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "export/plots_cli.h"
+#include "export/cli_plots.h"
 
 #include <algorithm>
 #include <cmath>

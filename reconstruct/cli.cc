@@ -1,4 +1,7 @@
-// lumislab-reconstruct: the batch and --watch drivers around ReconstructPosition.
+// lumislab-reconstruct: the command line, and the batch and --watch drivers around
+// ReconstructPosition.
+#include "reconstruct/cli.h"
+
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <filesystem>

@@ -1,5 +1,6 @@
-// lumislab-preview: its configuration and command line, and the steps the headless run and the
-// window share (renderer options, waiting for the slab, loading new positions).
+// lumislab-preview's configuration (PreviewConfig: from the command line, cli.h, and changed by
+// the window) and the steps the headless run and the window share (scene set-up, renderer
+// options, waiting for the slab, loading new positions, the false-colour picture).
 #pragma once
 
 #include <optional>
@@ -84,17 +85,6 @@ struct PreviewConfig {
 // not computed).
 double CheckReceiverPlane(const PreviewConfig& config, const SlabInfo& info);
 
-// The whole tool: command line, then the window or the headless run.
-int RunPreview(int argc, char** argv);
-
-// Parses the command line into `config` (help, version and CLI11 errors: the exit code to
-// return; bad values: BadInput). `write_test_slab` receives --write-test-slab.
-std::optional<int> ParsePreviewCommandLine(int argc, char** argv, PreviewConfig& config,
-                                           bool* write_test_slab);
-// The headless command line that renders what `config` describes into `out` (the window's
-// "command line" line and its screenshot log): every setting the window changes is a flag.
-std::string HeadlessCommandLine(const PreviewConfig& config, const std::string& out);
-
 // The scene of the configuration: MakeSceneSetup, then --camera.
 SceneSetup MakePreviewSetup(const PreviewConfig& config, const SlabInfo& info);
 // The orbit camera of `setup` as the six --camera values, and back.
@@ -121,8 +111,5 @@ std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, c
 // a scale bar (its extent over `width` pixels) and the plane's distance as the title.
 Rgb8Image FalseColourView(const PreviewConfig& config, const SceneSetup& setup,
                           const SlabInfo& info, const ImageF& irradiance);
-
-// Strict "WxH" (digits only, each 1..8192): false for anything else ("400x400junk").
-bool ParseSize(const std::string& text, int* width, int* height);
 
 }  // namespace lumislab

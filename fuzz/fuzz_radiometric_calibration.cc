@@ -5,7 +5,7 @@
 //   '1'  calib/response.json  lib/photo LoadResponseCurve <tmp>/in/response.json
 //   '2'  calib/flat.json      lib/photo LoadFlatMap      <tmp>/in/flat.json
 //   '3'  calib/scale.json     lib/photo LoadRadiometricScale <tmp>/in/scale.json
-//   '4'  captures.csv         acquire/capture_list.h ManifestPhotos (import's --manifest)
+//   '4'  captures.csv         acquire/photo_naming.h ManifestPhotos (import's --manifest)
 //   '5'  reference.json       calibrate/radiometric/scale_calibrator.h LoadScaleReference +
 //                             Check against a 3 x 2 grid on an 800 x 600 mm screen (calibrate
 //                             scale --reference)
@@ -17,7 +17,7 @@
 #include <cmath>
 #include <memory>
 
-#include "acquire/capture_list.h"
+#include "acquire/photo_naming.h"
 #include "calibrate/radiometric/scale_calibrator.h"
 #include "core/exr_io.h"
 #include "fuzz/fuzz_util.h"

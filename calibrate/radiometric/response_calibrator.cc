@@ -31,7 +31,7 @@ std::vector<cv::Mat> BgrCodes(const std::vector<CalibrationFrame>& frames) {
   return out;
 }
 
-// The observations of channel `channel` (BGR index) for the fit (calibrate/response_fit.h):
+// The observations of channel `channel` (BGR index) for the fit (response_fit.h):
 // up to `count` pixels, taken in a fixed scattered order so that they cover the image, in smooth
 // regions only (the channel's codes range over at most kMaxLocalRange in the pixel's 5 x 5
 // neighbourhood of the middle frame: JPEG's chroma subsampling and block artefacts move codes

@@ -19,7 +19,7 @@ struct ResponseOptions {
   void Check() const;        // BadInput naming the option
 };
 
-// Debevec and Malik's least squares on continuous codes (calibrate/response_fit.h) over sample
+// Debevec and Malik's least squares on continuous codes (response_fit.h) over sample
 // pixels chosen here: 3 x 3 means in smooth regions, in the frames where their neighbourhood is
 // neither clipped nor black; one curve for R, G, B unless `per_channel`. Frames must be 8-bit with
 // known exposures, at least two of them different (BadInput naming the frame and field). The curve

@@ -31,8 +31,8 @@ struct BoardCorners {
   double runner_up_contrast = 0;
 };
 
-// `gray8`: the photo stretched to 8 bits (gray_stretch.h); `photo`: its path, for messages.
-// Throws BadInput naming the photo when the board or the dot is not found.
+// `gray8`: the photo stretched to 8 bits (calibrate/gray_stretch.h); `photo`: its path, for
+// messages. Throws BadInput naming the photo when the board or the dot is not found.
 BoardCorners DetectBoard(const cv::Mat& gray8, const CalibrationTarget& target,
                          const std::string& photo, const DetectionOptions& options);
 

@@ -2,7 +2,8 @@
 // calib/screen.json (core/screen_calibration.h). OpenCV finds the corners and a starting
 // homography. Without a calibrated camera, Ceres refines the homography and two radial
 // distortion terms (screen_refiner.h); with one (calib/camera.json), the lens is known and only
-// the screen's pose is solved: cv::solvePnP, then Ceres (camera/camera_refiner.h RefinePose).
+// the screen's pose is solved: cv::solvePnP, then Ceres (calibrate/camera/camera_refiner.h
+// RefinePose).
 #pragma once
 
 #include <Eigen/Core>

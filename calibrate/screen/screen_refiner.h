@@ -1,8 +1,8 @@
 // Ceres refinement of the image -> screen mapping: 8 homography parameters plus the radial
 // distortion terms k1, k2 of core/screen_calibration.h, with a robust (Huber) loss in pixels.
 // One of the two translation units of lumislab_calibrate that include Ceres
-// (camera/camera_refiner.cc is the other; both take their solver settings from
-// ../ceres_options.h); this header keeps Ceres out of its includers.
+// (calibrate/camera/camera_refiner.cc is the other; both take their solver settings from
+// calibrate/ceres_options.h); this header keeps Ceres out of its includers.
 #pragma once
 
 #include <Eigen/Core>

@@ -6,9 +6,11 @@
 #include <sstream>
 
 #include "acquire/capture_list.h"
+#include "acquire/photo_naming.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/input_file.h"
+#include "core/json.h"
 #include "core/log.h"
 #include "lib/photo/exif.h"
 #include "lib/photo/photo_io.h"
@@ -129,6 +131,27 @@ void ImportOptions::Check() const {
                      std::to_string(brackets));
   if (std::set<double>(exposures.begin(), exposures.end()).size() != exposures.size())
     throw InputError("--exposures", "", "different exposures", "a repeated value");
+}
+
+Dataset ImportSkeleton(const ImportOptions& o) {
+  Dataset ds = Dataset::Parse(JsonDocument::Load(o.setup_file), o.out_dir, false);
+  ds.synthetic = false;
+  // The photo folder as the dataset will name it: relative to the dataset folder, so that the
+  // two can move together.
+  const fs::path photos = fs::weakly_canonical(fs::absolute(o.photos_dir));
+  const fs::path out = fs::weakly_canonical(fs::absolute(o.out_dir));
+  ds.photo_folder = photos.lexically_relative(out).string();
+  if (ds.photo_folder.empty()) ds.photo_folder = photos.string();
+  if (ds.photo_folder == ".") ds.photo_folder = "";
+  return ds;
+}
+
+void WriteImportedDataset(const Dataset& ds, const std::string& out_dir) {
+  const std::string out_json = out_dir + "/dataset.json";
+  const nlohmann::json json = ds.ToJson();
+  Dataset::Parse(JsonDocument::Parse(json.dump(2), out_json), out_dir);
+  MakeDirectories(out_dir);
+  WriteJsonAtomically(out_json, json);
 }
 
 ImportReport RunImport(const ImportOptions& o) {

@@ -55,6 +55,13 @@ struct ImportReport {
 // naming the file, line or position otherwise.
 ImportReport RunImport(const ImportOptions& options);
 
+// The dataset for the options: the setup file, photo_folder naming the camera's folder relative
+// to the dataset folder, no photos yet.
+Dataset ImportSkeleton(const ImportOptions& options);
+// Reads `dataset` back through the one dataset reader (duplicates, ranges) and writes it as
+// <out_dir>/dataset.json (atomic).
+void WriteImportedDataset(const Dataset& dataset, const std::string& out_dir);
+
 // The grid position of the k-th photo position of a scan (rows: i fastest; serpentine: rows,
 // every other one reversed; columns: j fastest).
 std::pair<int, int> ScanPosition(const SamplingGrid& grid, const std::string& scan, int k);

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "acquire/capture_list.h"
+#include "acquire/photo_naming.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/log.h"

@@ -1,4 +1,4 @@
-#include "calibrate/screen_calibrator.h"
+#include "calibrate/cli.h"
 #include "core/error.h"
 
 int main(int argc, char** argv) {

@@ -5,9 +5,10 @@
 //   '1'  calib/response.json  lib/photo LoadResponseCurve <tmp>/in/response.json
 //   '2'  calib/flat.json      lib/photo LoadFlatMap      <tmp>/in/flat.json
 //   '3'  calib/scale.json     lib/photo LoadRadiometricScale <tmp>/in/scale.json
-//   '4'  captures.csv         acquire/capture_list.h ManifestPhotos (import's --manifest)
-//   '5'  reference.json       calibrate/scale_calibrator.h LoadScaleReference + Check against a
-//                             3 x 2 grid on an 800 x 600 mm screen (calibrate scale --reference)
+//   '4'  captures.csv         acquire/photo_naming.h ManifestPhotos (import's --manifest)
+//   '5'  reference.json       calibrate/radiometric/scale_calibrator.h LoadScaleReference +
+//                             Check against a 3 x 2 grid on an 800 x 600 mm screen (calibrate
+//                             scale --reference)
 // The JSON readers of dark and flat also read the EXR map the JSON names: <tmp>/in/dark.exr and
 // flat.exr are small valid maps (4 x 3, written once), so the fuzzer explores the JSON. An
 // accepted dark map, response curve or flat field is applied the way the decoder does to a 4 x 3
@@ -16,8 +17,8 @@
 #include <cmath>
 #include <memory>
 
-#include "acquire/capture_list.h"
-#include "calibrate/scale_calibrator.h"
+#include "acquire/photo_naming.h"
+#include "calibrate/radiometric/scale_calibrator.h"
 #include "core/exr_io.h"
 #include "fuzz/fuzz_util.h"
 #include "lib/photo/photo_io.h"

@@ -96,7 +96,4 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s);
 std::string PlanTable(const PlanInput& in, const Plan& plan);
 std::string PlanJson(const PlanInput& in, const Plan& plan);
 
-// Entry point of lumislab-plan.
-int RunPlan(int argc, char** argv);
-
 }  // namespace lumislab

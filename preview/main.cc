@@ -1,5 +1,5 @@
 #include "core/error.h"
-#include "preview/run_preview.h"
+#include "preview/cli.h"
 
 int main(int argc, char** argv) {
   return lumislab::RunMain("preview", [&] { return lumislab::RunPreview(argc, argv); });

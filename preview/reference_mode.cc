@@ -8,8 +8,8 @@
 #include "lib/lightfield/reference_render.h"
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/scene.h"
+#include "preview/config.h"
 #include "preview/image_files.h"
-#include "preview/run_preview.h"
 
 namespace lumislab {
 namespace {

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "core/slab.h"
-#include "preview/run_preview.h"
+#include "preview/config.h"
 
 namespace lumislab {
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "lib/lightfield/tone_map.h"
+#include "preview/cli.h"
 #include "preview/window_state.h"
 
 namespace lumislab {

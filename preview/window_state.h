@@ -12,8 +12,8 @@
 #include "core/image.h"
 #include "core/slab.h"
 #include "lib/lightfield/scene_setup.h"
+#include "preview/config.h"
 #include "preview/renderer.h"
-#include "preview/run_preview.h"
 
 namespace lumislab {
 

@@ -1,5 +1,5 @@
 #include "core/error.h"
-#include "reconstruct/reconstructor.h"
+#include "reconstruct/cli.h"
 
 int main(int argc, char** argv) {
   return lumislab::RunMain("reconstruct", [&] { return lumislab::RunReconstruct(argc, argv); });

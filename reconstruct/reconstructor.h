@@ -83,8 +83,4 @@ SlabPosition ReconstructPosition(const Dataset& dataset, const ScreenCalibration
                                  const SlabInfo& info, int i, int j,
                                  const ReconstructOptions& options, PositionReport* report);
 
-// lumislab-reconstruct --dataset <dir> [--resolution N] [--watch] [--force] [--threads N]
-// [--lambda x] [--verbose]
-int RunReconstruct(int argc, char** argv);
-
 }  // namespace lumislab

@@ -1,5 +1,5 @@
 #include "core/error.h"
-#include "study/study.h"
+#include "study/cli.h"
 
 int main(int argc, char** argv) {
   return lumislab::RunMain("study", [&] { return lumislab::RunStudy(argc, argv); });

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/lab_model.h"
+
 namespace lumislab {
 
 // One point of the sweep: its knob and value, every setting, every error and time (a CSV row).
@@ -66,6 +68,26 @@ std::string TargetTable(const std::vector<StudyRow>& rows);
 std::string StudySvg(const std::vector<StudyRow>& rows, const std::vector<std::string>& knob_order,
                      int d_index);
 
-int RunStudy(int argc, char** argv);
+// The study's settings (lumislab-study's options, study/cli.cc).
+struct StudyOptions {
+  std::string scene = "default";
+  std::string out;
+  bool quick = false;
+  std::string knobs = "all";
+  LabModel lab;             // its brackets are the scene's (or the brackets knob's)
+  double photo_scale = 0;   // base photo size over the scene camera's (0: 1, --quick 0.25)
+  int resolution = 0;       // base slab texels per side (0: 150, --quick 48)
+  int render_px = 0;        // receiver-plane image side (0: 96, --quick 40)
+  int samples = 1;          // base N of the reference
+  int preview_width = 0;    // crypt image W x 3W/4 of the preview knobs and frame times
+  int preview_samples = 8;  // N of the reference the preview knobs are measured against
+  bool keep_photos = false;
+  int values = 3;  // values per knob: the first 2 or all 3 of each list
+};
+
+// The sweep into `options.out` (made if missing; a study of another scene or lab model there is
+// bad input): every point not yet in study.csv, then the preview's own knobs, then report.md and
+// the plots. Returns the rows of study.csv.
+std::vector<StudyRow> RunStudySweep(const StudyOptions& options, int threads);
 
 }  // namespace lumislab

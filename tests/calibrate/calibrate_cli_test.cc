@@ -8,7 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "board_renderer.h"
-#include "calibrate/screen_calibrator.h"
+#include "calibrate/cli.h"
+#include "calibrate/screen/screen_calibrator.h"
 #include "core/error.h"
 #include "core/exr_io.h"
 

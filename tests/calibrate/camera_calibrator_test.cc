@@ -11,7 +11,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "board_renderer.h"
-#include "calibrate/screen_calibrator.h"
+#include "calibrate/cli.h"
+#include "calibrate/screen/screen_calibrator.h"
 #include "core/camera_calibration.h"
 #include "core/error.h"
 

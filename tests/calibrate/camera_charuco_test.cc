@@ -12,7 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calibrate/camera_calibrator.h"
+#include "calibrate/camera/camera_calibrator.h"
 
 namespace fs = std::filesystem;
 

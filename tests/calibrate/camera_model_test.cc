@@ -8,7 +8,7 @@
 #include <fstream>
 #include <opencv2/calib3d.hpp>
 
-#include "calibrate/camera_projection_cost.h"
+#include "calibrate/camera/camera_projection_cost.h"
 #include "core/camera_calibration.h"
 #include "core/error.h"
 

@@ -1,5 +1,5 @@
 // HomographyDistortionCost: zero at the truth, and its residual reads in pixels.
-#include "calibrate/homography_distortion_cost.h"
+#include "calibrate/screen/homography_distortion_cost.h"
 
 #include <gtest/gtest.h>
 

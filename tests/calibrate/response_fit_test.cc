@@ -1,6 +1,7 @@
-// calibrate/response_fit.h against curves known exactly: observations made from a curve are
-// fitted back to it, whatever the scatter of the samples' irradiances and without rounding.
-#include "calibrate/response_fit.h"
+// calibrate/radiometric/response_fit.h against curves known exactly: observations made from a
+// curve are fitted back to it, whatever the scatter of the samples' irradiances and without
+// rounding.
+#include "calibrate/radiometric/response_fit.h"
 
 #include <gtest/gtest.h>
 

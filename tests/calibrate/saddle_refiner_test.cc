@@ -1,5 +1,5 @@
 // RefineSaddlePoints on rendered X-junctions at known sub-pixel positions and angles.
-#include "calibrate/saddle_refiner.h"
+#include "calibrate/screen/saddle_refiner.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // CalibrateScreenPhoto on rendered boards with a known camera: every pixel of the board maps
 // within 0.2 mm of the truth (frontal, oblique, mirrored, distorted, noisy), and bad views are
 // refused with BadInput naming the photo.
-#include "calibrate/screen_calibrator.h"
+#include "calibrate/screen/screen_calibrator.h"
 
 #include <gtest/gtest.h>
 

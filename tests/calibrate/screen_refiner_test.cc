@@ -1,6 +1,6 @@
 // RefineScreenMapping on exact correspondences from a known mapping: recovers it from a rough
 // start, and the Huber loss keeps one wrong corner from spoiling the fit.
-#include "calibrate/screen_refiner.h"
+#include "calibrate/screen/screen_refiner.h"
 
 #include <gtest/gtest.h>
 

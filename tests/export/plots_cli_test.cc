@@ -1,8 +1,6 @@
-// lumislab-export irradiance and polar (export/plots_cli.h, docs/design.md §4.9) on an exact
+// lumislab-export irradiance and polar (export/cli_plots.h, docs/design.md §4.9) on an exact
 // slab of the built-in synthetic luminaire: the plane's irradiance at D = d against the
 // luminaire's own, the pictures' sizes and contents, and bad input (exit 2, nothing written).
-#include "export/plots_cli.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
+#include "export/cli_plots.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/synthetic/truth.h"
 

@@ -14,7 +14,7 @@
 #include "core/exr_io.h"
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
-#include "preview/run_preview.h"
+#include "preview/cli.h"
 #include "preview_test_util.h"
 
 namespace lumislab {

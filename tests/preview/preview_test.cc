@@ -20,9 +20,9 @@
 #include "lib/lightfield/scenes.h"
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
+#include "preview/cli.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
-#include "preview/run_preview.h"
 #include "preview_test_util.h"
 
 namespace lumislab {

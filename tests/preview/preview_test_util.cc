@@ -1,7 +1,7 @@
 #include "preview_test_util.h"
 
 #include "core/error.h"
-#include "preview/run_preview.h"
+#include "preview/cli.h"
 
 namespace lumislab {
 

@@ -15,7 +15,7 @@
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
-#include "preview/run_preview.h"
+#include "preview/cli.h"
 #include "preview_test_util.h"
 
 namespace lumislab {

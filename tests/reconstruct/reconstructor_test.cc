@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/slab.h"
+#include "reconstruct/cli.h"
 #include "synthetic_dataset.h"
 
 namespace fs = std::filesystem;

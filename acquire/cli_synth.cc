@@ -1,0 +1,90 @@
+#include "acquire/cli_synth.h"
+
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/log.h"
+#include "core/stop_signal.h"
+
+namespace lumislab {
+namespace {
+
+int PrintScene(const std::string& scene) {
+  if (scene == "default") {
+    std::fputs(DefaultSceneJson().c_str(), stdout);
+  } else {
+    LoadScene(scene);  // validates
+    std::fputs(ReadTextFile(scene).c_str(), stdout);
+  }
+  return 0;
+}
+
+}  // namespace
+
+CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common) {
+  SynthOptions& o = c->options;
+  CLI::App* cmd = app.add_subcommand(
+      "synth",
+      "render the photos of a synthetic scene through both filter slides, a "
+      "calibration photo, dataset.json and the analytic truth/ into a dataset folder");
+  cmd->add_option("--scene", o.scene, "scene file (JSON) or \"default\"")->required();
+  cmd->add_option("--out", o.out_dir, "dataset folder to write");
+  cmd->add_option("--interval", o.interval_s,
+                  "live acquisition: dataset.json and the calibration photo first, then "
+                  "the positions one by one with this pause (s)")
+      ->check(FiniteIn(0, 3600));
+  cmd->add_flag("--force", o.force, "redo a dataset that is already complete");
+  cmd->add_option("--truth-resolution", o.truth_resolution, "texels per side of the truth slab")
+      ->capture_default_str();
+  cmd->add_option("--photo-format", o.photo_format,
+                  "photos of a scene without a quantization effect: half (half-float EXR, "
+                  "RLE, lossless for half: ~1 MB a photo) or float (32-bit float EXR)")
+      ->check(CLI::IsMember({"half", "float"}))
+      ->capture_default_str();
+  cmd->add_flag("--compress", o.compress_float,
+                "--photo-format float: PIZ-compress the photos (smaller, slower)");
+  cmd->add_flag("--camera-folder", o.camera_folder,
+                "write the capture as a camera leaves it: camera/IMG_0001.TIF (JPG with a "
+                "response, DNG with raw) ... in capture order with EXIF, camera/BOARD.PNG, "
+                "setup.json and truth/, no dataset.json (acquire import makes it)");
+  cmd->add_option("--calibration-views", o.calibration_views,
+                  "also write N photos of a free-standing 9x6 chessboard (30 mm squares) in "
+                  "varied poses, for lumislab-calibrate camera, into calibration/camera/")
+      ->check(CLI::Range(0, kMaxCalibrationViews))
+      ->capture_default_str();
+  cmd->add_flag("--print-scene", c->print_scene,
+                "print the scene as JSON (the built-in one for --scene default) and exit");
+  AddCommonOptions(cmd, common);
+  return cmd;
+}
+
+int RunSynthCommand(const SynthCommand& command, int threads) {
+  if (command.print_scene) return PrintScene(command.options.scene);
+  SynthOptions synth = command.options;
+  synth.out_dir = TrimTrailingSlashes(synth.out_dir);
+  synth.threads = threads;
+  std::ostringstream params;
+  params << "scene=" << synth.scene << " out=" << synth.out_dir << " interval="
+         << (synth.interval_s >= 0 ? std::to_string(synth.interval_s) + " s" : "none")
+         << " force=" << (synth.force ? "yes" : "no") << " photo_format=" << synth.photo_format
+         << " camera_folder=" << (synth.camera_folder ? "yes" : "no")
+         << " calibration_views=" << synth.calibration_views << " threads=" << synth.threads;
+  LogInfo("parameters: ", params.str());
+  const StopSignalScope stop_signals;  // Ctrl-C: finish the photos in hand, then stop
+  const SynthReport r = RunSynth(synth);
+  if (!r.skipped)
+    LogInfo("wrote ", r.photos_written, " photos, radiometric scale ", r.radiometric_scale,
+            " W/m^2 per unit");
+  if (StopRequested()) {
+    LogWarning(synth.interval_s >= 0
+                   ? "interrupted: the dataset is partial; run the same command again to redo it"
+                   : "interrupted: nothing was written (a previous dataset there is unchanged)");
+    return 1;
+  }
+  std::printf("dataset: %s\n", synth.out_dir.c_str());
+  return 0;
+}
+
+}  // namespace lumislab

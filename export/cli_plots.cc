@@ -1,0 +1,200 @@
+#include "export/cli_plots.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "core/atomic_file.h"
+#include "core/dataset.h"
+#include "core/error.h"
+#include "core/exr_io.h"
+#include "core/log.h"
+#include "core/slab.h"
+#include "core/stop_signal.h"
+#include "export/complete_slab.h"
+#include "lib/lightfield/false_colour.h"
+#include "lib/lightfield/far_field.h"
+#include "lib/lightfield/polar_plot.h"
+#include "lib/lightfield/reference_render.h"
+#include "lib/lightfield/scene_setup.h"
+#include "lib/photo/photo_write.h"
+
+namespace lumislab {
+namespace {
+
+struct IrradianceOptions {
+  std::string slab_dir, out;
+  double distance_mm = 0;
+  double extent_mm = 0;  // 0: the window seen at D (window * D / d)
+  int size = 512;
+  int samples = 2;
+  std::string range = "auto", scale = "linear";
+};
+
+struct PolarOptions {
+  std::string slab_dir, out;
+  double gamma_step_deg = 2.5;
+  int samples = 4;
+  int size = 600;
+  std::string title;
+};
+
+std::string Extension(const std::string& path) {
+  return std::filesystem::path(path).extension().string();
+}
+
+// The slab's irradiance on the plane z = D by the exact CPU reference (docs/design.md §4.5;
+// nothing in the way, so no visibility rays), through the false colour of §4.9.
+int RunIrradiance(const IrradianceOptions& o, int threads) {
+  LogInfo("parameters: slab=", o.slab_dir, " distance_mm=", o.distance_mm,
+          " extent_mm=", o.extent_mm, " size=", o.size, " samples=", o.samples, " range=", o.range,
+          " scale=", o.scale, " out=", o.out);
+  const std::string ext = Extension(o.out);
+  if (ext != ".png" && ext != ".exr") throw BadInput(o.out + ": --out must end in .png or .exr");
+  if (o.extent_mm != 0 && !(o.extent_mm >= 1 && o.extent_mm <= kMaxDistanceMm))
+    throw InputError("--extent-mm", "", "0 (default) or a length in [1, 1e5] mm",
+                     std::to_string(o.extent_mm));
+  FalseColourRequest request;
+  request.log = o.scale == "log";
+  ParseFalseColourRange(o.range, "--range", &request);
+  const SlabInfo info = SlabInfo::Load(o.slab_dir);
+  RequireCompleteSlab(info, o.slab_dir);
+  const std::vector<ImageF> irradiance = ReadSlabIrradiance(o.slab_dir, info, threads);
+  SceneRequest scene;
+  scene.name = "plane";
+  scene.receiver_plane_mm = o.distance_mm;
+  scene.extent_mm = o.extent_mm;
+  const SceneSetup setup = MakeSceneSetup(scene, info);
+  const ReferenceScene view(setup, o.size, o.size);
+  ReferenceOptions options;
+  options.samples = o.samples;
+  options.threads = threads;
+  options.visibility = false;  // the plane alone: nothing casts a shadow
+  const StopSignalScope stop_signals;
+  const ReferenceImage image = RenderReference(view, info, irradiance, options);
+  if (!image.complete) throw Failure("stopped by a signal; " + o.out + " not written");
+  if (ext == ".exr") {
+    WriteExr(o.out, image.irradiance, {"R", "G", "B"});
+  } else {
+    const Rgb8Image picture = FalseColourPicture(
+        image.irradiance, request, IrradianceUnitLabel(info.units), setup.extent / o.size,
+        "plane at " + FormatTick(setup.plane_z, 1) + " mm");
+    WriteRgb8File(o.out, picture.width, picture.height, picture.rgb);
+  }
+  LogInfo("irradiance on the plane at ", setup.plane_z, " mm, ", setup.extent, " mm wide, ", o.size,
+          "x", o.size, " (", IrradianceUnitLabel(info.units), ") -> ", o.out);
+  return 0;
+}
+
+// The far field in the four half-planes, up to the largest gamma every one of them saw.
+PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
+  const SlabInfo info = SlabInfo::Load(o.slab_dir);
+  RequireCompleteSlab(info, o.slab_dir);
+  const std::vector<SlabPosition> positions = ReadSlabPositions(o.slab_dir, info, threads);
+  std::vector<double> gamma;
+  for (int k = 0; k * o.gamma_step_deg <= 90 + 1e-9; ++k) gamma.push_back(k * o.gamma_step_deg);
+  FarFieldOptions options;
+  options.samples = o.samples;
+  options.threads = threads;
+  const std::vector<double> planes = {0, 90, 180, 270};
+  const FarField far = ComputeFarField(info, positions, planes, gamma, options);
+  size_t seen = 0;  // gamma[0 .. seen) seen in all four planes
+  while (seen < gamma.size() && far.seen[seen] && far.seen[gamma.size() + seen] &&
+         far.seen[2 * gamma.size() + seen] && far.seen[3 * gamma.size() + seen])
+    ++seen;
+  if (seen < 2)
+    throw BadInput(o.slab_dir + ": the slab saw too few directions for a polar plot (gamma 0 to " +
+                   std::to_string(seen == 0 ? 0.0 : gamma[seen - 1]) + " degrees)");
+  PolarPlotData data;
+  data.gamma_deg.assign(gamma.begin(), gamma.begin() + seen);
+  std::vector<double>* curves[] = {&data.c0, &data.c90, &data.c180, &data.c270};
+  int negative = 0;
+  for (int c = 0; c < 4; ++c)
+    for (size_t g = 0; g < seen; ++g) {
+      const double v = far.values[c * gamma.size() + g];
+      negative += v < 0;
+      curves[c]->push_back(std::max(0.0, v));  // the signed dual's noise can dip below 0
+    }
+  if (negative > 0) LogWarning(negative, " negative intensities drawn as 0");
+  data.unit = IntensityUnitLabel(info.units);
+  data.title = o.title.empty() ? "Far field (the slab saw \u03B3 = 0 to " +
+                                     FormatTick(data.gamma_deg.back(), o.gamma_step_deg) + "\u00B0)"
+                               : o.title;
+  return data;
+}
+
+int RunPolar(const PolarOptions& o, int threads) {
+  LogInfo("parameters: slab=", o.slab_dir, " gamma_step=", o.gamma_step_deg, " samples=", o.samples,
+          " size=", o.size, " out=", o.out);
+  const std::string ext = Extension(o.out);
+  if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
+  const PolarPlot plot = MakePolarPlot(PolarDataFromSlab(o, threads), o.size);
+  if (ext == ".svg") {
+    WriteTextAtomically(o.out, PolarPlotSvg(plot));
+  } else {
+    const Rgb8Image image = PolarPlotImage(plot);
+    WriteRgb8File(o.out, image.width, image.height, image.rgb);
+  }
+  LogInfo("polar plot -> ", o.out);
+  return 0;
+}
+
+}  // namespace
+
+ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
+  auto irradiance = std::make_shared<IrradianceOptions>();
+  CLI::App* irr = app.add_subcommand(
+      "irradiance",
+      "the slab's irradiance (illuminance for a lux slab) on the plane z = D of the luminaire "
+      "frame, by the exact CPU reference: .png false colour (viridis, colour bar in W/m² or lx, "
+      "iso-lines at its ticks, a length scale) or .exr linear");
+  irr->add_option("--slab", irradiance->slab_dir, "slab folder")->required();
+  irr->add_option("--distance-mm", irradiance->distance_mm, "D: the plane's distance from S (mm)")
+      ->required()
+      ->check(FiniteIn(kMinDistanceMm, kMaxDistanceMm));
+  irr->add_option("--extent-mm", irradiance->extent_mm,
+                  "the square's side on the plane (mm; default: the slab window seen at D)");
+  irr->add_option("--size", irradiance->size, "pixels per side")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  irr->add_option("--samples", irradiance->samples, "N x N samples per basis support (1..64)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  irr->add_option("--range", irradiance->range,
+                  "min:max of the colour bar in the slab's unit, or auto (0 .. the 99.5th "
+                  "percentile rounded up; log: three decades below the top)")
+      ->capture_default_str();
+  irr->add_option("--scale", irradiance->scale, "linear | log")
+      ->check(CLI::IsMember({"linear", "log"}))
+      ->capture_default_str();
+  irr->add_option("--out", irradiance->out, ".png (false colour) or .exr (linear)")->required();
+  AddCommonOptions(irr, common);
+
+  auto polar = std::make_shared<PolarOptions>();
+  CLI::App* pol = app.add_subcommand(
+      "polar",
+      "the far-field polar diagram of the slab (intensity in cd or W/sr against gamma, planes "
+      "C0-C180 and C90-C270, up to the largest gamma the slab saw in all four)");
+  pol->add_option("--slab", polar->slab_dir, "slab folder")->required();
+  pol->add_option("--out", polar->out, ".svg or .png")->required();
+  pol->add_option("--gamma-step", polar->gamma_step_deg, "degrees between the curves' points")
+      ->check(FiniteIn(0.1, 45))
+      ->capture_default_str();
+  pol->add_option("--samples", polar->samples, "N x N samples per basis support (1..64)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  pol->add_option("--size", polar->size, "the diagram's width in pixels (SVG user units)")
+      ->check(CLI::Range(200, 4096))
+      ->capture_default_str();
+  pol->add_option("--title", polar->title, "the title above the diagram");
+  AddCommonOptions(pol, common);
+
+  return [irr, pol, irradiance, polar](int threads) -> std::optional<int> {
+    if (irr->parsed()) return RunIrradiance(*irradiance, threads);
+    if (pol->parsed()) return RunPolar(*polar, threads);
+    return std::nullopt;
+  };
+}
+
+}  // namespace lumislab

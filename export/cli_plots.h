@@ -1,0 +1,25 @@
+// lumislab-export's pictures for a lab report (docs/design.md §4.9, §7):
+//   irradiance --slab <dir> --distance-mm D [--extent-mm W] --out x.png|x.exr
+//       the slab's irradiance (illuminance) on the plane z = D, false colour with colour bar and
+//       iso-lines (.png) or linear (.exr)
+//   polar --slab <dir> --out x.svg|x.png
+//       the far-field polar diagram, planes C0-C180 and C90-C270
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <optional>
+
+#include "core/command_line.h"
+
+namespace lumislab {
+
+// Runs the subcommand of a set that was parsed, with the tool's resolved thread count; nothing
+// when none of the set's subcommands was on the command line. (The same alias as
+// export/cli_formats.h's; a repeated alias of one type is allowed.)
+using ParsedCommand = std::function<std::optional<int>(int threads)>;
+
+// Adds irradiance and polar to `app` (each with the common options bound to `common`).
+ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common);
+
+}  // namespace lumislab

@@ -4,7 +4,7 @@
 # sanitizer report, timeout, out-of-memory, leak or an exception that is not a lumislab::Error).
 #
 # Usage: fuzz/run.sh [seconds per target] [fuzz build folder]
-#   defaults: 25 s, build-fuzz (configure it as pipelines/test.sh does, or see fuzz/README.md);
+#   defaults: 25 s, build-fuzz (configure it as scripts/test.sh does, or see fuzz/README.md);
 #   0 s replays the seed corpus once without mutating it (what CI runs: deterministic)
 # Environment:
 #   LUMISLAB_FUZZ_TARGETS  space-separated targets to run (default: all of fuzz/corpus/)

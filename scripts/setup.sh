@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages lumislab needs (only those missing) and builds it into build/.
-# Usage: pipelines/setup.sh [extra cmake args]
+# Usage: scripts/setup.sh [extra cmake args]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,9 +22,11 @@ packages=(
   # pipelines/Snakefile: batch conversion as a workflow that also runs on a cluster
   snakemake
   xvfb xauth x11-apps
-  # pipelines/test.sh's sanitizer and fuzz builds: clang 14, its sanitizer and libFuzzer
+  # scripts/test.sh's sanitizer and fuzz builds: clang 14, its sanitizer and libFuzzer
   # run-times, llvm-symbolizer for the stack traces (fuzz/README.md)
   clang libclang-rt-14-dev llvm
+  # scripts/test.sh's format stage
+  clang-format
 )
 missing=()
 for p in "${packages[@]}"; do

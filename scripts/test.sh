@@ -24,15 +24,17 @@
 # Most of them skip themselves in a sanitized build anyway (testing::kSanitized); the ones that
 # did not are EndToEnd.StageErrorIsMeasurableAgainstTheTruth, Plan.RecommendationMeasuredByTheStudy
 # and JpegCodingNoise.ModelPredictsTheCodingErrorOfAKnownPicture (their code runs sanitized in the
-# e2e tests, the study and plan tests and lib/photo's codec tests).
+# e2e tests, the study and plan tests and lib/photo's codec tests). The executables that hold only
+# accuracy tests are not built there (LUMISLAB_TEST_SKIP_TIERS).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 fuzz_seconds=${LUMISLAB_FUZZ_SECONDS:-15}
 # The sanitizer and fuzz builds: -O2 with line tables (readable stack traces). Not -O1: Eigen
 # needs its inlining, at -O1 the calibrate tests ran 30x slower than Release under ASan.
-# Unity builds, as scripts/setup.sh's.
+# Unity builds and lld, as scripts/setup.sh's.
 clang_args=(-G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_UNITY_BUILD=ON
+  -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld
   -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG"
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG")
 
@@ -83,7 +85,7 @@ tests_stage() {
 
 sanitizers_stage() {
   cmake -S . -B build-asan "${clang_args[@]}" -DLUMISLAB_SANITIZE=address,undefined \
-    -DLUMISLAB_BUILD_BENCH=OFF >/dev/null &&
+    -DLUMISLAB_BUILD_BENCH=OFF -DLUMISLAB_TEST_SKIP_TIERS=accuracy >/dev/null &&
     cmake --build build-asan -j "$jobs" &&
     (source fuzz/sanitizers/env.sh && run_ctest build-asan -LE accuracy)
 }

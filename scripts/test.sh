@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Install what is missing, build, and run the whole test suite (what CI runs), in four stages:
-#   1. format:     every tracked C++ file against .clang-format (clang-format --dry-run --Werror)
-#   2. tests:      the Release build in build/ (scripts/setup.sh) and ctest over it: every test
+#   1. tests:      the Release build in build/ (scripts/setup.sh, which also installs what is
+#                  missing) and ctest over it: every test
+#   2. format:     every tracked C++ file against .clang-format (clang-format --dry-run --Werror)
 #   3. sanitizers: the same sources built with clang, -fsanitize=address,undefined, -O2, into
 #                  build-asan/, and ctest over the tiers where memory errors live (below; fuzz/
 #                  sanitizers/ holds the run-time options and the third-party suppressions)
@@ -56,8 +57,8 @@ skipped() {
 }
 
 # ctest over a build folder, summarised in one line; extra arguments go to ctest (-LE accuracy).
-# ctest starts the long tests first: on a fresh build folder from their COST (declared with the
-# test in tests/), later from the times it recorded in the folder.
+# ctest starts the long tests first, also on a fresh build folder: they declare their COST
+# (tests/CMakeLists.txt).
 run_ctest() {
   local dir=$1 log rc
   shift
@@ -98,15 +99,15 @@ fuzz_stage() {
     LUMISLAB_FUZZ_ARGS="${LUMISLAB_FUZZ_ARGS:--seed=1}" fuzz/run.sh "$fuzz_seconds" build-fuzz
 }
 
-if [ "${LUMISLAB_SKIP_FORMAT:-0}" = 1 ]; then
-  skipped format LUMISLAB_SKIP_FORMAT
-else
-  stage format format_stage
-fi
 if [ "${LUMISLAB_SKIP_TESTS:-0}" = 1 ]; then
   skipped tests LUMISLAB_SKIP_TESTS  # and scripts/setup.sh: the packages are assumed there
 else
   stage tests tests_stage
+fi
+if [ "${LUMISLAB_SKIP_FORMAT:-0}" = 1 ]; then
+  skipped format LUMISLAB_SKIP_FORMAT
+else
+  stage format format_stage
 fi
 if [ "${LUMISLAB_SKIP_SANITIZERS:-0}" = 1 ]; then
   skipped sanitizers LUMISLAB_SKIP_SANITIZERS

@@ -8,7 +8,7 @@
 #include "core/basis.h"
 #include "core/error.h"
 #include "core/json.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 
 namespace lumislab {
 

@@ -10,7 +10,7 @@
 #include "core/dataset.h"
 #include "core/image.h"
 #include "lib/photo/exif.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "lib/synthetic/scene.h"
 
 namespace lumislab {

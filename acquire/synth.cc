@@ -17,7 +17,7 @@
 #include "core/progress.h"
 #include "core/slab.h"
 #include "core/stop_signal.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "lib/synthetic/render.h"
 #include "lib/synthetic/truth.h"
 

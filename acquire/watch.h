@@ -15,8 +15,9 @@ namespace lumislab {
 
 struct WatchOptions {
   ImportOptions import;  // the folder, setup, dataset and how the photos are named (not partial)
-  // A file is taken once its size and modification time have not changed for this long (s) and
-  // it decodes as an image: a file still being copied is waited for, never read.
+  // A file is taken once its size and modification time have not changed for this long (s),
+  // then decoded (BadInput when it is not a whole image): a file still being copied is waited
+  // for, not read, unless its copy stalls for this long.
   double settle_s = 1;
   double poll_s = 0.2;        // s between two looks at the folder
   double idle_timeout_s = 0;  // stop after this long without a new or growing file (0: never)

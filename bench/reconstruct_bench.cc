@@ -35,8 +35,7 @@ double Seconds(std::chrono::steady_clock::time_point t0) {
 }
 
 // CPU time of the whole process (user + system, all threads), seconds: unlike wall time, not
-// inflated while other processes hold the cores (the development machine's 2 cores are shared;
-// wall times there vary by +-25 % and more).
+// inflated while other processes hold the cores (on a shared machine wall times vary widely).
 double ProcessCpuSeconds() {
   timespec t{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);

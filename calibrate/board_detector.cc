@@ -52,7 +52,7 @@ std::string SizeText(const CalibrationTarget& t) {
   return std::to_string(t.squares_x - 1) + "x" + std::to_string(t.squares_y - 1);
 }
 
-// FAST_CHECK: without it the classic detector spends ~20 s on a photo of noise.
+// FAST_CHECK: without it the classic detector spends many seconds on a photo of noise.
 bool FindCorners(const cv::Mat& image, const cv::Size& pattern, bool sb_fallback,
                  std::vector<cv::Point2f>* corners, std::string* detector) {
   try {

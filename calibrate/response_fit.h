@@ -1,6 +1,6 @@
 // The least-squares fit behind `lumislab-calibrate response` (docs/design.md §5.14): the log of
 // a camera's inverse response, g(z) = ln(linear value of code z), from pixels seen in several
-// frames of known exposure. Debevec and Malik's model g(z_ij) = ln E_i + ln t_j, with three
+// frames of known exposure. Debevec and Malik's model g(z_ij) = ln E_i + ln t_j, with four
 // changes that make it hold up on noisy JPEG frames:
 //   - codes are continuous (a sample's code is a local mean, not rounded): g is piecewise
 //     linear between the 256 integer codes, so a mean code carries its fraction;

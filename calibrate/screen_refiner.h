@@ -1,6 +1,7 @@
 // Ceres refinement of the image -> screen mapping: 8 homography parameters plus the radial
 // distortion terms k1, k2 of core/screen_calibration.h, with a robust (Huber) loss in pixels.
-// The only translation unit of lumislab_calibrate that includes Ceres.
+// One of the two translation units of lumislab_calibrate that include Ceres (camera_refiner.cc
+// is the other; both take their solver settings from ceres_options.h).
 #pragma once
 
 #include <Eigen/Core>

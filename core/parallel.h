@@ -8,16 +8,18 @@
 
 namespace lumislab {
 
-// Upper bound of every --threads option.
+// Upper bound of the value every --threads option accepts (not of the count 0 resolves to).
 constexpr int kMaxThreads = 256;
 
-// 0 -> the machine's cores; otherwise `requested`, which must be in [0, kMaxThreads]
-// (BadInput naming --threads otherwise).
+// 0 -> the machine's cores (std::thread::hardware_concurrency(), at least 1, not capped at
+// kMaxThreads); otherwise `requested`, which must be in [0, kMaxThreads] (BadInput naming
+// --threads otherwise).
 int ResolveThreads(int requested);
 
-// Runs body(k) for k in [0, count) on min(threads, count) threads (the caller is one of them).
-// `threads` <= 1 runs in order on the calling thread. The first exception is rethrown after
-// every thread has stopped; indices not yet taken then are never run.
+// Runs body(k) for k in [0, count) on min(threads, count) threads (the caller is one of them;
+// fewer when the system refuses to start one). `threads` <= 1 runs in order on the calling
+// thread. The first exception is rethrown after every thread has stopped; indices not yet taken
+// then are never run.
 void ParallelFor(int count, int threads, const std::function<void(int)>& body);
 
 }  // namespace lumislab

@@ -22,6 +22,11 @@ void Progress::Advance(int n, const std::string& note) {
   Draw(note);
 }
 
+int Progress::done() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_;
+}
+
 void Progress::Finish() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (finished_) return;

@@ -1,4 +1,5 @@
-// Progress reporter: a bar on a terminal, plain "label: k/n" lines otherwise. Thread-safe.
+// Progress reporter: a bar on a terminal, plain "label: k/n" lines otherwise. Thread-safe: every
+// member, done() included, takes the one mutex.
 #pragma once
 
 #include <chrono>
@@ -13,7 +14,7 @@ class Progress {
   ~Progress();
   void Advance(int n = 1, const std::string& note = "");
   void Finish();
-  int done() const { return done_; }
+  int done() const;
 
  private:
   void Draw(const std::string& note);
@@ -24,7 +25,7 @@ class Progress {
   bool finished_ = false;
   int last_line_percent_ = -1;
   std::chrono::steady_clock::time_point start_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
 };
 
 }  // namespace lumislab

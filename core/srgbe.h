@@ -15,7 +15,11 @@
 namespace lumislab {
 
 extern const float kSrgbeMax;
-extern const float kSrgbeMinNormal;  // smallest nonzero magnitude of the largest channel
+// 2^-129: the smallest magnitude of the largest channel that keeps a full 7-bit mantissa
+// (m = 64 at the lowest exponent). Below it precision drops a bit per halving; the smallest
+// nonzero magnitude is 2^-135 (m = 1), and a triple whose largest channel is under 2^-136
+// encodes as zero.
+extern const float kSrgbeMinNormal;
 
 uint32_t EncodeSrgbe(float r, float g, float b);
 std::array<float, 3> DecodeSrgbe(uint32_t packed);

@@ -18,7 +18,7 @@
 #include "lib/lightfield/polar_plot.h"
 #include "lib/lightfield/reference_render.h"
 #include "lib/lightfield/scene_setup.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 
 namespace lumislab {
 namespace {

@@ -21,6 +21,7 @@
 #include "core/exr_io.h"
 #include "fuzz/fuzz_util.h"
 #include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "lib/photo/radiometric_calibration.h"
 
 using namespace lumislab;

@@ -21,7 +21,7 @@
 #include "core/exr_io.h"
 #include "core/screen_calibration.h"
 #include "core/slab.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "lib/photo/radiometric_calibration.h"
 #include "lib/photometry/eulumdat.h"
 #include "lib/photometry/ies.h"

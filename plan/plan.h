@@ -48,7 +48,7 @@ struct PlanSetting {
 };
 
 // Predicted relative L2 of the receiver-plane irradiance at one distance, per term, for a grid
-// that covers (coverage is a condition, not a term: RequiredGrid).
+// that covers (coverage is a condition, not a term: SettingCovers, RequiredPositions).
 struct ErrorTerms {
   double parallax = 0;    // exact model's first-order parallax at D != d (independent of h)
   double slab = 0;        // the bell fit's own error, (a / footprint)^2

@@ -5,7 +5,7 @@
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "lib/lightfield/tone_map.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 
 namespace lumislab {
 

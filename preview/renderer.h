@@ -7,10 +7,17 @@
 // Deferred shading: a G-buffer (luminaire-frame position, normal, albedo per pixel) is drawn when
 // the view changes, and each light pass is one full-screen pass over it; the shaders have the
 // options compiled in (LightProgram).
-// Caching: shadow maps are kept until the scene or the luminaire pose changes; the accumulated
-// image and the G-buffer are kept until the camera, the scene, the pose or an option changes, so
-// a newly arrived position only costs its own light pass. Lights are batched (texture arrays, up
-// to kLightsPerPass per pass).
+// Caching: shadow maps are kept until the scene, the luminaire pose or an option that shapes them
+// changes, or a position's new E' reaches beyond the rectangle its map was drawn over; the
+// accumulated image and the G-buffer are kept until the camera, the scene, the pose, an option or
+// the size changes, or an accumulated position's E' is replaced, so a newly arrived position only
+// costs its own light pass. Lights are batched (texture arrays, up to kLightsPerPass per pass,
+// kShortcutLightsPerPass with the shortcuts).
+//
+// The methods are in files by phase: renderer.cc (set-up, uploads, Render(), read-back),
+// renderer_shadows.cc (shadow maps and their sharing), renderer_merge.cc (merged lights),
+// renderer_tiles.cc (light culling by tiles), renderer_light.cc (light passes, coarse shading),
+// renderer_reproject.cc (reprojection); the shaders in preview/shaders/.
 #pragma once
 
 #include <Eigen/Core>
@@ -31,10 +38,11 @@ namespace lumislab {
 enum class TextureFilter { kBilinear = 0, kNearest = 1, kCubic = 2 };
 
 struct RenderOptions {
+  // What is drawn.
   bool shadows = true;
-  bool srgbe = false;       // sRGBE-packed accumulation instead of float
-  int shadow_size = 512;    // shadow-map texels per side
-  bool shadow_pcf = false;  // 2x2 filtered depth compare (softer edges, ~15 % slower)
+  bool srgbe = false;                              // sRGBE-packed accumulation instead of float
+  int shadow_size = 512;                           // shadow-map texels per side
+  bool shadow_pcf = false;                         // 2x2 filtered depth compare (softer edges)
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
   bool cull_back_faces = false;  // camera passes only: see into a closed room from outside
   // Shadow maps hold only the faces turned to the light (docs/design.md §4.2). In a closed scene
@@ -45,14 +53,16 @@ struct RenderOptions {
   // surface (W/m^2), which --view false-colour maps.
   bool unit_albedo = false;
   TextureFilter texture_filter = TextureFilter::kBilinear;
-  // Shortcuts (docs/design.md §4.2, "Faster frames"); both off: the full per-position render.
+
+  // Shortcuts (docs/design.md §4.2, "Faster frames"): each changes the image within the bound
+  // its knob sets; all off (the defaults): the full per-position render.
   // Shadow-map sharing: neighbouring positions in blocks of g x g share one map rendered from
   // the block's centre, g the largest whose shadow edges move by at most this many shadow texels
   // over the depth range the maps see (0: off, every position its own map).
   double shadow_share_texels = 0;
   // Light merging: blocks of merge_group x merge_group positions become one light (summed E'
-  // texture, one shadow lookup) for receivers beyond the depth where the merged term's error is
-  // bounded by merge_error times the block's peak term (1: off).
+  // texture, the mean of the members' shadow lookups) for receivers beyond the depth where the
+  // merged term's error is bounded by merge_error times the block's peak term (1: off).
   int merge_group = 1;
   double merge_error = 0.01;
   // Coarse shading: a pass with at least kCoarseMinLights lights is shaded at every second pixel
@@ -65,33 +75,39 @@ struct RenderOptions {
   // surface and their sums spread by at most this fraction of their peak; the others are shaded
   // exactly (0: off).
   double reproject_tolerance = 0;
+  // Sharing or merging on: positions then use the shortcuts' light program and passes (a
+  // merged light's entry, a shared map), and their shadow maps are drawn whole.
+  bool SharesOrMergesLights() const { return shadow_share_texels > 0 || merge_group > 1; }
+
+  // Exact savings: the same image bit for bit; off only to check that.
   // Each position's shadow map is drawn (and cleared) only over the rectangle its lookups can
   // reach: where its E' is not zero, widened by the texture filter's and the normal offset's
-  // reach. Exact (a lookup outside multiplies an E' of 0); off only to check that it is exact.
-  // Maps shared or merged (the shortcuts above) are drawn whole.
+  // reach (a lookup outside multiplies an E' of 0). Maps shared or merged are drawn whole.
   bool shadow_scissor = true;
   // A frame's shadow maps in one instanced draw where the driver has
   // ARB_shader_viewport_layer_array (false: one draw per map, as without it). Fixed when the
   // renderer is created.
   bool layered_shadow_maps = true;
   // Light culling by tiles: each tile of 16 x 16 pixels shades only the lights whose E' can be
-  // non-zero at one of its pixels (a light left out adds E' = 0: the same image bit for bit). Off
-  // only to check that.
+  // non-zero at one of its pixels (a light left out adds E' = 0).
   bool tiled_lights = true;
+
   // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
   bool time_phases = false;
 };
 
 // Wall time of the phases of the last Render() (milliseconds; only with time_phases).
+// depth_ms: the G-buffer; shadow_ms: the shadow maps (and, when maps are drawn, a reprojection
+// before them); light_ms: the light passes (and a reprojection without maps drawn).
 struct PhaseTimes {
-  double depth_ms = 0, shadow_ms = 0, light_ms = 0;  // depth_ms: the G-buffer
+  double depth_ms = 0, shadow_ms = 0, light_ms = 0;
 };
 
 constexpr int kLightsPerPass = 64;
 // Coarse shading pays where the light loop outweighs the interpolation test (about as costly as
 // a few lights); passes with fewer lights (live mode adds one) are shaded exactly.
 constexpr int kCoarseMinLights = 8;
-constexpr int kFastLightsPerPass = 128;  // the shortcuts' program (members + merged lights)
+constexpr int kShortcutLightsPerPass = 128;  // the shortcuts' program (members + merged lights)
 
 // What the shortcuts chose at the last Render() (for the bench, the window and the log).
 struct ShortcutState {
@@ -142,52 +158,80 @@ class Renderer {
   void Display(double exposure, int viewport_w, int viewport_h) const;
 
  private:
-  struct Gl;
+  struct Gl;  // the GL objects (renderer_gl.h)
+  // One light of a pass: a position's, or a merged block's (renderer_merge.cc).
   struct LightEntry {
     Eigen::Vector2d centre, shadow_centre;
     int layer = 0, shadow_layer = 0;
     int span_begin = -1, span_count = 1;     // merged: its members' entries (shadows averaged)
     std::array<int, 4> support{0, 0, 0, 0};  // slab texels where its E' is not 0 (support_)
   };
-  bool Fast() const { return options_.shadow_share_texels > 0 || options_.merge_group > 1; }
   // One shadow map: its layer, seen from centre (a position's, or a shared map's block mean).
   struct ShadowJob {
     int layer = 0;
     Eigen::Vector2d centre;
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the map texels drawn: [x0, x1) x [y0, y1)
   };
-  // The map position l's light reads (its own, or with sharing its block's, in the layer
-  // shadow_layer_ names): whole, or without the shortcuts its rectangle (shadow_scissor).
-  ShadowJob ShadowJobFor(int l) const;
-  // Clears and draws the maps (shadow_valid_ is the caller's).
-  void RenderShadowMaps(const std::vector<ShadowJob>& jobs);
-  void ChooseShadowGroups();
-  void MergedTexture(int group);
-  void LightPass(const std::vector<int>& lights);
-  static void PackLights(const std::vector<LightEntry>& entries, std::vector<float>* lights,
-                         std::vector<int>* layers);
-  // One light pass over `entries` (fast: the shortcuts' program, whose lights [0, near_end)
-  // shade receivers nearer than z_far and [far_begin, size) the others).
-  void EntriesPass(const std::vector<LightEntry>& entries, bool fast, int near_end, int far_begin,
-                   double z_far);
   // How a light pass shades: every pixel exactly; coarse shading's samples, their resolve and the
   // compute pass over the pixels listed; reprojection's pass (it lists for kExactList too).
   enum class Shading { kExact, kCoarse, kResolve, kExactList, kReproject };
+
+  // renderer.cc: the render targets at the present size; Render()'s phases.
+  void AllocateTargets();
+  // Clears the sums and draws the G-buffer of the present view.
+  void DrawView();
+  // The positions present and not yet in the accumulated image.
+  std::vector<int> PositionsToAdd() const;
+
+  // renderer_shadows.cc.
+  // The map position l's light reads (its own, or with sharing its block's, in the layer
+  // shadow_layer_ names): whole, or without the shortcuts its rectangle (shadow_scissor).
+  ShadowJob ShadowJobFor(int l) const;
+  // Draws the maps the positions `todo` read that are not valid, choosing the sharing first.
+  void UpdateShadowMaps(const std::vector<int>& todo);
+  // Clears and draws the maps (shadow_valid_ is the caller's).
+  void RenderShadowMaps(const std::vector<ShadowJob>& jobs);
+  // Shadow-map sharing: each position's map layer and centre (shadow_layer_, shadow_centre_).
+  void ChooseShadowGroups();
+
+  // renderer_merge.cc.
+  // Builds and uploads the merged texture of merge block `group` and its depth bound.
+  void MergedTexture(int group);
+  // The light passes that add `todo` with sharing or merging on.
+  void ShortcutPasses(const std::vector<int>& todo);
+
+  // renderer_tiles.cc: the light lists of the tiles for one pass's entries (lights: their
+  // PackLights, 4 floats each; near_end and far_begin as EntriesPass's), after the tiles' bounds
+  // if the G-buffer changed.
+  void TileLists(int lights_per_pass, const float* lights, const std::vector<LightEntry>& entries,
+                 int near_end, int far_begin);
+
+  // renderer_light.cc.
+  // The light passes that add `lights` (with sharing or merging: ShortcutPasses).
+  void LightPasses(const std::vector<int>& lights);
+  // One pass of up to kLightsPerPass positions, each its own light and shadow map.
+  void LightPass(const std::vector<int>& lights);
+  static void PackLights(const std::vector<LightEntry>& entries, std::vector<float>* lights,
+                         std::vector<int>* layers);
+  // One light pass over `entries` (shortcuts: the shortcuts' program, whose lights
+  // [0, near_end) shade receivers nearer than z_far and [far_begin, size) the others).
+  void EntriesPass(const std::vector<LightEntry>& entries, bool shortcuts, int near_end,
+                   int far_begin, double z_far);
   // The passes that shade `lights` lights at the present options.
   std::vector<Shading> ShadingPasses(int lights) const;
   void SetCommonUniforms(unsigned program, Shading shading);
-  // The light lists of the tiles for one pass's entries (lights: their PackLights, 4 floats
-  // each; near_end and far_begin as EntriesPass's), after the tiles' bounds if the G-buffer
-  // changed.
-  void TileLists(int lights_per_pass, const float* lights, const std::vector<LightEntry>& entries,
-                 int near_end, int far_begin);
-  // The light program for the present options (fast: the shortcuts'), linked when first used.
-  unsigned LightProgram(bool fast, Shading shading = Shading::kExact);
+  // The light program for the present options (shortcuts: the shortcuts'), linked when first
+  // used.
+  unsigned LightProgram(bool shortcuts, Shading shading = Shading::kExact);
   void DrawLightPass(Shading shading);
-  void FastPasses(const std::vector<int>& todo);
-  void LightPasses(const std::vector<int>& lights);
+
+  // renderer_reproject.cc.
+  // The view shaded in full so far becomes reprojection's source (before the G-buffer changes).
+  void KeepViewAsSource();
+  // After a new G-buffer: reprojects the source's sums when it may (true); otherwise the view is
+  // to be shaded in full (false).
+  bool TryReproject();
   void Reproject();
-  void AllocateTargets();
 
   SlabInfo info_;
   int width_, height_;

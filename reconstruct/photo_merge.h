@@ -5,30 +5,18 @@
 // a longer exposure measured the pixel, and the rest are averaged with the inverse-variance
 // weights of a sensor noise model (NoiseModel). The exposure ratios between brackets are
 // estimated from the pixels and reported against the recorded ones; optionally used.
+// The parts: merge_exposure.h (one photo's noise terms and readers), bracket_ratios.h (the ratio
+// estimate), merge_kernels.h (the row kernels, one copy per instruction set); the photos are
+// decoded by lib/photo/dataset_photo.h.
 #pragma once
 
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include "core/dataset.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/dataset_photo.h"
 
 namespace lumislab {
-
-struct DecodedPhoto {
-  PhotoEntry entry;
-  Photo photo;  // decoded with the dataset's radiometry and the entry's exposure
-};
-
-// Decodes one photo of the dataset, with the radiometric corrections of calib/ when given; a
-// missing or undecodable file is bad input naming the photo.
-DecodedPhoto DecodeDatasetPhoto(const Dataset& dataset, const PhotoEntry& entry,
-                                std::shared_ptr<const PhotoCorrections> corrections = nullptr);
-
-// Checks that every photo has the calibration's image size (bad input naming the photo).
-void CheckPhotoSizes(const std::vector<DecodedPhoto>& photos, int width, int height,
-                     const std::string& calibration_file);
 
 // Noise of a recorded value u (linear, above black, in units of the white level: u = 1 at the
 // white level), the same for every photo of a slide:

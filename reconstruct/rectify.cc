@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_allocator.h"
 
 namespace lumislab {
 
@@ -252,8 +252,8 @@ cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
   LUMISLAB_CHECK(signal.type() == CV_32FC4 || signal.type() == CV_32FC3,
                  "Rectify: expects a CV_32FC3/4 image");
   // The samples (K x K per texel: 1800 x 1800 x 4 floats, 52 MB, for the bench's 6000 x 4000
-  // photos) in huge pages (NewPhotoImage): on the development VM a fresh 4 kB page costs
-  // 15 - 50 us to first touch, ~0.2 - 0.4 s for this image in 4 kB pages (docs/design.md 8.3).
+  // photos) in huge pages (NewPhotoImage): in 4 kB pages, the page faults of the first touch
+  // are a large part of the remap's time (docs/design.md §8.3).
   cv::Mat samples = NewPhotoImage(map.map_xy.rows, map.map_xy.cols, signal.type()), texels;
   cv::remap(signal, samples, map.map_xy, map.map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));

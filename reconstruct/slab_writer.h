@@ -20,6 +20,8 @@ class SlabWriter {
   SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir = "",
              const std::string& units = "");
 
+  // Unlocked: read its layout and grid only while positions are written (`present` changes
+  // under the lock; ask IsPresent, Complete, PresentCount).
   const SlabInfo& info() const { return info_; }
   const std::string& dir() const { return dir_; }
   bool IsPresent(int i, int j) const;

@@ -45,8 +45,8 @@ fi
 
 jobs=$(nproc)
 # Unity build: a library's sources compiled eight to a translation unit, so the heavy headers
-# (OpenCV, Ceres, Eigen) are parsed once per batch, not once per file: about 40 % less compile
-# time from scratch, which is what CI pays twice. Pass -DCMAKE_UNITY_BUILD=OFF for file-by-file
+# (OpenCV, Ceres, Eigen) are parsed once per batch, not once per file: a build from scratch,
+# which is what CI pays twice, takes much less time. Pass -DCMAKE_UNITY_BUILD=OFF for file-by-file
 # rebuilds while developing.
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON \
   -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld "$@" >/dev/null

@@ -32,7 +32,7 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 fuzz_seconds=${LUMISLAB_FUZZ_SECONDS:-15}
 # The sanitizer and fuzz builds: -O2 with line tables (readable stack traces). Not -O1: Eigen
-# needs its inlining, at -O1 the calibrate tests ran 30x slower than Release under ASan.
+# needs its inlining: at -O1 under ASan the calibrate tests run many times slower than Release.
 # Unity builds and lld, as scripts/setup.sh's.
 clang_args=(-G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_UNITY_BUILD=ON
   -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld

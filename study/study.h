@@ -43,7 +43,7 @@ std::vector<std::string> SplitCsvLine(const std::string& line);
 void ReadCsvLines(const std::string& path, const std::string& header, size_t fields,
                   const std::function<void(const std::vector<std::string>&)>& parse);
 
-// Measured times scatter with the machine's load (reconstruct and render by ±25 % and more);
+// Measured times scatter with the machine's load (reconstruct's and render's the most);
 // totals within this fraction of each other count as the same time, so that a point is not put
 // on the front, or named cheapest, over a more accurate one for a few hundred ms of scatter.
 constexpr double kTimeScatter = 0.05;

@@ -5,7 +5,7 @@ _lumislab_sanitizers="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 # Every ASan error is fatal; leaks are checked at exit (LSan, suppressions in lsan.supp).
 # exitcode=66: a process that a sanitizer stops exits 66, never one of lumislab's codes 0-3, so a
 # test that runs a tool and expects exit 1, 2 or 3 fails when the tool hit a sanitizer report.
-# detect_stack_use_after_return stays off (ASan's default): it made the CPU-bound tests ~25 %
+# detect_stack_use_after_return stays off (ASan's default): it makes the CPU-bound tests markedly
 # slower; set ASAN_OPTIONS=detect_stack_use_after_return=1 before sourcing to have it.
 export ASAN_OPTIONS="exitcode=66:detect_leaks=1:check_initialization_order=1:\
 strict_init_order=1:handle_abort=1:symbolize=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_format.h"
 #include "lib/photo/raw_decode.h"
 
 namespace lumislab {

@@ -1,9 +1,9 @@
 // PNG and TIFF decoding and encoding through libpng and libtiff directly, for lib/photo's decoder
 // (photo_io.cc) and writers; JPEG through libjpeg is in jpeg_decode.h. Not through OpenCV's
 // imgcodecs: Debian's libopencv_imgcodecs links GDAL and GDCM, and with them ~110 more shared
-// libraries that every process loads at start, ~0.1 s of CPU per process on the development VM (a
-// tool's --help took 0.12 s with it, a program without it 0.012 s). The tests start the tools
-// thousands of times; a lab's batch conversion once per stage and dataset.
+// libraries that every process loads at start, which multiplies the start-up time of a tool (its
+// --help included). The tests start the tools thousands of times; a lab's batch conversion once
+// per stage and dataset.
 //
 // Images are cv::Mat in OpenCV's conventions, so that the rest of lumislab sees what imread gave
 // (the exceptions are said below):

@@ -14,6 +14,8 @@
 
 #include "core/error.h"
 #include "lib/photo/image_codecs.h"
+#include "lib/photo/photo_allocator.h"
+#include "lib/photo/photo_format.h"
 #include "lib/photo/photo_io.h"
 
 namespace lumislab {

@@ -1,23 +1,13 @@
 #include "lib/photo/photo_io.h"
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <deque>
 #include <filesystem>
 #include <fstream>
-#include <limits>
-#include <mutex>
-#include <opencv2/imgproc.hpp>
 
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
-#include "core/input_file.h"
-#include "lib/photo/camera_write.h"
 #include "lib/photo/image_codecs.h"
 #include "lib/photo/jpeg_decode.h"
 #include "lib/photo/raw_decode.h"
@@ -27,119 +17,6 @@ namespace {
 
 float SrgbToLinear(float v) {
   return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
-double LinearToSrgb(double v) {
-  v = std::clamp(v, 0.0, 1.0);
-  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-}
-
-// cv::Mat's standard allocator (OpenCV's StdMatAllocator), except that a buffer of 4 MB or more
-// is aligned to 2 MB, marked for transparent huge pages, and kept when released for the next
-// image of the same byte size. (Fresh pages are zeroed by the kernel at first touch: 864 MB of
-// JPEG photo buffers per position, ~0.75 s of a 6000 x 4000 position's ~2.35 s CPU time on the
-// development VM, docs/design.md 8.3; the photos of the next position have the same sizes.) The
-// kept buffers and those in use add up to at most the most bytes ever in use at once (the oldest
-// kept buffers are freed first), so the process never holds more than at its busiest. Other
-// buffers are freed with std::free.
-class HugePageAllocator : public cv::MatAllocator {
- public:
-  cv::UMatData* allocate(int dims, const int* sizes, int type, void* data0, size_t* step,
-                         cv::AccessFlag, cv::UMatUsageFlags) const override {
-    size_t total = CV_ELEM_SIZE(type);
-    for (int i = dims - 1; i >= 0; --i) {
-      if (step) {
-        if (data0 && step[i] != cv::Mat::AUTO_STEP) {
-          CV_Assert(total <= step[i]);
-          total = step[i];
-        } else {
-          step[i] = total;
-        }
-      }
-      total *= size_t(sizes[i]);
-    }
-    void* data = data0;
-    if (!data) data = Huge(total) ? TakeKept(total) : nullptr;
-    if (!data) {
-      if (posix_memalign(&data, Huge(total) ? kHuge : 64, std::max<size_t>(total, 1)) != 0) {
-        if (Huge(total)) Uncount(total);
-        throw std::bad_alloc();
-      }
-#ifdef MADV_HUGEPAGE
-      // Advice only: where the kernel has no THP the pages stay 4 kB.
-      if (Huge(total)) madvise(data, total / kHuge * kHuge, MADV_HUGEPAGE);
-#endif
-    }
-    auto* u = new cv::UMatData(this);
-    u->data = u->origdata = static_cast<uchar*>(data);
-    u->size = total;
-    if (data0) u->flags |= cv::UMatData::USER_ALLOCATED;
-    return u;
-  }
-  bool allocate(cv::UMatData* u, cv::AccessFlag, cv::UMatUsageFlags) const override {
-    return u != nullptr;
-  }
-  void deallocate(cv::UMatData* u) const override {
-    if (!u) return;
-    CV_Assert(u->urefcount == 0 && u->refcount == 0);
-    if (!(u->flags & cv::UMatData::USER_ALLOCATED)) {
-      if (Huge(u->size))
-        Keep(u->origdata, u->size);
-      else
-        std::free(u->origdata);
-    }
-    delete u;
-  }
-
- private:
-  static constexpr size_t kHuge = size_t(2) << 20;
-  static bool Huge(size_t bytes) { return bytes >= 2 * kHuge; }
-
-  // A kept buffer of exactly `bytes` (the most recently kept), or nullptr: the caller allocates
-  // a fresh one, counted here as in use.
-  void* TakeKept(size_t bytes) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    in_use_ += bytes;
-    for (auto k = kept_.rbegin(); k != kept_.rend(); ++k)
-      if (k->second == bytes) {
-        void* data = k->first;
-        kept_bytes_ -= bytes;
-        kept_.erase(std::next(k).base());
-        return data;
-      }
-    peak_ = std::max(peak_, in_use_);
-    FreeOldestKept();
-    return nullptr;
-  }
-  void Uncount(size_t bytes) const {  // a fresh buffer that could not be allocated
-    std::lock_guard<std::mutex> lock(mutex_);
-    in_use_ -= bytes;
-  }
-  void Keep(void* data, size_t bytes) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    in_use_ -= bytes;
-    kept_.emplace_back(data, bytes);
-    kept_bytes_ += bytes;
-    FreeOldestKept();
-  }
-  // Frees the oldest kept buffers until kept + in use <= peak (mutex_ held).
-  void FreeOldestKept() const {
-    while (!kept_.empty() && kept_bytes_ + in_use_ > peak_) {
-      std::free(kept_.front().first);
-      kept_bytes_ -= kept_.front().second;
-      kept_.pop_front();
-    }
-  }
-
-  mutable std::mutex mutex_;
-  mutable std::deque<std::pair<void*, size_t>> kept_;  // oldest first
-  mutable size_t kept_bytes_ = 0, in_use_ = 0, peak_ = 0;
-};
-
-// The allocator of NewPhotoImage. Never destroyed: images held by other static objects may
-// outlive any static allocator.
-cv::MatAllocator* PhotoAllocator() {
-  static HugePageAllocator* const allocator = new HugePageAllocator;
-  return allocator;
 }
 
 // Checks a PNG's chunk structure before libpng decodes it: the size in IHDR (refused beyond
@@ -171,46 +48,6 @@ void CheckPng(const std::string& path) {
     if (at > file_size) throw BadInput(path + ": truncated PNG (a chunk runs past the end)");
     if (std::memcmp(chunk + 4, "IEND", 4) == 0) return;
   }
-}
-
-// Which of DNGVersion (50706) and Make (271) the first IFD of a TIFF container holds. Reads the
-// IFD's entries only (at most 4096); a cut or odd IFD counts as holding neither, and the
-// decoder then reports what is wrong with the file.
-struct TiffTags {
-  bool dng_version = false, make = false;
-};
-TiffTags ScanFirstIfd(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  unsigned char header[8];
-  TiffTags tags;
-  if (!in.read(reinterpret_cast<char*>(header), 8)) return tags;
-  const bool big = header[0] == 'M';
-  auto get = [&](const unsigned char* b, int n) {
-    uint32_t v = 0;
-    for (int k = 0; k < n; ++k) v |= uint32_t(b[big ? k : n - 1 - k]) << (8 * (n - 1 - k));
-    return v;
-  };
-  unsigned char count_bytes[2];
-  in.seekg(std::streamoff(get(header + 4, 4)));
-  if (!in.read(reinterpret_cast<char*>(count_bytes), 2)) return tags;
-  const uint32_t count = std::min<uint32_t>(get(count_bytes, 2), 4096);
-  for (uint32_t k = 0; k < count; ++k) {
-    unsigned char entry[12];
-    if (!in.read(reinterpret_cast<char*>(entry), 12)) break;
-    const uint32_t tag = get(entry, 2);
-    tags.dng_version |= tag == 50706;
-    tags.make |= tag == 271;
-  }
-  return tags;
-}
-
-// Camera RAW containers other than TIFF that LibRaw is asked about (ORF, RW2, RAF, CR3). Only
-// these: LibRaw also identifies headerless RAWs by their file size alone, which garbage can
-// match.
-bool RawMagic(const unsigned char* m) {
-  return std::memcmp(m, "IIRO", 4) == 0 || std::memcmp(m, "IIRS", 4) == 0 ||
-         std::memcmp(m, "MMOR", 4) == 0 || std::memcmp(m, "IIU\0", 4) == 0 ||
-         std::memcmp(m, "FUJIFILM", 8) == 0 || std::memcmp(m + 4, "ftypcrx ", 8) == 0;
 }
 
 }  // namespace
@@ -247,42 +84,6 @@ PhotoSpec CalibrationPhotoSpec(const Dataset& dataset) {
   PhotoSpec spec = PhotoSpecOf(dataset, entry);
   spec.saturation_level = 1e30;  // the board's contrast is what counts, not clipping
   return spec;
-}
-
-const char* PhotoFormatName(PhotoFormat format) {
-  switch (format) {
-    case PhotoFormat::kPng:
-      return "PNG";
-    case PhotoFormat::kJpeg:
-      return "JPEG";
-    case PhotoFormat::kTiff:
-      return "TIFF";
-    case PhotoFormat::kExr:
-      return "EXR";
-    case PhotoFormat::kRaw:
-      return "camera RAW";
-  }
-  return "?";
-}
-
-PhotoFormat DetectPhotoFormat(const std::string& path) {
-  CheckInputFile(path, "photo");
-  unsigned char magic[12] = {};
-  std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(magic), sizeof magic);
-  if (!in && in.gcount() < 4) throw BadInput(path + ": not a photo (file too short)");
-  if (std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0) return PhotoFormat::kPng;
-  if (magic[0] == 0xff && magic[1] == 0xd8 && magic[2] == 0xff) return PhotoFormat::kJpeg;
-  if (std::memcmp(magic, "II*\0", 4) == 0 || std::memcmp(magic, "MM\0*", 4) == 0) {
-    const TiffTags tags = ScanFirstIfd(path);
-    const bool cr2 = magic[8] == 'C' && magic[9] == 'R';
-    if (tags.dng_version || cr2 || (tags.make && LibRawIdentifiesRaw(path)))
-      return PhotoFormat::kRaw;
-    return PhotoFormat::kTiff;
-  }
-  if (std::memcmp(magic, "\x76\x2f\x31\x01", 4) == 0) return PhotoFormat::kExr;
-  if (RawMagic(magic) && LibRawIdentifiesRaw(path)) return PhotoFormat::kRaw;
-  throw BadInput(path + ": not a photo lumislab reads (PNG, JPEG, TIFF, OpenEXR or camera RAW)");
 }
 
 double Photo::CodeMax() const {
@@ -324,16 +125,6 @@ std::vector<float> FractionalCodeTable(const float* table) {
   std::vector<float> entries(kFractionalCodeTable, table[255]);
   for (int c = 0; c <= kTop; ++c) entries[c] = ReadBetweenCodes(table, uint16_t(c));
   return entries;
-}
-
-cv::Mat NewPhotoImage(int rows, int cols, int type) {
-  cv::Mat image;
-  image.allocator = PhotoAllocator();
-  image.create(rows, cols, type);
-  // Later create() calls on this Mat (or its copies) would keep the allocator: only the
-  // buffer is ours.
-  image.allocator = nullptr;
-  return image;
 }
 
 Photo DecodePhoto(const std::string& path, const PhotoSpec& spec) {
@@ -508,77 +299,6 @@ cv::Mat LinearGray(const Photo& photo) {
     }
   }
   return gray;
-}
-
-void WriteImageFile(const std::string& path, const cv::Mat& image, int jpeg_quality) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  if (ext == ".tif" || ext == ".tiff") return WriteTiff(path, image, PhotoExif{});
-  LUMISLAB_CHECK(ext == ".png" || ext == ".jpg" || ext == ".jpeg",
-                 "WriteImageFile: a .png, .jpg or .tif path, got " + path);
-  WriteAtomically(path, [&](const std::string& tmp) {
-    if (ext == ".png") return EncodePng(tmp, image, path);
-    const std::vector<unsigned char> jpeg = EncodeJpeg(image, jpeg_quality);
-    std::ofstream file(tmp, std::ios::binary);
-    file.write(reinterpret_cast<const char*>(jpeg.data()), std::streamsize(jpeg.size()));
-    file.close();
-    if (!file) throw IoError(path, "cannot write the JPEG");
-  });
-}
-
-void WriteRgb8File(const std::string& path, int width, int height,
-                   const std::vector<uint8_t>& rgb) {
-  if (rgb.size() != size_t(width) * height * 3) throw Failure(path + ": RGB buffer size mismatch");
-  cv::Mat bgr(height, width, CV_8UC3);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const uint8_t* p = &rgb[(size_t(y) * width + x) * 3];
-      bgr.at<cv::Vec3b>(y, x) = cv::Vec3b(p[2], p[1], p[0]);
-    }
-  WriteImageFile(path, bgr);
-}
-
-cv::Mat PhotoCodes(const ImageF& linear, PhotoEncoding encoding) {
-  LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "PhotoCodes: 1 or 3 channels");
-  const bool srgb = encoding == PhotoEncoding::kSrgb8Png;
-  const bool eight_bit = srgb || encoding == PhotoEncoding::kCurve8Jpeg;
-  const int type = eight_bit ? CV_8UC(linear.channels) : CV_16UC(linear.channels);
-  const double max = eight_bit ? 255.0 : 65535.0;
-  cv::Mat out(linear.height, linear.width, type);
-  for (int y = 0; y < linear.height; ++y)
-    for (int x = 0; x < linear.width; ++x)
-      for (int c = 0; c < linear.channels; ++c) {
-        const double v = linear.at(x, y, c);
-        const double code = std::round((srgb ? LinearToSrgb(v) : std::clamp(v, 0.0, 1.0)) * max);
-        const int oc = linear.channels == 3 ? 2 - c : 0;  // OpenCV stores BGR
-        if (eight_bit)
-          out.ptr<uint8_t>(y)[x * linear.channels + oc] = uint8_t(code);
-        else
-          out.ptr<uint16_t>(y)[x * linear.channels + oc] = uint16_t(code);
-      }
-  return out;
-}
-
-void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding,
-                int jpeg_quality) {
-  LUMISLAB_CHECK(linear.channels == 3 || linear.channels == 1, "WritePhoto: 1 or 3 channels");
-  if (encoding == PhotoEncoding::kHalfExr || encoding == PhotoEncoding::kFloatExr ||
-      encoding == PhotoEncoding::kFloatExrPiz) {
-    ExrOptions options;
-    options.half = encoding == PhotoEncoding::kHalfExr;
-    options.compression = encoding == PhotoEncoding::kHalfExr       ? ExrCompression::kRle
-                          : encoding == PhotoEncoding::kFloatExrPiz ? ExrCompression::kPiz
-                                                                    : ExrCompression::kNone;
-    const std::vector<std::string> names = linear.channels == 3
-                                               ? std::vector<std::string>{"R", "G", "B"}
-                                               : std::vector<std::string>{"Y"};
-    WriteExr(path, linear, names, {}, options);
-    return;
-  }
-  const cv::Mat out = PhotoCodes(linear, encoding);
-  const bool jpeg = encoding == PhotoEncoding::kCurve8Jpeg;
-  WriteImageFile(path, out, jpeg ? jpeg_quality : 95);
 }
 
 }  // namespace lumislab

@@ -1,6 +1,6 @@
 // The one photo decoder of lumislab: every stage that reads a camera photo reads it here
 // (docs/design.md §5). It owns
-//   - format detection from the file's content (the extension is not trusted),
+//   - format detection from the file's content (lib/photo/photo_format.h),
 //   - camera RAW and DNG through LibRaw (lib/photo/raw_decode.h): linear sensor values with the
 //     file's black and white level, white balance unity or as shot, full or half size,
 //   - the transfer curve: 8-bit photos are camera output and linearised through the sRGB curve
@@ -9,8 +9,8 @@
 //   - the saturation mask: a value curve(code / code_max) >= saturation_level is clipped,
 //   - exposure normalisation: values are divided by the photo's relative exposure, so photos of
 //     different exposures are comparable.
-// Writing image files (atomically) is here too, so that every PNG/EXR a tool writes goes
-// through one place.
+// Decoded images are allocated by lib/photo/photo_allocator.h; images are written by
+// lib/photo/photo_write.h.
 #pragma once
 
 #include <array>
@@ -21,18 +21,11 @@
 #include <vector>
 
 #include "core/dataset.h"
-#include "core/image.h"
+#include "lib/photo/photo_format.h"
 #include "lib/photo/radiometric_calibration.h"
 
 namespace lumislab {
 
-// kRaw: a camera RAW or DNG (LibRaw). A TIFF container is a DNG when its first IFD holds the
-// DNGVersion tag; a TIFF without it is a camera RAW (NEF, ARW, PEF, ...) when it names a camera
-// maker and LibRaw identifies a Bayer mosaic in it, since a plain TIFF reader would decode
-// only its small preview. Anything else in a TIFF container is a plain TIFF (libtiff).
-enum class PhotoFormat { kPng, kJpeg, kTiff, kExr, kRaw };
-// Largest photo decoded (pixels; a 100-megapixel camera fits), checked from the header.
-constexpr long long kMaxPhotoPixels = 1LL << 27;
 // kResponse: a camera response calibrated by lumislab-calibrate response (calib/response.json),
 // used for 8-bit photos whenever PhotoSpec::corrections holds one; never asked for, only resolved.
 enum class Transfer { kAuto, kLinear, kSrgb, kResponse };
@@ -102,9 +95,9 @@ constexpr int kFractionalCodeOne = 256;
 // The one reading of a fractional code through a per-code table (256 entries; the curve value
 // of each whole code): the table's value read linearly between the two codes around it.
 // Without a branch, which the merge's row loop mispredicted (f = 0 at every code 0 and 255 and
-// at random elsewhere; a test loop: 1.2 - 4 ns per value with the branch, 0.8 without): at a
-// whole code (f = 0) both reads are table[k] and the value is table[k] + 0 = table[k] exactly
-// (the tables hold finite values or NaN, never an infinity).
+// at random elsewhere; a test loop measured it slower): at a whole code (f = 0) both reads are
+// table[k] and the value is table[k] + 0 = table[k] exactly (the tables hold finite values or
+// NaN, never an infinity).
 inline float ReadBetweenCodes(const float* table, uint16_t fractional_code) {
   const int k = fractional_code >> 8, f = fractional_code & 255;
   // f > 0 only below code 255: table[k + 1] is in the table.
@@ -123,13 +116,6 @@ inline int CodeAtOrAbove(uint16_t fractional_code) {
   return (fractional_code + kFractionalCodeOne - 1) >> 8;
 }
 
-// A new image for a photo's pixels (type as cv::Mat::create). Large ones are allocated in
-// transparent huge pages (madvise(MADV_HUGEPAGE), for a kernel whose THP mode is `madvise`):
-// filling a fresh 144 MB image costs ~37000 first-touch page faults in 4 kB pages, 0.5 - 1 s on
-// the development VM, against ~72 faults of 2 MB pages. Released as any cv::Mat; a large one's
-// buffer is kept for the next image of its size (the kernel zeroes fresh pages, photo_io.cc).
-cv::Mat NewPhotoImage(int rows, int cols, int type);
-
 // The spec of a dataset's slide photo (its radiometry and the photo's exposure), and of its
 // calibration photo (exposure 1, nothing clipped).
 PhotoSpec PhotoSpecOf(const Dataset& dataset, const PhotoEntry& entry);
@@ -139,9 +125,6 @@ PhotoSpec CalibrationPhotoSpec(const Dataset& dataset);
 // unsupported pixel layout is BadInput naming the photo (exit 2), as is a photo whose size
 // differs from that of a calibration map in spec.corrections (naming both).
 Photo DecodePhoto(const std::string& path, const PhotoSpec& spec = {});
-// The format from the file's first bytes; BadInput naming the file when it is none of ours.
-PhotoFormat DetectPhotoFormat(const std::string& path);
-const char* PhotoFormatName(PhotoFormat format);
 
 // Linear, exposure-normalised RGB of a pixel, and which channels are clipped.
 class LinearReader {
@@ -169,31 +152,5 @@ cv::Mat Codes8(const Photo& photo);
 // The whole photo as linear, exposure-normalised Rec. 709 luminance (CV_32FC1); BadInput when a
 // value is not finite.
 cv::Mat LinearGray(const Photo& photo);
-
-// Writes `image` (8-bit or 16-bit, 1, 3 or 4 channels in OpenCV's B, G, R (A) order) under a
-// temporary name, then renames it into place, as PNG, JPEG (8-bit, 1 or 3 channels, at
-// `jpeg_quality`) or uncompressed TIFF by the path's extension (.png, .jpg/.jpeg, .tif/.tiff;
-// lib/photo/image_codecs.h).
-void WriteImageFile(const std::string& path, const cv::Mat& image, int jpeg_quality = 95);
-// 8-bit RGB (width * height * 3 bytes, RGB interleaved, row 0 on top: lib/lightfield's Rgb8Image
-// and the preview's tone-mapped frames) through WriteImageFile (PNG by the path's ending).
-void WriteRgb8File(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
-
-// How the synthetic camera stores a photo of normalised linear RGB values (ImageF, 3 channels).
-enum class PhotoEncoding {
-  kLinear16Png,  // round(v * 65535), clipped: a 16-bit camera (values already quantised)
-  kSrgb8Png,     // through the sRGB curve, 8 bit: a camera's PNG/JPEG-like output
-  kHalfExr,      // half-float EXR, RLE (lossless for half; ~5e-4 relative precision)
-  kFloatExr,     // 32-bit float EXR, uncompressed
-  kFloatExrPiz,  // 32-bit float EXR, PIZ
-  // Not linear: the values are a camera response's output in [0, 1] (the synthetic `response`
-  // effect), written as round(v * 255) in an 8-bit JPEG at `jpeg_quality`.
-  kCurve8Jpeg,
-};
-void WritePhoto(const std::string& path, const ImageF& linear, PhotoEncoding encoding,
-                int jpeg_quality = 95);
-// The codes an 8- or 16-bit encoding (kLinear16Png, kSrgb8Png, kCurve8Jpeg) stores, in
-// OpenCV's BGR order: what WritePhoto writes, for writers with EXIF (lib/photo/camera_write.h).
-cv::Mat PhotoCodes(const ImageF& linear, PhotoEncoding encoding);
 
 }  // namespace lumislab

@@ -7,9 +7,9 @@
 //                                    over the pixels that see the screen;
 //   calib/scale.json                 the absolute scale: irradiance (W/m^2 or lux) per unit of
 //                                    corrected linear value at exposure 1.
-// lumislab-calibrate writes them (calibrate/radiometric_*.cc); reconstruct and the later
-// calibration steps read them here. Maps are in the decoder's linear units before the division
-// by the exposure: (curve(code) - black_level) / (white_level - black_level).
+// lumislab-calibrate writes them (its dark, flat, response and scale calibrators); reconstruct
+// and the later calibration steps read them here. Maps are in the decoder's linear units before the
+// division by the exposure: (curve(code) - black_level) / (white_level - black_level).
 #pragma once
 
 #include <array>

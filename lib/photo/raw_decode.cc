@@ -9,7 +9,8 @@
 #include <memory>
 
 #include "core/error.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_allocator.h"
+#include "lib/photo/photo_format.h"
 
 namespace lumislab {
 namespace {

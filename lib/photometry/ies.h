@@ -23,8 +23,10 @@ IntensityDistribution ReadIes(const std::string& path);
 extern const char* const kIesRequiredKeywords[4];  // TEST, TESTLAB, ISSUEDATE, MANUFAC
 
 struct IesWriteOptions {
-  // LM-63-2019's file generation type (line 11, second value): 1.00010 = "test at an
-  // unaccredited lab, interpolated angle set", what a distribution computed from a slab is.
+  // LM-63-2019's file generation type (line 11, second value), written as given. The default
+  // 1.00010 is "computer simulation" in the standard's table (Table 1), not "test at an
+  // unaccredited lab, interpolated angle set" (that is 1.01000); which one a distribution
+  // computed from a slab should carry is issue 29's to settle.
   std::string file_generation_type = "1.00010";
 };
 

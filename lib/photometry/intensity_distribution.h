@@ -38,8 +38,9 @@ struct IntensityDistribution {
   std::vector<double> values;     // values[ic * gamma_deg.size() + ig]; cd or W/sr, >= 0
   bool photometric = true;        // cd (lm) or W/sr (W)
   LuminousOpening opening;
-  // Keywords and other text fields as the file names them ("TEST", "MANUFAC", ... for IES;
-  // "company", "luminaire_name", ... for EULUMDAT), in file order.
+  // Keywords and other text fields, in file order: IES keywords as the file names them
+  // ("TEST", "MANUFAC", ...); EULUMDAT's text lines under the IES name where one exists
+  // (company -> "MANUFAC", luminaire name -> "LUMINAIRE", ...), else "_LDT_<FIELD>".
   std::vector<std::pair<std::string, std::string>> keywords;
   double input_watts = 0;  // luminaire input power, W (0: unknown)
 

@@ -192,7 +192,7 @@ std::shared_ptr<const Effect> MakeLens(const JsonView& spec, const EffectSetting
 }  // namespace
 
 void SensorNoiseEffect::Apply(ImageF& rgb, const PhotoContext& context) const {
-  // splitmix-style mixing so that neighbouring photo indices get unrelated streams.
+  // std::seed_seq mixes seed and photo index so that neighbouring indices get unrelated streams.
   std::seed_seq seq{static_cast<unsigned>(seed_), static_cast<unsigned>(seed_ >> 32),
                     static_cast<unsigned>(context.photo_index), 0x6c756d69u};
   std::mt19937_64 rng(seq);

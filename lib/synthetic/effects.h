@@ -44,7 +44,8 @@ class Effect {
 };
 
 // Shot noise (Gaussian with variance = electrons, electrons = v full_well) plus Gaussian read
-// noise, in electrons; deterministic for a seed (the RNG of photo k is seeded from seed + k).
+// noise, in electrons; deterministic for a seed (photo k's mt19937_64 is seeded by a
+// std::seed_seq of the seed's two 32-bit halves, k and a constant).
 class SensorNoiseEffect : public Effect {
  public:
   SensorNoiseEffect(double full_well_e, double read_noise_e, unsigned long long seed)
@@ -72,7 +73,7 @@ class QuantizationEffect : public Effect {
 
 // Light fall-off of the lens: cos^4 of the angle off the camera axis (pinhole: tan = distance
 // to the principal point / focal length) times 1 + k1 r^2 + k2 r^4, r = distance to the
-// principal point / its distance to the corner pixel centres.
+// principal point / the principal point's distance to pixel (0, 0)'s centre.
 class VignettingEffect : public Effect {
  public:
   VignettingEffect(const CameraSpec& camera, double k1, double k2, bool cos4);

@@ -104,7 +104,7 @@ enum class Input {
 
 // The valid datasets, made once for a build of the tools and shared by every process (the
 // shards, which ctest runs side by side, and single cases run by hand): making them in each
-// (acquire, calibrate, reconstruct: about 0.5 s) is what this saves. They live in the build tree
+// (acquire, calibrate, reconstruct, each time) is what this saves. They live in the build tree
 // under a key of the sizes and times of the tools and of this test, are made under an exclusive
 // lock (flock) into a staging folder that is renamed into place, and are only ever read (each case
 // works on its own copy).

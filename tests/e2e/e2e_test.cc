@@ -119,7 +119,7 @@ TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
 TEST(EndToEnd, BlackLevelAmbientAndBracketsLeaveTheSlabAccurate) {
   // An accuracy run at full size; each of its paths runs under the sanitizers in smaller tests
   // (Reconstruct.ExposureBracketsRecoverClippedHighlights, BracketMerge.*, AmbientEffect.*,
-  // DarkEffect.*), where this one took 51 s.
+  // DarkEffect.*); this one is too long to run there.
   if (testing::kSanitized) GTEST_SKIP() << "accuracy run: the Release build's";
   const std::string ds = RunPipeline(
       "e2e_cancelling",

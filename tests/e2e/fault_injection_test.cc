@@ -17,7 +17,7 @@
 // 8 calibrate, 10 reconstruct, 10 preview). Only the processes this test starts are ever
 // signalled, by their pid. A failing test keeps its folder (logs/ holds every run's output).
 //
-// Run alone: ctest -L fault_injection (about 30 s on 2 cores).
+// Run alone: ctest -L fault_injection.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>

@@ -14,7 +14,7 @@
 #include "core/json.h"
 #include "core/screen_calibration.h"
 #include "core/slab_compare.h"
-#include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "lib/photo/radiometric_calibration.h"
 #include "test_util.h"
 

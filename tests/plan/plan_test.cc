@@ -251,7 +251,7 @@ TEST(Plan, ParallaxFloorMakesTargetsAwayFromDOutOfReach) {
 // The recommendation measured end to end: lumislab-study on the default scene with the planner's
 // grid for 1 % at 2d (extent x1) and the same h at half the span (x0.5, cheaper): the recommended
 // grid covers the view at d, meets the target at 2d and is predicted within the stated factor at
-// d, 2d and 4d; the cheaper one does not cover and misses the target (about 5 s).
+// d, 2d and 4d; the cheaper one does not cover and misses the target.
 TEST(Plan, RecommendationMeasuredByTheStudy) {
   PlanInput in = PlanInputFromScene(LoadScene("default"));
   in.receiver_mm = 2 * in.distance_mm;

@@ -1,5 +1,5 @@
-// Receiver-plane irradiance of acquire's default synthetic luminaire (acquire/scene.h
-// DefaultScene, truth slab from acquire/truth.h) against its analytic PlaneIrradiance at
+// Receiver-plane irradiance of acquire's default synthetic luminaire (lib/synthetic/scene.h
+// DefaultScene, truth slab from lib/synthetic/truth.h) against its analytic PlaneIrradiance at
 // D = d, 2d, 4d, compared inside the window's cone (where the slab holds light).
 #include <gtest/gtest.h>
 

@@ -12,6 +12,7 @@
 #include "core/exr_io.h"
 #include "core/json.h"
 #include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "lib/photo/radiometric_calibration.h"
 #include "photo_test_util.h"
 

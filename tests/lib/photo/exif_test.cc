@@ -11,6 +11,7 @@
 
 #include "lib/photo/camera_write.h"
 #include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "photo_test_util.h"
 
 namespace lumislab {

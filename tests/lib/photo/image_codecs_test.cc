@@ -24,6 +24,7 @@
 #include "core/error.h"
 #include "lib/photo/jpeg_decode.h"
 #include "lib/photo/photo_io.h"
+#include "lib/photo/photo_write.h"
 #include "photo_test_util.h"
 
 namespace lumislab {

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "lib/photo/photo_allocator.h"
 #include "lib/photo/photo_io.h"
 #include "photo_test_util.h"
 

@@ -1,0 +1,3 @@
+// Shadow maps hold depth only: their fragments write nothing else.
+#version 450 core
+void main() {}

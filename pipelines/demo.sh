@@ -4,7 +4,7 @@
 # Usage: pipelines/demo.sh [output folder, default out/default]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-pipelines/setup.sh
+scripts/setup.sh
 out="${1:-out/default}"
 bin=build/bin
 "$bin/lumislab-acquire" synth --scene default --out "$out"

@@ -40,7 +40,7 @@ TexelCorners CornerPixels(const ScreenCalibration& calibration, const SlabLayout
   const Eigen::Matrix3d image_from_screen = calibration.screen_from_image.inverse();
   // A screen point behind the camera maps through the homography to a mirrored pixel, which can
   // lie inside the photo: its texel would read the light of another point (a camera near a
-  // large screen at a grazing angle, tests/cli/hard_cases_test.cc). Points in front share the
+  // large screen at a grazing angle, tests/e2e/hard_cases_test.cc). Points in front share the
   // sign of the homogeneous coordinate with the photo's centre, which the camera sees; the
   // homography's overall sign is arbitrary, so it is taken from there.
   const Eigen::Vector2d centre_px(0.5 * (calibration.image_width - 1),
@@ -91,7 +91,7 @@ double MeasureTexels(const TexelCorners& c, const PhotoBounds& photo, RectifyMap
 // sample also reads photo pixels beyond the texel: bilinear reads of the F x F-averaged image
 // reach photo pixels up to 2F - 1 away, which there show the frame around the screen, not the
 // light (the edge texels came out 4 % dark with light running off the screen,
-// tests/cli/hard_cases_test.cc). Such a sample gets weight 0 (`sample_weight`), and the texel
+// tests/e2e/hard_cases_test.cc). Such a sample gets weight 0 (`sample_weight`), and the texel
 // is the mean of its other samples: the light over the part of the texel that reads only the
 // screen. A texel with less than kMinCleanSamples of its samples left is unseen. Texels far from
 // the edge have no such sample, and when no texel has one `sample_weight` stays empty. `f` is

@@ -1,4 +1,4 @@
-# Sourced by pipelines/test.sh and fuzz/run.sh: the sanitizer run-time options of the sanitizer
+# Sourced by scripts/test.sh and fuzz/run.sh: the sanitizer run-time options of the sanitizer
 # build's test suite and of the fuzz targets (fuzz/README.md). Options already in the environment
 # are kept and come last, so they win over these on a clash.
 _lumislab_sanitizers="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

@@ -2,7 +2,8 @@
 // arcades, tiled floors. Scene frame, mm, y up. Every part is built so that neighbouring parts
 // meet exactly: vaults over bays that share an edge use the same vertices along it, and a
 // surface that ends on another one ends on its plane (a wall rises past the vault that meets
-// it), so no ray from inside a room escapes between two parts (tests/lightfield/scenes_test.cc).
+// it), so no ray from inside a room escapes between two parts
+// (tests/lib/lightfield/scenes_test.cc).
 #pragma once
 
 #include <Eigen/Core>

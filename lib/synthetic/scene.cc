@@ -186,7 +186,7 @@ void ParseCalibration(const JsonView& root, SynthScene* scene) {
   t.squares_y = 13;
   t.square_mm = std::min({80.0, (scene->screen_w_mm - 80) / 14, (scene->screen_h_mm - 80) / 13});
   // On a small screen the 40 mm margins leave little or nothing: a screen of 100 mm got squares
-  // of 0.7 mm, a board no camera finds (tests/cli/hard_cases_test.cc, RandomisedSweep). Below
+  // of 0.7 mm, a board no camera finds (tests/e2e/hard_cases_test.cc, RandomisedSweep). Below
   // half of the small-screen board's square, that board (90 % of the screen) is used.
   const double small = 0.9 * std::min(scene->screen_w_mm / 14, scene->screen_h_mm / 13);
   if (!(t.square_mm > 0.5 * small)) t.square_mm = small;

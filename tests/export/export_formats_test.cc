@@ -8,7 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "../cli/test_util.h"
+#include "../e2e/test_util.h"
 #include "core/geometry.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/photometry/eulumdat.h"

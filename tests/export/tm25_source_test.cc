@@ -9,8 +9,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "../acquire/ray_samples.h"
-#include "../cli/test_util.h"
+#include "../e2e/test_util.h"
+#include "../lib/synthetic/ray_samples.h"
 #include "core/atomic_file.h"
 #include "core/slab.h"
 #include "lib/lightfield/far_field.h"

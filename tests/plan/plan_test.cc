@@ -13,7 +13,7 @@
 #include <set>
 #include <sstream>
 
-#include "../cli/test_util.h"
+#include "../e2e/test_util.h"
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
 

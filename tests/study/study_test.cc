@@ -11,7 +11,7 @@
 #include <map>
 #include <thread>
 
-#include "../cli/test_util.h"
+#include "../e2e/test_util.h"
 #include "core/atomic_file.h"
 #include "study/preview_sweep.h"
 

@@ -100,8 +100,9 @@ SlabError Errors(const SlabComparison& c) {
 
 TEST(LensCalibration, CameraFromViewsThenScreenPoseMatchesTruth) {
   if (testing::kSanitized)
-    GTEST_SKIP() << "accuracy run: the Release build's (the lens, the views and the pose solve "
-                    "run under the sanitizers in acquire_lens_effect_test and calibrate_cli_test)";
+    GTEST_SKIP()
+        << "accuracy run: the Release build's (the lens, the views and the pose solve "
+           "run under the sanitizers in synthetic_lens_effect_test and calibrate_cli_test)";
   const std::string dir = FreshDir("lens_calibration");
   std::string scene = SceneJson(2, 2, kCamera, kLens);
   scene.insert(scene.rfind('}'), kBoard);

@@ -1,4 +1,4 @@
-// The JPEG coding model of the noise floor (tests/cli/noise_floor.h, JpegCodingModel) against
+// The JPEG coding model of the noise floor (tests/e2e/jpeg_coding_model.h) against
 // the coding itself: a known picture with known noise is written as JPEG (libjpeg through
 // OpenCV, as the synthetic camera writes its photos) at several qualities and decoded by
 // lumislab's decoder (lib/photo/jpeg_decode.h); the measured error of the decoded codes against

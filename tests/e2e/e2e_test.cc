@@ -94,7 +94,7 @@ TEST(EndToEnd, NoisyCaptureWithinNoiseFloor) {
   const std::string clean = RunPipeline("e2e_clean", SceneJson(3, 3, kFrontalCamera, "[]"));
   const std::string noisy = RunPipeline("e2e_noisy", SceneJson(3, 3, kFrontalCamera, kNoise));
   const SlabComparison c = CompareSlabs(noisy + "/slab", noisy + "/truth");
-  // The sensor of kNoise, one 16-bit exposure per slide (tests/cli/noise_floor.h).
+  // The sensor of kNoise, one 16-bit exposure per slide (tests/e2e/noise_floor.h).
   testing::SensorNoiseModel sensor;
   sensor.full_well_e = kFullWell;
   sensor.read_noise_e = kReadNoise;

@@ -8,7 +8,7 @@
 // tool (or a contract to settle), never a reason to edit the expectation.
 //
 // Each case is a TEST_P; ctest runs them in 8 shards (Cli/Catalogue.shard<i>of8, each one process
-// running every 8th case: tests/cli/CMakeLists.txt; ctest -L catalogue runs them all; one case
+// running every 8th case: tests/e2e/CMakeLists.txt; ctest -L catalogue runs them all; one case
 // alone: bad_input_catalogue_test --gtest_filter='*/<name>'). The valid inputs (a 2x2 grid of
 // 320x240 photos, 16-bit PNG and half-float EXR, calibrated, a 40x40 slab) are made once per build
 // of the tools under a lock in the build tree (see Masters) and copied into a fresh folder per
@@ -68,7 +68,7 @@ constexpr int kSanitizerSampleEvery = 4;
 // ------------------------------------------------------------------------------------------
 // The valid inputs.
 
-// The scene of tests/cli/cli_bad_input_test.cc with smaller photos: 2x2 grid, 320x240 px.
+// The scene of tests/e2e/cli_bad_input_test.cc with smaller photos: 2x2 grid, 320x240 px.
 std::string ValidScene(bool png) {
   json scene = {{"schema_version", 1},
                 {"setup",

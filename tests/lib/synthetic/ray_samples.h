@@ -1,6 +1,6 @@
 // Rays importance-sampled from sources whose light is known in closed form, as TM-25 ray sets:
-// the ray source's tests (tests/acquire/ray_source_test.cc) and the TM-25 round trip through a
-// capture (tests/export/tm25_source_test.cc). Seeded, so every run draws the same rays.
+// the ray source's tests (tests/lib/synthetic/ray_source_test.cc) and the TM-25 round trip through
+// a capture (tests/export/tm25_source_test.cc). Seeded, so every run draws the same rays.
 #pragma once
 
 #include <cmath>

@@ -143,7 +143,7 @@ TEST(Radiometry, DarkRefusesBadFrames) {
 }
 
 // The response recovered from five JPEG frames (gamma 2.2 + shoulder, quality 95) against the
-// true curve, with sensor noise (a full well of 30000 e-, as tests/cli/real_camera_test.cc's
+// true curve, with sensor noise (a full well of 30000 e-, as tests/e2e/real_camera_test.cc's
 // camera; it dithers the codes) or without; `rms` and `max` are the tolerances.
 void CheckResponseCurve(bool noisy, double rms, double max) {
   const std::string ds =

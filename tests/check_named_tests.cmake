@@ -1,0 +1,30 @@
+# cmake -DCTEST=<ctest> -DBUILD=<build folder> -DNAMES=<file, one test name a line>
+#       -P check_named_tests.cmake
+# Fails naming every test of NAMES that `ctest -N` does not list (tests/CMakeLists.txt: the tests
+# that TESTS and COSTS entries name).
+cmake_minimum_required(VERSION 3.18)
+execute_process(COMMAND ${CTEST} --test-dir ${BUILD} -N OUTPUT_VARIABLE listing
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "ctest -N failed (${rc})")
+endif()
+string(REGEX MATCHALL "Test +#[0-9]+: [^\n]+" lines "${listing}")
+set(known "")
+foreach(line IN LISTS lines)
+  string(REGEX REPLACE "^Test +#[0-9]+: " "" name "${line}")
+  list(APPEND known "${name}")
+endforeach()
+file(STRINGS ${NAMES} names)
+set(missing "")
+foreach(name IN LISTS names)
+  if(NOT name IN_LIST known)
+    list(APPEND missing "${name}")
+  endif()
+endforeach()
+list(LENGTH known count)
+if(missing)
+  string(REPLACE ";" "\n  " missing "${missing}")
+  message(FATAL_ERROR "named in a TESTS or COSTS entry of tests/ but no such test:\n  ${missing}")
+endif()
+list(LENGTH names n)
+message("all ${n} tests named by TESTS and COSTS entries exist (of ${count})")

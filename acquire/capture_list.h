@@ -1,7 +1,6 @@
-// The list of a capture's photos that `acquire import` and `acquire watch` share (docs/design.md
-// §5.3), each photo checked as it is added, as a lab wants before a long run: import hands it a
-// whole folder at once; watch hands it each photo as it arrives. The photos come named by
-// photo_naming.h.
+// The list of a capture's photos that `acquire import` and `acquire watch` share (docs/formats.md
+// §3), each photo checked as it is added, as a lab wants before a long run: import hands it a whole
+// folder at once; watch hands it each photo as it arrives. The photos come named by photo_naming.h.
 #pragma once
 
 #include <map>

@@ -1,4 +1,4 @@
-// lumislab-acquire filter: the two printable filter slides T+ and T- (docs/design.md §2).
+// lumislab-acquire filter: the two printable filter slides T+ and T- (docs/method.md §2).
 #pragma once
 
 #include <string>

@@ -1,5 +1,5 @@
 // lumislab-acquire import: a folder of camera photos and a setup file become a dataset
-// (docs/design.md §5.3). The photos stay where the camera wrote them: dataset.json names their
+// (docs/formats.md §3). The photos stay where the camera wrote them: dataset.json names their
 // folder (photo_folder) and each file in it; nothing is copied or modified.
 #pragma once
 

@@ -1,4 +1,4 @@
-// How a capture's description names each photo (docs/design.md §5.3), for `acquire import`
+// How a capture's description names each photo (docs/formats.md §3), for `acquire import`
 // and `acquire watch`: a manifest (CSV), a file-name template, or the capture order. The photos
 // so named are checked and listed by capture_list.h. (Folder listing and temporary names:
 // core/input_file.h.)

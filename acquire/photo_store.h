@@ -1,4 +1,4 @@
-// How the synthetic capture stores its slide photos (docs/design.md §5.4, §5.10): the dataset's
+// How the synthetic capture stores its slide photos (docs/formats.md §4, §10): the dataset's
 // own encodings (lib/photo WritePhoto), an RGGB Bayer mosaic in a DNG for a scene with the `raw`
 // effect, and, for `synth --camera-folder`, the files a camera leaves behind: camera-style names
 // in capture order and EXIF (lib/photo/camera_write.h), with a setup file instead of a dataset.

@@ -1,5 +1,5 @@
-// lumislab-acquire synth: the synthetic capture of a scene into a dataset folder (docs/design.md
-// §5, §8).
+// lumislab-acquire synth: the synthetic capture of a scene into a dataset folder (docs/formats.md,
+// docs/testing.md).
 #pragma once
 
 #include <string>

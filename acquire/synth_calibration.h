@@ -1,5 +1,5 @@
 // The radiometric calibration captures of `acquire synth` (scene block calibration_captures,
-// docs/design.md §5.10): dark, flat and response frames under calibration/ with their manifest
+// docs/formats.md §10): dark, flat and response frames under calibration/ with their manifest
 // calibration/captures.json, and their truth (truth/flat.exr, truth/dark.exr,
 // truth/reference.json).
 #pragma once

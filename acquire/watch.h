@@ -1,4 +1,4 @@
-// lumislab-acquire watch: `import` while the photos arrive (docs/design.md §5.3), from any
+// lumislab-acquire watch: `import` while the photos arrive (docs/formats.md §3), from any
 // tethering software (gphoto2 --capture-tethered, a camera vendor's tool, a copy). dataset.json
 // is written at once with the setup and no photos, then rewritten (atomically) each time a grid
 // position becomes complete, so that `reconstruct --watch` and `preview --watch` follow a real

@@ -67,7 +67,7 @@ int Run(int argc, char** argv) {
   fast.merge_error = 0.05;
   fast.coarse_tolerance = -1;  // auto, as lumislab-preview: 0.1 with shadows, off without
   fast.reproject_tolerance = 0.1;
-  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/design.md §8)"};
+  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/testing.md)"};
   app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
   app.add_option("--size", size, "image side")->capture_default_str();
   app.add_option("--shadow-size", shadow_size, "shadow-map side")->capture_default_str();

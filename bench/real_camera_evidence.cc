@@ -28,7 +28,7 @@ TEST_F(RealCameraEvidence, JpegNoiseFree) {
   ASSERT_EQ(rows[0].positions.size(), 9u);
   // 0.86 % overall, 0.92 % worst position: without noise the 8-bit rounding of the curve's
   // output and JPEG's coding are not dithered, and 4 x 4-pixel means keep them
-  // (docs/design.md §5.16). Held at 1.2 % so that a regression shows.
+  // (docs/formats.md §16). Held at 1.2 % so that a regression shows.
   for (const auto& p : rows[0].positions)
     EXPECT_LE(p.relative_l2, 0.012) << "position " << p.i << "," << p.j;
   // Each correction matters; the dark map least here (1.2 % without it): the dark signal is

@@ -1,4 +1,4 @@
-# reconstruct_bench: per-position decode time vs full reconstruction time (docs/design.md §8).
+# reconstruct_bench: per-position decode time vs full reconstruction time (docs/testing.md).
 # Its datasets come from the reconstruct tests' analytic dataset library; the camera photos
 # (JPEG, TIFF, DNG) are written with lib/photo's camera writers.
 if(TARGET lumislab_reconstruct_testdata)

@@ -1,4 +1,4 @@
-// reference_table: the exact CPU reference (docs/design.md §4.5) of the built-in synthetic
+// reference_table: the exact CPU reference (docs/method.md §4.5) of the built-in synthetic
 // luminaire's truth slab (9 x 7, h = 5 mm, d = 750 mm, 300 texels) against the analytic image of
 // its emitters, per samples per basis support N: the receiver plane at D = d, 2d and 4d (64 x 64
 // pixels over the window's cone; error over the pixels the grid covers, GridCovers) and the crypt

@@ -15,7 +15,7 @@ namespace lumislab {
 int RunCalibrate(int argc, char** argv) {
   CLI::App app{
       "lumislab-calibrate: camera, screen and radiometric calibration into <dataset>/calib/ "
-      "(docs/design.md §5.5, §5.12 - §5.16). Order: response, dark, screen, flat, scale (flat "
+      "(docs/formats.md §5, §12 - §16). Order: response, dark, screen, flat, scale (flat "
       "and scale need the screen); each later step decodes its frames with the earlier steps' "
       "corrections"};
   app.require_subcommand(1);

@@ -1,5 +1,5 @@
 // lumislab-calibrate dark | response | flat | scale: the command lines of the radiometric
-// calibration (docs/design.md §5.13 - §5.16) around the calibrators of radiometric/.
+// calibration (docs/formats.md §13 - §16) around the calibrators of radiometric/.
 #pragma once
 
 #include <CLI/CLI.hpp>

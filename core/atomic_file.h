@@ -1,4 +1,4 @@
-// Atomic writes (docs/design.md §5): write under a temporary name in the same folder, then rename.
+// Atomic writes (docs/formats.md): write under a temporary name in the same folder, then rename.
 // Temporary names start with '.', keep the extension (so encoders pick the format) and are
 // ignored by every folder watcher.
 #pragma once

@@ -1,4 +1,4 @@
-// The 1D bell basis (docs/design.md §2), its exact dual and the truncated printed filter.
+// The 1D bell basis (docs/method.md §2), its exact dual and the truncated printed filter.
 // x is in units of the grid spacing h (dimensionless).
 #pragma once
 
@@ -32,7 +32,7 @@ constexpr int kMaxFilterTruncation = 8;
 // that keep two conditions exactly: the integral of phi~ is 1 (constants, hence flux, are
 // reproduced) and <phi~, phi> = 1 (the filter responds 1 to its own basis function); a plain
 // rescale of the exact dual keeps only the first. K = 1 gives c0 = 53/39, c1 = -7/39: the
-// printed filter of docs/design.md §2 (support +-2h).
+// printed filter of docs/method.md §2 (support +-2h).
 class DualFilter {
  public:
   // K in [kMinFilterTruncation, kMaxFilterTruncation]; BadInput otherwise.
@@ -57,9 +57,10 @@ class DualFilter {
 };
 
 // The first-order bound on the exact model's parallax error for light z mm behind S seen on a
-// receiver plane D mm from S with the slab's plane M at d (docs/design.md §4.5): 2 a sum|c_m|
+// receiver plane D mm from S with the slab's plane M at d (docs/method.md §4.5): 2 a sum|c_m|
 // with a = z / (d + z) |1 - d / D|. At 1 or more the expansion the bound rests on does not
-// converge: no error bound holds there (measured: 1.7 at D = 0.05 d, z = 20 mm, §8.2).
+// converge: no error bound holds there (measured: 1.7 at D = 0.05 d, z = 20 mm, docs/testing.md
+// §2).
 double ParallaxFirstOrderBound(double z_mm, double d_mm, double D_mm, const DualFilter& filter);
 
 }  // namespace lumislab

@@ -1,5 +1,5 @@
 // calib/camera.json: the camera's intrinsics and lens distortion, from many views of a board
-// (lumislab-calibrate camera, docs/design.md §5.12). Pixel coordinates follow OpenCV: (0,0) is the
+// (lumislab-calibrate camera, docs/formats.md §12). Pixel coordinates follow OpenCV: (0,0) is the
 // centre of the top-left pixel, x right, y down; camera frame x right, y down, z forward (mm).
 //
 // Model (OpenCV's five-coefficient Brown-Conrady model, so that the same numbers mean the same

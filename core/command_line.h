@@ -1,4 +1,4 @@
-// The preamble every lumislab tool shares (docs/design.md §7): --verbose and --threads on the
+// The preamble every lumislab tool shares (docs/architecture.md §7): --verbose and --threads on the
 // tool and on each of its subcommands, parsing with CLI11's messages mapped to exit code 2, the
 // log prefix and level, and the thread count resolved once.
 //   CLI::App app{"lumislab-x: ..."};

@@ -1,4 +1,4 @@
-// dataset.json (docs/design.md §5): the setup, the printed filter, the radiometric scale and the
+// dataset.json (docs/formats.md): the setup, the printed filter, the radiometric scale and the
 // photos; and the JSON blocks that several files share (grid, filter, a pair of lengths), each
 // parsed by one function with one set of limits.
 #pragma once
@@ -24,7 +24,7 @@ constexpr int kDatasetSchemaVersion = 3;
 struct FilterInfo {
   std::string basis = "bell";
   double spacing_mm = 0;
-  std::vector<double> dual_coefficients;  // [c0, c1, ...] as in docs/design.md §2
+  std::vector<double> dual_coefficients;  // [c0, c1, ...] as in docs/method.md §2
   double peak = 0;                        // max |Phi~| of the 2D filter; slides are Phi~/peak
   DualFilter Filter() const { return DualFilter::FromCoefficients(dual_coefficients); }
   static FilterInfo Of(const DualFilter& filter, double spacing_mm);

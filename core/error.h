@@ -1,5 +1,5 @@
-// Errors with the exit codes of docs/design.md §7. Thrown, never aborted on; mains turn them into
-// codes.
+// Errors with the exit codes of docs/architecture.md §7. Thrown, never aborted on; mains turn them
+// into codes.
 #pragma once
 
 #include <stdexcept>

@@ -1,4 +1,4 @@
-// Geometry terms of docs/design.md §3. Lengths in mm; d is the S-M distance.
+// Geometry terms of docs/method.md §3. Lengths in mm; d is the S-M distance.
 #pragma once
 
 #include <Eigen/Core>

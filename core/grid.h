@@ -1,5 +1,5 @@
-// Sampling grid on S and the slab texel layout on M (docs/design.md §1, §5). All lengths in mm,
-// luminaire frame.
+// Sampling grid on S and the slab texel layout on M (docs/method.md §1, docs/formats.md). All
+// lengths in mm, luminaire frame.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
-// The one check of an input path before it is opened (docs/design.md §7.3): it must exist and be
-// a regular file. A FIFO would block the reader forever and a folder or device is never a valid
+// The one check of an input path before it is opened (docs/architecture.md §7.3): it must exist and
+// be a regular file. A FIFO would block the reader forever and a folder or device is never a valid
 // input, so they are refused by name before any library sees them.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The lab's time for a capture (docs/design.md §4.7, §4.8): every grid position costs one stage
+// The lab's time for a capture (docs/method.md §4.7, §4.8): every grid position costs one stage
 // move and settle, then for each slide (T+, T-) one exposure per bracket,
 //   seconds = positions x (move + slides x brackets x exposure).
 // One model for lumislab-study (which measures what a setting costs) and lumislab-plan (which

@@ -1,4 +1,4 @@
-// The light slab on disk (docs/design.md §5): slab/slab.json + slab/pos_<i>_<j>.exr.
+// The light slab on disk (docs/formats.md): slab/slab.json + slab/pos_<i>_<j>.exr.
 // Each position stores E_ij (irradiance on M, luminaire frame, W m^-2 or relative) as float RGB
 // plus a "mask" channel (1 = seen, 0 = not seen; unseen texels hold 0), in the texel layout of
 // SlabLayout. Metadata is repeated as EXR attributes so one file stands on its own.

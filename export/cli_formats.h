@@ -1,4 +1,4 @@
-// lumislab-export's file-format subcommands (docs/design.md §7.8):
+// lumislab-export's file-format subcommands (docs/architecture.md §7.8):
 //   info <file> [--json]                 what an IES, EULUMDAT or TM-25 file holds
 //   ies | ldt --slab <dir> --out <file>  the slab's far-field intensity as IES LM-63-2019 or
 //                                        EULUMDAT

@@ -44,8 +44,8 @@ std::string Extension(const std::string& path) {
   return std::filesystem::path(path).extension().string();
 }
 
-// The slab's irradiance on the plane z = D by the exact CPU reference (docs/design.md §4.5;
-// nothing in the way, so no visibility rays), through the false colour of §4.9.
+// The slab's irradiance on the plane z = D by the exact CPU reference (docs/method.md §4.5;
+// nothing in the way, so no visibility rays), through the false colour of docs/method.md §4.9.
 int RunIrradiance(const IrradianceOptions& o, int threads) {
   LogInfo("parameters: slab=", o.slab_dir, " distance_mm=", o.distance_mm,
           " extent_mm=", o.extent_mm, " size=", o.size, " samples=", o.samples, " range=", o.range,

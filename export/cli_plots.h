@@ -1,4 +1,4 @@
-// lumislab-export's pictures for a lab report (docs/design.md §4.9, §7):
+// lumislab-export's pictures for a lab report (docs/method.md §4.9, docs/architecture.md §7):
 //   irradiance --slab <dir> --distance-mm D [--extent-mm W] --out x.png|x.exr
 //       the slab's irradiance (illuminance) on the plane z = D, false colour with colour bar and
 //       iso-lines (.png) or linear (.exr)

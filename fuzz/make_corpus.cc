@@ -488,7 +488,7 @@ void Photometry(const std::string& scratch) {
   WriteTm25(set, scratch + "/rays.ray");
   const std::string radiant = ReadTextFile(scratch + "/rays.ray");
   Take(scratch + "/rays.ray", "fuzz_tm25", "radiant_2_rays.ray");
-  // Offsets of the header fields (docs/design.md §5.17): 76 spectral tables, 80 additional
+  // Offsets of the header fields (docs/formats.md §17): 76 spectral tables, 80 additional
   // items, 84 text block bytes, 256 the flags (radiant, wavelength, luminous, Stokes,
   // tristimulus, spectrum index from 264), 36288 the end of the fixed header.
   std::string all = radiant.substr(0, kTm25FixedHeaderBytes);

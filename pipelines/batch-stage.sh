@@ -6,7 +6,7 @@
 #       [--rays N] [--preview-size WxH] [--lab L] [--manufacturer M] [--metadata meta.json]
 #
 # <stage>: calibrate | reconstruct | export | tm25 | preview. <out>: the batch's output folder.
-# The dataset's name is its folder's name. What each stage writes (docs/design.md §6.5):
+# The dataset's name is its folder's name. What each stage writes (docs/architecture.md §6):
 #   calibrate    <dataset>/calib/screen.json        (lumislab-calibrate screen)
 #   reconstruct  <dataset>/slab/                    (lumislab-reconstruct)
 #   export       <out>/<name>/<name>.ies, <name>.ldt, polar.png, irradiance_<D>mm.png
@@ -70,7 +70,7 @@ reconstruct() {
 export_files() {
   local export="$bin/lumislab-export" slab="$dataset/slab"
   mkdir -p "$dest"
-  # A lab's IES file must name the test, the lab and the maker (§7.8); the test is the dataset.
+  # A lab's IES file must name the test, the lab and the maker (docs/architecture.md §7.8); the test is the dataset.
   local ids=(--test "$name")
   [ ${#keywords[@]} -gt 0 ] || ids+=(--lab unspecified --manufacturer unspecified)
   run "$export" ies --slab "$slab" --out "$dest/$name.ies" --force --threads "$threads" \

@@ -11,7 +11,7 @@
 #       [--response <folder>] [--dark <folder>] [--flat <folder>] [--reference <reading.json>]
 #       [--force]
 #   runs acquire import, then the calibrations whose frames are given, in the order each needs
-#   (response, dark, screen, flat, scale; docs/design.md §5.13 - §5.16), then reconstruct.
+#   (response, dark, screen, flat, scale; docs/formats.md §13 - §16), then reconstruct.
 #   --response, --dark, --flat: folders of calibration frames (a bracketed series of any scene
 #   with a wide range; frames with the lens capped; frames of the evenly lit screen); their
 #   exposures come from EXIF. --reference: a meter reading at a screen point (calibrate scale).

@@ -46,7 +46,7 @@ int RunPlan(int argc, char** argv) {
   CLI::App app{
       "lumislab-plan: before a capture, the grid (h, nu x nv), K and slab resolution that reach a "
       "target accuracy of the receiver-plane irradiance at distance D, with the predicted error "
-      "per term and the lab time (docs/design.md §4.8). Give the luminaire by --scene or by "
+      "per term and the lab time (docs/method.md §4.8). Give the luminaire by --scene or by "
       "--aperture-mm and --depth-mm. Prints a table; --json writes it for machines. A target out "
       "of reach is a warning (exit 0) with the cheapest setting near the least predicted error."};
   PlanInput in;
@@ -143,7 +143,7 @@ int RunPlan(int argc, char** argv) {
     const double zmax = depth_max > 0 ? depth_max : depth;
     if (zmax < depth) throw BadInput("--depth-max-mm: must be at least --depth-mm");
     // The aperture's corner at the deepest point and at S itself bound every crossing
-    // (the crossing is monotone in the depth, §4.8).
+    // (the crossing is monotone in the depth, docs/method.md §4.8).
     in.light = {{ax, ay, zmax}, {ax, ay, 1e-9}};
     in.depth_mm = depth;
   }

@@ -15,17 +15,17 @@ namespace lumislab {
 
 namespace {
 
-// The model's constants (docs/design.md §4.8), each fitted to one measurement of the study
+// The model's constants (docs/method.md §4.8), each fitted to one measurement of the study
 // (docs/study/default-quick) and checked against the others (tests/plan/plan_test.cc).
-// Share of the first-order parallax bound 2 a sum|c_m| (§4.5) seen as relative L2 on the plane:
-// 0.623 % at 2d on the default scene, whose bound is 4.46 %.
+// Share of the first-order parallax bound 2 a sum|c_m| (docs/method.md §4.5) seen as relative L2 on
+// the plane: 0.623 % at 2d on the default scene, whose bound is 4.46 %.
 constexpr double kParallaxShare = 0.14;
 // Receiver-plane error of the bell fit, kSlab (a / l)^2, a the texel, l = h (d + z) / z a
 // position's bell footprint on M: 0.12 % at 48 texels, h = 5 mm, z = 20 mm (0.32 %, 0.026 % at 24
 // and 96 texels).
 constexpr double kSlab = 0.055;
 // N-sample quadrature of the supports at D != d: 1.2e-4 at 2d for h = 5 mm, d = 750 mm, N = 1
-// (§4.5), taken as kQuadrature (h / d)^2 |1 - d / D| / N.
+// (docs/method.md §4.5), taken as kQuadrature (h / d)^2 |1 - d / D| / N.
 constexpr double kQuadrature = 5.4;
 // What the knobs above do not reach: photos, the screen calibration from the board photo,
 // bilinear lookups (covered error at d 0.03 - 0.12 % whatever the photo size).
@@ -127,7 +127,8 @@ PlanInput PlanInputFromScene(const SynthScene& scene) {
   in.screen_w_mm = scene.screen_w_mm;
   in.screen_h_mm = scene.screen_h_mm;
   in.k_max = scene.k_max;
-  // Coverage from every emitter; the error terms from the intensity-weighted depth (§4.8).
+  // Coverage from every emitter; the error terms from the intensity-weighted depth (docs/method.md
+  // §4.8).
   double wz = 0, w = 0;
   for (const Emitter& e : scene.luminaire.emitters) {
     const double z = -e.position_mm.z();
@@ -179,12 +180,13 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
     p.warnings.push_back(
         "h above " + std::to_string(int(kCalibratedHMax)) +
         " mm is outside the model's calibrated range: the study measured more error than it "
-        "predicts there (h = 20 mm, 5 x 5, default scene: 0.32 % at d, 0.88 % at 2d; §4.8)");
+        "predicts there (h = 20 mm, 5 x 5, default scene: 0.32 % at d, 0.88 % at 2d; "
+        "docs/method.md §4.8)");
   }
   // Receivers near S (D -> 0): the parallax error is first order in a = z/(d + z) |1 - d/D|,
-  // bounded by 2 a sum|c_m| (§4.5) for the deepest light. Once that reaches 1 the expansion the
-  // model rests on does not converge (measured on the default scene: 0.05 d, 2 a sum|c_m| = 1.7;
-  // §8.2): no prediction holds, whatever the grid.
+  // bounded by 2 a sum|c_m| (docs/method.md §4.5) for the deepest light. Once that reaches 1 the
+  // expansion the model rests on does not converge (measured on the default scene: 0.05 d, 2 a
+  // sum|c_m| = 1.7; docs/testing.md §2): no prediction holds, whatever the grid.
   double z_max = 0;
   for (const LightPoint& l : in.light) z_max = std::max(z_max, l.z);
   const double first_order =
@@ -195,7 +197,7 @@ Plan EvaluatePlan(const PlanInput& in, const PlanSetting& s) {
     std::snprintf(buf, sizeof buf,
                   "the receiver plane at D = %.4g mm is too close to S for the method: the "
                   "first-order parallax bound 2 a sum|c_m| is %.2f (>= 1) for light %.4g mm "
-                  "behind S, so no error prediction holds there (docs/design.md §8.2)",
+                  "behind S, so no error prediction holds there (docs/testing.md §2)",
                   in.D(), first_order, z_max);
     p.warnings.push_back(buf);
   }
@@ -227,7 +229,7 @@ Plan MakePlan(const PlanInput& in) {
     s.samples = in.samples;
     s.nu = RequiredPositions(c.u_mm, h, in.k_max);
     s.nv = RequiredPositions(c.v_mm, h, in.k_max);
-    if (s.nu > 1000 || s.nv > 1000) continue;  // SamplingGrid's limit (§1.3)
+    if (s.nu > 1000 || s.nv > 1000) continue;  // SamplingGrid's limit (docs/method.md §1.3)
     for (const int r : kResolutions) {
       if (r < in.resolution_min) continue;
       if (r > in.resolution_max) break;
@@ -268,7 +270,7 @@ Plan MakePlan(const PlanInput& in) {
                       " (this setting: " + Percent(e.total) + ")";
     if (e.parallax >= e.slab && e.parallax >= e.quadrature)
       why += ", most of it the exact model's parallax error at D != d (" + Percent(e.parallax) +
-             ", §4.5), which neither h, the slab resolution nor N reduces";
+             ", docs/method.md §4.5), which neither h, the slab resolution nor N reduces";
     else
       why += "; raise --h-max or --resolution-max";
     why += ". The setting shown is the cheapest within 5 % of the least predicted error.";

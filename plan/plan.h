@@ -1,8 +1,8 @@
-// lumislab-plan: the lab's question before a capture (docs/design.md §4.8). From the luminaire's
+// lumislab-plan: the lab's question before a capture (docs/method.md §4.8). From the luminaire's
 // size and depth, d, the screen and a target accuracy at a receiver distance D it recommends the
 // grid (h, nu x nv), K and the slab resolution, with the predicted error per term and the lab
-// time of lumislab-study's lab model. The error model is stated and calibrated in §4.8 against
-// the study's measurements (docs/study/).
+// time of lumislab-study's lab model. The error model is stated and calibrated in docs/method.md
+// §4.8 against the study's measurements (docs/study/).
 #pragma once
 
 #include <string>
@@ -28,9 +28,9 @@ struct PlanInput {
   double roi_w_mm = 0, roi_h_mm = 0;  // region of interest on the plane z = D (0: window x D/d)
   double target = 0.01;               // relative L2 of the receiver-plane irradiance at D
   int k_max = 1;
-  int samples = 1;           // N of the reference render (§4.5)
+  int samples = 1;           // N of the reference render (docs/method.md §4.5)
   double h_max_mm = 10;      // largest h considered (the study's measured range)
-  int resolution_min = 48;   // smallest slab resolution considered (see §4.8)
+  int resolution_min = 48;   // smallest slab resolution considered (see docs/method.md §4.8)
   int resolution_max = 512;  // largest slab resolution considered
   LabModel lab;  // the lab time of a setting (core/lab_model.h, shared with lumislab-study)
 
@@ -38,7 +38,7 @@ struct PlanInput {
 };
 
 // d, the screen, K and the light of a synthetic scene: every emitter for coverage, the
-// intensity-weighted mean depth for the error terms (§4.8).
+// intensity-weighted mean depth for the error terms (docs/method.md §4.8).
 PlanInput PlanInputFromScene(const SynthScene& scene);
 
 struct PlanSetting {

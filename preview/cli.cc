@@ -149,7 +149,7 @@ void AddModeOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& ext
   app.add_option("--bench-frames", config.bench_frames)->capture_default_str();
   auto* reference = app.add_flag(
       "--reference", config.reference,
-      "exact CPU reference instead of OpenGL (docs/design.md §4.5): eq. 12 integrated over S with "
+      "exact CPU reference instead of OpenGL (docs/method.md §4.5): eq. 12 integrated over S with "
       "the exact model, --samples N per basis support, visibility by ray casting (Embree); slow, "
       "on --threads threads");
   app.add_option("--samples", config.samples,
@@ -317,7 +317,7 @@ bool ParseSize(const std::string& text, int* width, int* height) {
 std::optional<int> ParsePreviewCommandLine(int argc, char** argv, PreviewConfig& config,
                                            bool* write_test_slab) {
   CLI::App app{
-      "lumislab-preview: the measured luminaire lighting a scene (docs/design.md §4); headless "
+      "lumislab-preview: the measured luminaire lighting a scene (docs/method.md §4); headless "
       "(--backend osmesa or egl, --out) or in a window with controls (--backend window)"};
   app.footer(
       "--threads sizes lumislab's own CPU work (deriving E' of the slab positions as they are "

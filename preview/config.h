@@ -53,13 +53,13 @@ struct PreviewConfig {
   // Faster frames (RenderOptions): shadow-map sharing (largest edge shift in shadow texels, 0:
   // off), merged lights (block side, 1: off; 0: auto, MergeGroup) and their error bound. On by
   // default only where the image stays within 1 % of the full per-position render on the
-  // default rooms (docs/design.md §4.2): merging 2 x 2 without shadows; sharing never.
+  // default rooms (docs/method.md §4.2): merging 2 x 2 without shadows; sharing never.
   double shadow_share = 0;
   int merge_group = 0;
   double merge_error = 0.05;
   // Coarse shading's and reprojection's tolerances (RenderOptions; 0: off). Coarse shading: < 0
   // is auto, CoarseTolerance (0.1 in a room with shadows, where full frames wait on the light
-  // passes). Both keep the default rooms within 1 % of the full render (design §4.2).
+  // passes). Both keep the default rooms within 1 % of the full render (docs/method.md §4.2).
   double coarse_tolerance = -1;
   double reproject_tolerance = 0.1;
   bool watch = false;
@@ -79,7 +79,7 @@ struct PreviewConfig {
 };
 
 // Plane mode with D < d: the parallax error of the method grows as z |1 - d/D| for light z mm
-// behind S (docs/design.md §4.5). With z known (the flag, or truth/luminaire.json of the
+// behind S (docs/method.md §4.5). With z known (the flag, or truth/luminaire.json of the
 // dataset holding the slab) it logs the first-order bound, and warns that no bound holds once
 // it reaches 1; without z it says that the error there depends on it. Returns the bound (-1:
 // not computed).

@@ -1,4 +1,5 @@
-// A headless GL 4.5 core context through EGL (docs/design.md §4.2, §6.4): lumislab-preview
+// A headless GL 4.5 core context through EGL (docs/method.md §4.2, docs/architecture.md §5):
+// lumislab-preview
 // --backend egl and bench/preview_gpu_check. libEGL is opened at run time (dlopen) and nothing
 // is linked, so binaries that carry this run where libEGL is missing (OSMesa only) and on GPU
 // nodes without OSMesa. Surfaceless: the renderer draws only into its own framebuffers.

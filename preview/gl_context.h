@@ -1,6 +1,6 @@
 // GL contexts of the preview: OSMesa offscreen (headless renders, tests, benchmarks), EGL
 // (headless on a GPU, preview/egl_context.h) and a GLFW window, all loading GL 4.5 core through
-// the same glad loader (docs/design.md §6).
+// the same glad loader (docs/architecture.md).
 #pragma once
 
 #include <memory>

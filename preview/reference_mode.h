@@ -1,4 +1,4 @@
-// lumislab-preview --reference / --analytic (docs/design.md §4.5): the same scene, pose, camera,
+// lumislab-preview --reference / --analytic (docs/method.md §4.5): the same scene, pose, camera,
 // size and output as a headless render, computed on the CPU by lib/lightfield's exact reference
 // (Embree ray casting) instead of OpenGL: from the slab through the exact model, or straight from
 // a synthetic luminaire's emitters (the analytic truth).

@@ -1,4 +1,4 @@
-// The preview renderer (docs/design.md §4): per grid position a textured spot light at c_ij with
+// The preview renderer (docs/method.md §4): per grid position a textured spot light at c_ij with
 // the projective texture E'_ij, f = cos(theta) cos(theta') / delta^2 and a shadow map from c_ij;
 // light only towards +z of the luminaire frame and only through the screen window; Lambertian
 // materials; float (RGBA32F, additive blending) or sRGBE-packed accumulation (paper §4.2).
@@ -32,7 +32,7 @@
 
 namespace lumislab {
 
-// How E'_ij is read between its texel centres (docs/design.md §4.6's knob): the hardware's
+// How E'_ij is read between its texel centres (docs/method.md §4.6's knob): the hardware's
 // bilinear filter (the paper's, the default), the nearest texel, or Catmull-Rom cubic
 // interpolation (16 texel reads instead of one filtered read).
 enum class TextureFilter { kBilinear = 0, kNearest = 1, kCubic = 2 };
@@ -45,7 +45,7 @@ struct RenderOptions {
   bool shadow_pcf = false;                         // 2x2 filtered depth compare (softer edges)
   double radiance_scale = 1.0 / 3.14159265358979;  // albedo/pi (radiance); 1: irradiance view
   bool cull_back_faces = false;  // camera passes only: see into a closed room from outside
-  // Shadow maps hold only the faces turned to the light (docs/design.md §4.2). In a closed scene
+  // Shadow maps hold only the faces turned to the light (docs/method.md §4.2). In a closed scene
   // (every surface facing the room, solids facing out) the nearest surface along a ray from the
   // light faces it; silhouettes can lose up to a shadow texel (crypt: 0.6 % of the image).
   bool shadow_cull = false;
@@ -54,7 +54,7 @@ struct RenderOptions {
   bool unit_albedo = false;
   TextureFilter texture_filter = TextureFilter::kBilinear;
 
-  // Shortcuts (docs/design.md §4.2, "Faster frames"): each changes the image within the bound
+  // Shortcuts (docs/method.md §4.2, "Faster frames"): each changes the image within the bound
   // its knob sets; all off (the defaults): the full per-position render.
   // Shadow-map sharing: neighbouring positions in blocks of g x g share one map rendered from
   // the block's centre, g the largest whose shadow edges move by at most this many shadow texels

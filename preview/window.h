@@ -1,5 +1,5 @@
 // The interactive GLFW window of lumislab-preview (--backend window) with its Dear ImGui controls
-// panel (docs/design.md §4.4): fps, positions arrived (a grid), exposure and tone map,
+// panel (docs/method.md §4.4): fps, positions arrived (a grid), exposure and tone map,
 // shadows and their quality, float/sRGBE, the luminaire pose (fields; Ctrl+drag moves, Shift+drag
 // aims), the camera (orbit: left drag, right drag pans, wheel zooms; fly: arrows, PgUp/PgDn),
 // a screenshot button (P) and the headless command line of what is shown. Keys: +/- exposure,

@@ -73,7 +73,7 @@ void ShadowsPanel(WindowState& s) {
   } else {
     ImGui::Text("shadow size %d", c.shadow_size);
   }
-  // Faster frames (docs/design.md §4.2): each shortcut's knob, 0 / 1 = off.
+  // Faster frames (docs/method.md §4.2): each shortcut's knob, 0 / 1 = off.
   float share = float(c.shadow_share);
   if (ImGui::SliderFloat("share maps (texels)", &share, 0.0f, 4.0f, "%.2f")) {
     c.shadow_share = share;

@@ -1,4 +1,4 @@
-// Regularised least-squares fit of box-averaged texel data onto the bell basis (docs/design.md §3).
+// Regularised least-squares fit of box-averaged texel data onto the bell basis (docs/method.md §3).
 //
 // Every texel of the slab carries one bell function centred on it (in texel units). The box
 // average of the bell field over a texel is b = B c, B = Bx (x) By with the 1D stencil

@@ -320,7 +320,7 @@ int RunReconstruct(int argc, char** argv) {
   RunConfig config;
   CLI::App app{
       "lumislab-reconstruct: photos of each grid position -> fitted E_ij in "
-      "<dataset>/slab (docs/design.md §3)"};
+      "<dataset>/slab (docs/method.md §3)"};
   CommonOptions common;
   AddCommonOptions(&app, &common);
   app.add_option("--dataset", config.dataset_dir, "dataset folder (with dataset.json)")->required();

@@ -1,7 +1,7 @@
 // Photos of one grid position -> one image of E = peak * scale * (E+ - E-) in photo pixel space.
 // Decoding and linearisation are lib/photo's (one decoder for every stage). Brackets (several
 // exposures of a slide) are merged per slide, pixel and channel into one linear radiance value
-// (docs/design.md §3.5 step 2): clipped values are left out, near-black values are left out when
+// (docs/method.md §3.5 step 2): clipped values are left out, near-black values are left out when
 // a longer exposure measured the pixel, and the rest are averaged with the inverse-variance
 // weights of a sensor noise model (NoiseModel). The exposure ratios between brackets are
 // estimated from the pixels and reported against the recorded ones; optionally used.

@@ -1,5 +1,5 @@
-// What reconstruct takes from the radiometric calibration in calib/ (docs/design.md §5.13 -
-// §5.16): the per-pixel corrections the decoder applies (dark, response, flat) and the absolute
+// What reconstruct takes from the radiometric calibration in calib/ (docs/formats.md §13 -
+// §16): the per-pixel corrections the decoder applies (dark, response, flat) and the absolute
 // scale (calib/scale.json before dataset.json's radiometry.scale_w_m2).
 #pragma once
 

@@ -17,7 +17,7 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
 }
 
 // Where every photo is an integer one read through a linear transfer (so that a code step is the
-// near-black floor's unit, docs/design.md §3.5.1): the brightest stored code of the photos above
+// near-black floor's unit, docs/method.md §3.5.1): the brightest stored code of the photos above
 // their black level, in code steps, if it lies below `floor`; else the first row maximum met at
 // or above `floor` (the scan stops there: a lit position is told after a row or a few, where
 // the whole scan reads every sample, 864 MB for six 16-bit RGB 6000 x 4000 photos). -1 for other

@@ -52,7 +52,7 @@ struct PositionReport {
   double fit_residual = 0;
   // How much the fit moved the texel box averages b to the bell coefficients c,
   // sum |c - b| / sum |b| over the seen texels and channels: about (1/12) |lap E| a^2 / |E|
-  // for light smooth over several texels (docs/design.md §3.6), of order 1 for light that
+  // for light smooth over several texels (docs/method.md §3.6), of order 1 for light that
   // varies within a texel, which the slab cannot hold (its flux stays right, not its shape).
   double bell_correction = 0;
   // Nothing measured: every seen texel is 0, or the brightest stored code of the position's

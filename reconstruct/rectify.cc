@@ -253,7 +253,7 @@ cv::Mat Rectify(const cv::Mat& signal, const RectifyMap& map) {
                  "Rectify: expects a CV_32FC3/4 image");
   // The samples (K x K per texel: 1800 x 1800 x 4 floats, 52 MB, for the bench's 6000 x 4000
   // photos) in huge pages (NewPhotoImage): in 4 kB pages, the page faults of the first touch
-  // are a large part of the remap's time (docs/design.md §8.3).
+  // are a large part of the remap's time (docs/testing.md §3).
   cv::Mat samples = NewPhotoImage(map.map_xy.rows, map.map_xy.cols, signal.type()), texels;
   cv::remap(signal, samples, map.map_xy, map.map_frac, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));

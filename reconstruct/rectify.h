@@ -1,8 +1,8 @@
-// Photo pixel space -> slab texels of one grid position, with area averaging (docs/design.md §3,
-// §5). The texel at (s, t) (luminaire frame) sees the lab screen point (s, t) - c_ij, which the
-// screen calibration maps to a photo pixel. Each texel is sampled on a K x K grid (K chosen so the
-// samples are at least as dense as the photo pixels), bilinearly (cv::remap), and the K x K
-// blocks are box-averaged (cv::resize INTER_AREA with an integer factor).
+// Photo pixel space -> slab texels of one grid position, with area averaging (docs/method.md §3,
+// docs/formats.md). The texel at (s, t) (luminaire frame) sees the lab screen point (s, t) - c_ij,
+// which the screen calibration maps to a photo pixel. Each texel is sampled on a K x K grid (K
+// chosen so the samples are at least as dense as the photo pixels), bilinearly (cv::remap), and the
+// K x K blocks are box-averaged (cv::resize INTER_AREA with an integer factor).
 #pragma once
 
 #include <Eigen/Core>

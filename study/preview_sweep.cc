@@ -174,9 +174,9 @@ void RunPreviewSweep(const PreviewSweepOptions& o, std::vector<PreviewRow>* rows
       // Without shadows the preview merges 2 x 2 positions by default; this row is the full
       // per-position render without shadows, the merge has its own rows.
       points.push_back({scene, "shadows", "off", {"--no-shadows", "--merge-group", "1"}, false});
-      // The faster-frames shortcuts (§4.2): shadow maps shared within 1 shadow texel of edge
-      // shift, and 2 x 2 positions merged for receivers beyond the depth of a 5 % bound, with
-      // and without shadows.
+      // The faster-frames shortcuts (docs/method.md §4.2): shadow maps shared within 1 shadow texel
+      // of edge shift, and 2 x 2 positions merged for receivers beyond the depth of a 5 % bound,
+      // with and without shadows.
       points.push_back({scene, "shadow_share", "1 texel", {"--shadow-share", "1"}, false});
       points.push_back(
           {scene, "merge", "2x2 at 5 %", {"--merge-group", "2", "--merge-error", "0.05"}, false});

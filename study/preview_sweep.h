@@ -1,4 +1,4 @@
-// The preview's own knobs in lumislab-study (docs/design.md §4.7): the OpenGL image
+// The preview's own knobs in lumislab-study (docs/method.md §4.7): the OpenGL image
 // (`lumislab-preview`, headless, OSMesa here) and the exact reference at N samples per basis
 // support (`lumislab-preview --reference`), each against the reference at many samples, on the
 // crypt and on the receiver plane at 2d, for one slab; with the OSMesa frame time (`--bench`).

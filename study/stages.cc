@@ -47,7 +47,7 @@ double RunStage(const std::string& tool, const std::vector<std::string>& args,
     _exit(127);
   }
   // Polled so that a stop signal reaches the stage too: it finishes its item and leaves what it
-  // wrote valid (§7.6), and the study stops after it.
+  // wrote valid (docs/architecture.md §7.6), and the study stops after it.
   int status = 0;
   bool forwarded = false;
   for (;;) {

@@ -1,6 +1,7 @@
-// How lumislab-study runs the other tools (docs/design.md §4.7): as the executables beside its
+// How lumislab-study runs the other tools (docs/method.md §4.7): as the executables beside its
 // own, one subprocess per stage, so the time measured is what a user waits and a stage's own
-// command line keeps its resumption, staging and validation (§6.2: a stage never links another).
+// command line keeps its resumption, staging and validation (docs/architecture.md §2: a stage never
+// links another).
 #pragma once
 
 #include <string>

@@ -115,8 +115,9 @@ std::vector<std::string> ReconstructArgs(const Setting& s, const std::string& ds
 
 // acquire synth -> calibrate screen -> reconstruct in work/<dataset>/, once: a finished dataset
 // keeps its stage times in times.json (written last), and its photos are removed then unless
-// --keep-photos. An interrupted one is continued by the stages' own resumption (§7.4). Then
-// the preview's frame time on the crypt with this slab (`bench_size`, WxH).
+// --keep-photos. An interrupted one is continued by the stages' own resumption
+// (docs/architecture.md §7.4). Then the preview's frame time on the crypt with this slab
+// (`bench_size`, WxH).
 StageTimes RunChain(const nlohmann::json& base_scene, const Setting& s, const std::string& work,
                     int threads, bool keep_photos, const std::string& bench_size) {
   const std::string dir = work + "/" + DatasetName(s);

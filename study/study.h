@@ -1,4 +1,4 @@
-// lumislab-study (docs/design.md §4.7): what accuracy costs in time. A sweep over a synthetic
+// lumislab-study (docs/method.md §4.7): what accuracy costs in time. A sweep over a synthetic
 // scene, one knob at a time around a base setting; each point runs the whole chain (acquire synth
 // -> calibrate screen -> reconstruct) and measures the slab against truth/ and the receiver-plane
 // irradiance of the exact reference against the analytic image at D = d, 2d, 4d, with the times.

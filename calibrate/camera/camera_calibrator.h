@@ -1,5 +1,5 @@
 // lumislab-calibrate camera: many photos of a board -> the camera's intrinsics and distortion
-// (core/camera_calibration.h, docs/design.md §5.12). The board is found in every photo
+// (core/camera_calibration.h, docs/formats.md §12). The board is found in every photo
 // (camera_board.h), cv::calibrateCamera gives the start, views whose RMS is an outlier are
 // dropped, and Ceres refines the intrinsics, distortion and every pose (camera_refiner.h).
 #pragma once

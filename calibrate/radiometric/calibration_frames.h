@@ -1,6 +1,6 @@
 // The photos a radiometric calibration step reads (dark, flat or response frames, named on the
 // command line), decoded by the one decoder with the dataset's radiometry and the corrections
-// calibrated before the step (docs/design.md §5.13 - §5.16).
+// calibrated before the step (docs/formats.md §13 - §16).
 #pragma once
 
 #include <memory>

@@ -1,5 +1,5 @@
 // lumislab-calibrate dark: dark frames (lens capped) -> calib/dark.json + dark.exr
-// (docs/design.md §5.13).
+// (docs/formats.md §13).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -19,7 +19,7 @@ struct DarkOptions {
 
 // The per-pixel dark level: the mean of the frames (linear, before the exposure division) when
 // they share one exposure, else per pixel and channel the least-squares line offset + current x
-// exposure. `report` receives the numbers docs/design.md §5.13 lists.
+// exposure. `report` receives the numbers docs/formats.md §13 lists.
 DarkMap CalibrateDark(const std::vector<CalibrationFrame>& frames, const DarkOptions& options,
                       nlohmann::json* report);
 

@@ -1,6 +1,6 @@
 // lumislab-calibrate flat: frames of the screen under uniform irradiance -> calib/flat.json +
 // flat.exr, the per-pixel gain of lens vignetting times screen non-uniformity
-// (docs/design.md §5.15).
+// (docs/formats.md §15).
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -85,7 +85,7 @@ std::vector<float> Observations(const std::vector<cv::Mat>& codes, int channel, 
 
 // RMS and mean of log((v_b / e_b) / (v_a / e_a)) over the channel values whose codes are in
 // [32, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent. (Below
-// code 32 a dark offset, which the curve absorbs (docs/design.md §5.14), and noise dominate.)
+// code 32 a dark offset, which the curve absorbs (docs/formats.md §14), and noise dominate.)
 nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<double>& exposure,
                            const std::array<std::array<float, 256>, 3>& curve_rgb) {
   double sum = 0, sum2 = 0;

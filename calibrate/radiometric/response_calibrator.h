@@ -1,6 +1,6 @@
 // lumislab-calibrate response: a bracketed series of one still scene -> the camera's response
 // curve (8-bit frames, calib/response.json) or a linearity report (16-bit, float, RAW frames,
-// calib/linearity.json); docs/design.md §5.14.
+// calib/linearity.json); docs/formats.md §14.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -1,4 +1,4 @@
-// The least-squares fit behind `lumislab-calibrate response` (docs/design.md §5.14): the log of
+// The least-squares fit behind `lumislab-calibrate response` (docs/formats.md §14): the log of
 // a camera's inverse response, g(z) = ln(linear value of code z), from pixels seen in several
 // frames of known exposure. Debevec and Malik's model g(z_ij) = ln E_i + ln t_j, with four
 // changes that make it hold up on noisy JPEG frames:

@@ -1,5 +1,5 @@
 // lumislab-calibrate scale: a radiometer (or lux meter) reading at a known screen point for one
-// grid position, through T+ and T- -> calib/scale.json (docs/design.md §5.16).
+// grid position, through T+ and T- -> calib/scale.json (docs/formats.md §16).
 #pragma once
 
 #include <Eigen/Core>

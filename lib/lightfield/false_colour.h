@@ -1,4 +1,4 @@
-// The photometrist's view of an irradiance (illuminance) image (docs/design.md §4.9): each pixel's
+// The photometrist's view of an irradiance (illuminance) image (docs/method.md §4.9): each pixel's
 // value through a perceptual colour map (viridis) on a linear or logarithmic scale, iso-lines at
 // the scale's ticks, a colour bar with tick labels and the unit, and optionally a length scale
 // bar. GL-free: the preview (--view false-colour) and lumislab-export (irradiance on a plane)
@@ -40,7 +40,7 @@ struct FalseColourScale {
 FalseColourScale AutoScale(const std::vector<float>& values, bool log);
 
 // The scalar the picture maps: Rec. 709 luminance of each RGB pixel (the quantity a radiometer
-// or lux meter calibration scales, docs/design.md §5.16), row 0 on top.
+// or lux meter calibration scales, docs/formats.md §16), row 0 on top.
 std::vector<float> PixelLuminance(const ImageF& image);
 
 // Which pixels draw the iso-line of each level: a pixel is marked when a level lies between its
@@ -86,7 +86,7 @@ Rgb8Image FalseColourPicture(const ImageF& irradiance, const FalseColourRequest&
 // "1500", "0.25", "2e+05": a tick value with as many decimals as the ticks' step needs.
 std::string FormatTick(double value, double step);
 
-// The unit a picture shows for slab.json's `units` (docs/design.md §3.7): irradiance
+// The unit a picture shows for slab.json's `units` (docs/method.md §3.7): irradiance
 // ("W/m^2" -> W/m², "lux" -> lx) or, for the far field, intensity (W/sr, cd).
 std::string IrradianceUnitLabel(const std::string& slab_units);
 std::string IntensityUnitLabel(const std::string& slab_units);

@@ -65,7 +65,7 @@ struct RayCellCancelling {
 };
 
 // One texel's profile f over the cells (row-major, ax.cells per row) made non-negative with its
-// flux and centroid kept (docs/design.md §5.17): the negative cells are set to 0 and positive
+// flux and centroid kept (docs/formats.md §17): the negative cells are set to 0 and positive
 // cell c gives w_c = clamp(k_c (alpha + beta . (x_c - x_n)), 0, f_c), where k_c is the negative
 // mass within kRayCancelRadius cells of c (so only cells near a negative lobe give, most where
 // the lobes are deepest) and x_n the negative part's centroid; alpha and beta solve

@@ -1,6 +1,7 @@
-// What a slab says about the luminaire far away and as rays (docs/design.md §5.17): the
+// What a slab says about the luminaire far away and as rays (docs/formats.md §17): the
 // far-field intensity I(w) = integral over S of L(x, w) cos(theta) dA, from the exact model of
-// §3.3, and rays importance-sampled from the slab's radiance (TM-25 export). GL-free.
+// docs/method.md §3.3, and rays importance-sampled from the slab's radiance (TM-25 export).
+// GL-free.
 #pragma once
 
 #include <Eigen/Core>
@@ -13,7 +14,8 @@
 namespace lumislab {
 
 // Rec. 709 luminance: the one channel far-field and ray files carry (lux slabs give cd and lm,
-// W/m^2 slabs W/sr and W, as calib/scale.json's radiometer reading weighs RGB, §5.16).
+// W/m^2 slabs W/sr and W, as calib/scale.json's radiometer reading weighs RGB, docs/formats.md
+// §16).
 inline Eigen::Vector3d LuminanceWeights() { return {0.2126, 0.7152, 0.0722}; }
 
 // Every position the slab lists, E_ij and mask, by linear index j * nu + i (empty for the
@@ -28,7 +30,7 @@ struct FarFieldOptions {
 };
 
 // I on a C / gamma grid (degrees, type C: gamma = 0 along +z, C = 0 towards +x, C = 90 towards
-// +y; docs/design.md §5.17).
+// +y; docs/formats.md §17).
 struct FarField {
   std::vector<double> c_deg, gamma_deg;
   std::vector<double> values;  // values[ic * gamma_deg.size() + ig]: W/sr (cd for lux slabs)
@@ -56,7 +58,7 @@ struct SlabRays {
   std::vector<SlabRay> rays;
   double flux_per_ray = 0;  // W (lm for lux slabs); the same for every ray
   double total_flux = 0;    // the slab's flux: sum over positions and seen texels of E dA
-  // What making the light field non-negative moved (docs/design.md §5.17), W and mm:
+  // What making the light field non-negative moved (docs/formats.md §17), W and mm:
   double moved_flux = 0;           // the negative part within texels, cancelled over (u, v)
   double moved_mean_mm = 0;        // mean distance on S from the mass taken to the nearest lobe
   double moved_max_mm = 0;         // the largest such distance
@@ -65,11 +67,11 @@ struct SlabRays {
   double texel_moved_mean_mm = 0;  // their mean distance on M
 };
 
-// N rays distributed as the slab's light field (the exact model, §3.3): through texel dA of M,
-// basis function ij sends Phi_ij(u, v) E_ij(s, t) / h^2 du dv dA (W), so the flux density over
-// (u, v, s, t) is sum_ij Phi_ij E_ij / h^2. E_ij is signed (the dual filter has negative lobes)
-// and so is the sum; a ray file carries no negative flux, so the field is first made
-// non-negative keeping what planes at any distance see to first order: each texel's profile
+// N rays distributed as the slab's light field (the exact model, docs/method.md §3.3): through
+// texel dA of M, basis function ij sends Phi_ij(u, v) E_ij(s, t) / h^2 du dv dA (W), so the flux
+// density over (u, v, s, t) is sum_ij Phi_ij E_ij / h^2. E_ij is signed (the dual filter has
+// negative lobes) and so is the sum; a ray file carries no negative flux, so the field is first
+// made non-negative keeping what planes at any distance see to first order: each texel's profile
 // over (u, v), on cells of h / 4, has its negative cells cancelled against positive cells within
 // h of them, keeping the texel's flux (the irradiance at d, exactly) and its (u, v) centroid
 // (the centre of its light on every plane); texels of negative net flux are first cancelled

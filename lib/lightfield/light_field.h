@@ -1,4 +1,4 @@
-// The slab as the renderer uses it (docs/design.md §4): per grid position the texture
+// The slab as the renderer uses it (docs/method.md §4): per grid position the texture
 // E'_ij = E_ij / g_ij in W/sr (g_ij the shift-invariant geometry term, converted to m^-2), read
 // from disk ready to upload, and the CPU evaluation of the same textured-spot-light formula (eq. 14
 // for one position; tests and exact comparisons). No GL here: the renderer only uploads E'.

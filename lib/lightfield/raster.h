@@ -1,5 +1,5 @@
 // A plain 8-bit RGB picture and what the photometrist's pictures draw on it (false colour, colour
-// bar, polar plot: docs/design.md §4.9): filled rectangles, thick polylines (solid or dashed) and
+// bar, polar plot: docs/method.md §4.9): filled rectangles, thick polylines (solid or dashed) and
 // text in a built-in 5 x 7 bitmap font. No image or font library: lib/lightfield stays free of GL
 // and OpenCV; lib/photo's WriteRgb8File writes the result.
 #pragma once

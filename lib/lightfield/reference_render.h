@@ -1,6 +1,7 @@
-// The exact CPU reference of the preview (docs/design.md §4.5): what each pixel of a view sees,
+// The exact CPU reference of the preview (docs/method.md §4.5): what each pixel of a view sees,
 // found by ray casting (Embree 3), lit by
-//  * the slab through the exact model (§3.3): eq. 12 of Granier et al. integrated over S with
+//  * the slab through the exact model (docs/method.md §3.3): eq. 12 of Granier et al. integrated
+//  over S with
 //    N x N samples per basis support and visibility by one occlusion ray per sample, or
 //  * point sources straight (the analytic truth of a synthetic luminaire), with the same
 //    visibility.
@@ -86,7 +87,7 @@ struct ReferenceImage {
 // (R^2 / cos^2 theta = R^4 / d^2 = d^2 |delta|^4 / delta_z^4; the mm^2 of 1/g and the mm^-2 of
 // the solid angle cancel), E_ij bilinear in the texels and zero outside the slab window, V one
 // occlusion ray from x to (u, v, 0). On the plane z = d with normal -z this is w / h^2 E_ij(x)
-// for every sample: the exact model gives sum_ij E_ij(x) at any N (docs/design.md §4.5).
+// for every sample: the exact model gives sum_ij E_ij(x) at any N (docs/method.md §4.5).
 ReferenceImage RenderReference(const ReferenceScene& view, const SlabInfo& info,
                                const std::vector<ImageF>& irradiance,
                                const ReferenceOptions& options);

@@ -1,4 +1,4 @@
-// Scene files through Assimp, read in a child process (docs/design.md §4.4).
+// Scene files through Assimp, read in a child process (docs/method.md §4.4).
 //
 // Assimp reads some 40 formats, and hostile or broken files make Debian's Assimp 5.2 abort
 // inside its post-processing or loop forever in its PLY reader (both found by fuzz_mesh_ply).

@@ -1,7 +1,7 @@
 // Diffuse textures of scene files (lib/lightfield/scene_file.cc, in the import's child process):
 // the material's first diffuse texture, embedded in the file or beside it, decoded by stb_image
 // and linearised through the sRGB curve, then sampled at each triangle corner's texture
-// coordinate: the preview's albedo is per vertex (docs/design.md §4.4), so a texture gives the
+// coordinate: the preview's albedo is per vertex (docs/method.md §4.4), so a texture gives the
 // mesh its colours at the vertices, not finer detail.
 #pragma once
 

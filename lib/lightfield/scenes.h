@@ -1,7 +1,7 @@
 // Scenes for the preview: triangle soups with per-vertex normal and Lambertian albedo, in the
 // scene (world) frame, mm. Built-in crypt (~500 triangles) and cloister (~8000 triangles): closed
 // vaulted rooms with columns and arches that cast shadows, like the paper's test scenes
-// (docs/design.md §4.4; built from lib/lightfield/scene_parts.h); files via Assimp.
+// (docs/method.md §4.4; built from lib/lightfield/scene_parts.h); files via Assimp.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,7 +1,7 @@
 // Tone mapping of the preview's linear images (radiance or irradiance) for PNG files and the
 // window, and the comparison of two renders; plain buffers, no image library. The window shows
 // exactly what a headless PNG of the same settings holds: both go through EncodeSrgb8 with the
-// factor of ExposureFactor (docs/design.md §4.4).
+// factor of ExposureFactor (docs/method.md §4.4).
 #pragma once
 
 #include <cstdint>

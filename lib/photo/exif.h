@@ -1,5 +1,5 @@
 // What a camera records about a shot (EXIF), read from a photo: the exposure that makes photos of
-// different exposures comparable (docs/design.md §5.3, relative exposure t ISO / N^2) and who
+// different exposures comparable (docs/formats.md §3, relative exposure t ISO / N^2) and who
 // took it with what. JPEG through libexif, camera RAW and DNG through LibRaw, TIFF through
 // libtiff; PNG and OpenEXR carry none here.
 #pragma once

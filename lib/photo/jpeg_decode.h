@@ -1,10 +1,10 @@
-// Colour JPEG photos decoded without the 8-bit rounding of the colour conversion (docs/design.md
-// §5.4), for DecodePhoto. A JPEG stores Y, Cb and Cr as 8-bit samples; a decoder's conversion to
-// R, G and B (R = Y + 1.402 (Cr - 128), ...) lands between codes and every decoder then rounds it
-// to an 8-bit code again, an error of up to half a code on top of the camera's own rounding that
-// the response curve then magnifies (one code is 1-5 % of a dark value). Here libjpeg decodes to
-// Y, Cb, Cr (its inverse DCT and chroma upsampling, as every decoder) and the conversion is done
-// in floating point: the codes keep their fractions, and the curve is read between its codes.
+// Colour JPEG photos decoded without the 8-bit rounding of the colour conversion (docs/formats.md
+// §4), for DecodePhoto. A JPEG stores Y, Cb and Cr as 8-bit samples; a decoder's conversion to R, G
+// and B (R = Y + 1.402 (Cr - 128), ...) lands between codes and every decoder then rounds it to an
+// 8-bit code again, an error of up to half a code on top of the camera's own rounding that the
+// response curve then magnifies (one code is 1-5 % of a dark value). Here libjpeg decodes to Y, Cb,
+// Cr (its inverse DCT and chroma upsampling, as every decoder) and the conversion is done in
+// floating point: the codes keep their fractions, and the curve is read between its codes.
 #pragma once
 
 #include <opencv2/core.hpp>

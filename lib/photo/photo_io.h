@@ -1,5 +1,5 @@
 // The one photo decoder of lumislab: every stage that reads a camera photo reads it here
-// (docs/design.md §5). It owns
+// (docs/formats.md). It owns
 //   - format detection from the file's content (lib/photo/photo_format.h),
 //   - camera RAW and DNG through LibRaw (lib/photo/raw_decode.h): linear sensor values with the
 //     file's black and white level, white balance unity or as shot, full or half size,

@@ -1,4 +1,4 @@
-// The radiometric calibration files of calib/ (docs/design.md §5.13 - §5.16) and the per-pixel
+// The radiometric calibration files of calib/ (docs/formats.md §13 - §16) and the per-pixel
 // corrections the one decoder applies with them (lib/photo/photo_io.h LinearReader):
 //   calib/dark.json + dark.exr       per-pixel dark level (offset, optionally dark current per
 //                                    unit exposure) and hot pixels, camera image space;

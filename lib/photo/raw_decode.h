@@ -1,4 +1,4 @@
-// Camera RAW and DNG photos through LibRaw (docs/design.md §5.4), for DecodePhoto. Photometric
+// Camera RAW and DNG photos through LibRaw (docs/formats.md §4), for DecodePhoto. Photometric
 // rules: the sensor's values, linear, no gamma, no auto-brightening, no colour matrix; the
 // file's black level (common, per-channel and repeat pattern) subtracted and its white level
 // mapped to 1, per channel: value = (code - black) / (white - black).

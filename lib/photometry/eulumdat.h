@@ -1,4 +1,4 @@
-// EULUMDAT (.ldt) photometric files (docs/design.md §5.17): the reader takes every symmetry
+// EULUMDAT (.ldt) photometric files (docs/formats.md §17): the reader takes every symmetry
 // indicator Isym 0-4 and converts the intensities from cd/klm to cd with the flux of the first
 // lamp set; the writer writes the same layout from a distribution.
 #pragma once

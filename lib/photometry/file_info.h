@@ -1,4 +1,4 @@
-// What an IES, EULUMDAT or TM-25 file holds: `lumislab-export info` (docs/design.md §7.8) and
+// What an IES, EULUMDAT or TM-25 file holds: `lumislab-export info` (docs/architecture.md §7.8) and
 // the fuzz target fuzz_photometry_info share this, the format detection included.
 #pragma once
 

@@ -1,4 +1,4 @@
-// IES LM-63 photometric files (docs/design.md §5.17): the reader takes the 1986, 1991, 1995,
+// IES LM-63 photometric files (docs/formats.md §17): the reader takes the 1986, 1991, 1995,
 // 2002 and 2019 editions, type C photometry, every symmetry of the horizontal angles,
 // TILT=NONE and TILT=INCLUDE (read, recorded as the keyword "TILT", not applied: it describes
 // other mounting angles); TILT=<file>, type B and type A are refused by name. The writer writes

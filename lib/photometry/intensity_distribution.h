@@ -1,9 +1,8 @@
-// A far-field intensity distribution as the lighting industry's files hold it (docs/design.md
-// §5.17): type C photometry, intensity on a grid of C planes (azimuth) and gamma angles (polar),
-// in candela (photometric) or W/sr (radiometric). gamma = 0 along +z of the luminaire frame,
-// C = 0 towards +x, C = 90 towards +y. The grid covers only the part of the sphere the
-// symmetry leaves (IES LM-63 and EULUMDAT store it the same way); Intensity() and TotalFlux()
-// apply the symmetry.
+// A far-field intensity distribution as the lighting industry's files hold it (docs/formats.md
+// §17): type C photometry, intensity on a grid of C planes (azimuth) and gamma angles (polar), in
+// candela (photometric) or W/sr (radiometric). gamma = 0 along +z of the luminaire frame, C = 0
+// towards +x, C = 90 towards +y. The grid covers only the part of the sphere the symmetry leaves
+// (IES LM-63 and EULUMDAT store it the same way); Intensity() and TotalFlux() apply the symmetry.
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// ANSI/IES TM-25-13 ray files (docs/design.md §5.17 gives the byte layout): a binary header,
+// ANSI/IES TM-25-13 ray files (docs/formats.md §17 gives the byte layout): a binary header,
 // then per ray float32 x y z (mm), kx ky kz (unit direction) and the flagged columns. The
 // writer writes rays with position, direction and one flux column (luminous or radiant); the
 // reader reads any valid file (every flag, spectral tables, extra columns, text block) and keeps

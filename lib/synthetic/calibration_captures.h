@@ -1,4 +1,4 @@
-// The radiometric calibration captures of the synthetic camera (docs/design.md §5.10, scene
+// The radiometric calibration captures of the synthetic camera (docs/formats.md §10, scene
 // block `calibration_captures`): dark frames, flat frames, a bracketed response series and the
 // reading of a radiometer at a screen point, made through the same camera effects as the slide
 // photos (only those that apply to each), with the truth they must recover.

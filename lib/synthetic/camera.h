@@ -10,7 +10,7 @@
 
 namespace lumislab {
 
-// The `lens` effect (docs/design.md §5.10): OpenCV's five-coefficient Brown-Conrady distortion
+// The `lens` effect (docs/formats.md §10): OpenCV's five-coefficient Brown-Conrady distortion
 // (core/camera_calibration.h) and the principal point moved off the image centre.
 struct LensSpec {
   double k1 = 0, k2 = 0, k3 = 0, p1 = 0, p2 = 0;

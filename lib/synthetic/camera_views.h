@@ -1,5 +1,5 @@
 // Views of a free-standing chessboard for the camera calibration (`acquire synth
-// --calibration-views N`, docs/design.md §5.10): N poses of a printed board in front of the
+// --calibration-views N`, docs/formats.md §10): N poses of a printed board in front of the
 // scene's camera, tilted and moved so that they constrain the focal length, rendered through the
 // camera (and its lens) as lumislab-calibrate camera expects them.
 #pragma once

@@ -1,4 +1,4 @@
-// Camera effects of the synthetic capture (docs/design.md §8.1): each is one small step applied
+// Camera effects of the synthetic capture (docs/testing.md §1): each is one small step applied
 // to a rendered photo, in the order the scene lists them. Only listed effects are computed.
 #pragma once
 

@@ -1,5 +1,5 @@
 // The synthetic luminaire: point emitters with cos^n lobes behind the filter plane S
-// (docs/design.md §1-3), and TM-25 ray files as sources (lib/synthetic/ray_source.h). The point
+// (docs/method.md §1-3), and TM-25 ray files as sources (lib/synthetic/ray_source.h). The point
 // emitters are analytic, so they double as the ground truth of every synthetic test; a ray
 // source's truth is its own rays through the same splat as its photos (PlaneLight).
 #pragma once
@@ -15,7 +15,7 @@
 
 namespace lumislab {
 
-// A measured far-field distribution (IES or EULUMDAT file, docs/design.md §5.10, §5.17) as an
+// A measured far-field distribution (IES or EULUMDAT file, docs/formats.md §10, §17) as an
 // emitter's lobe: the file's intensity divided by its peak, its gamma = 0 axis and C = 0 plane
 // turned into the luminaire frame by `luminaire_from_file` (R = Rz Ry Rx of rotation_deg).
 struct MeasuredLobe {
@@ -69,7 +69,7 @@ struct Luminaire {
 // captures read their light through it. The luminaire must outlive it.
 class PlaneLight {
  public:
-  // Through the two slides of the filter centred at c (T+ and T-, docs/design.md §2.5) onto M
+  // Through the two slides of the filter centred at c (T+ and T-, docs/method.md §2.5) onto M
   // (z = d), over [lo, hi] of M.
   static PlaneLight ThroughSlides(const Luminaire& luminaire, const DualFilter& f, double h_mm,
                                   const Eigen::Vector2d& c_mm, double d_mm,

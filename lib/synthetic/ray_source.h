@@ -1,4 +1,4 @@
-// A TM-25 ray file as a synthetic source (scene emitter "rays", docs/design.md §5.10, §5.17): the
+// A TM-25 ray file as a synthetic source (scene emitter "rays", docs/formats.md §10, §17): the
 // file's rays placed in the luminaire frame, and the splat map that turns rays into irradiance
 // on a plane. A ray is a sample of the light field, so the capture deposits each ray's flux on a
 // fine lattice of the receiving plane with a tent kernel and reads the lattice back bilinearly:

@@ -1,5 +1,5 @@
-// The synthetic scene: setup, luminaire, camera, calibration target and effects (docs/design.md
-// §8). Read from a JSON scene file (validated through core/json.h) or the built-in "default".
+// The synthetic scene: setup, luminaire, camera, calibration target and effects (docs/testing.md).
+// Read from a JSON scene file (validated through core/json.h) or the built-in "default".
 #pragma once
 
 #include <memory>
@@ -24,7 +24,7 @@ struct SynthScene {
   SamplingGrid grid;
   double screen_w_mm = 0;  // physical screen, lab frame, centred on the optical axis
   double screen_h_mm = 0;
-  int k_max = 1;  // filter truncation (docs/design.md §2)
+  int k_max = 1;  // filter truncation (docs/method.md §2)
   Luminaire luminaire;
   CameraSpec camera;
   CalibrationTarget calibration;                       // photo = photos/calib_0.png

@@ -32,7 +32,7 @@ SlabInfo DefaultSlabInfo(int nu, int nv, double spacing_mm, int resolution);
 // the ray crosses S where the grid's dual filters sum to 1, |u| <= ((nu - 1)/2 - K) h and
 // |v| <= ((nv - 1)/2 - K) h for a truncated dual with K + 1 coefficients, and meets M inside the
 // slab window, less the spread |1 - d / x_z| (K + 2) h of the rays a reconstruction draws from
-// the supports around it (docs/design.md §4.5). Elsewhere images from the slab fall short of the
+// the supports around it (docs/method.md §4.5). Elsewhere images from the slab fall short of the
 // analytic truth however exact the renderer. Point emitters only: ray sources are not looked at
 // (their users, the analytic images and the study, refuse them: RequirePointEmitters).
 bool GridCovers(const Luminaire& luminaire, const SlabInfo& info, const Eigen::Vector3d& x);

@@ -113,7 +113,7 @@ TEST(DualTest, PeakIsTheMaximumMagnitude) {
   EXPECT_LT(min, -0.05);
 }
 
-// sum|c_m| and the parallax bound 2 z/(d + z) |1 - d/D| sum|c_m| built on it (design §4.5).
+// sum|c_m| and the parallax bound 2 z/(d + z) |1 - d/D| sum|c_m| built on it (docs/method.md §4.5).
 TEST(DualTest, SumOfMagnitudesAndTheParallaxBound) {
   const DualFilter f = DualFilter::FromCoefficients({1.5, -0.25});
   EXPECT_DOUBLE_EQ(f.SumAbs(), 2.0);  // c_0 once, c_1 for +1 and -1

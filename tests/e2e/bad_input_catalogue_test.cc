@@ -1,8 +1,9 @@
 // The bad-input catalogue: one table of cases over the five tools, each a mutation of a small
 // valid input, the command that must refuse it, and what the refusal must look like
-// (docs/design.md §7): exit code 2, one error line naming the file and the field, no crash, no
-// hang, and nothing under the case folder changed (every file's bytes hashed before and after;
-// only what a case allows may change) with no temporary file ('.' names, §7.5) left behind.
+// (docs/architecture.md §7): exit code 2, one error line naming the file and the field, no crash,
+// no hang, and nothing under the case folder changed (every file's bytes hashed before and after;
+// only what a case allows may change) with no temporary file ('.' names, docs/architecture.md §7.5)
+// left behind.
 //
 // The cases are written to the contract, not to today's behaviour: a failing case is a bug in a
 // tool (or a contract to settle), never a reason to edit the expectation.
@@ -270,7 +271,7 @@ std::string Garbage() {
   return bytes;
 }
 
-// --- the lighting industry's files (docs/design.md §5.17)
+// --- the lighting industry's files (docs/formats.md §17)
 
 // tests/data/ies/7.ies (a real LM-63-2002 file: 37 gamma angles, one C plane) with `from`
 // replaced by `to` (the first occurrence; "" leaves it whole), under `file`; keep_fraction < 1
@@ -303,7 +304,7 @@ Mutation Ldt(const std::string& file, std::map<int, std::string> edits = {}) {
     WriteBinaryFile(dir + "/" + file, text);
   };
 }
-// A TM-25 ray file (little-endian, docs/design.md §5.17) whose header says `header_rays` rays of
+// A TM-25 ray file (little-endian, docs/formats.md §17) whose header says `header_rays` rays of
 // luminous flux and which holds `rays` of them; `poison` >= 0 makes that ray's x NaN, `version`
 // is the file version (2013 the valid one).
 Mutation Tm25(const std::string& file, uint64_t header_rays, int rays, int poison = -1,
@@ -364,7 +365,7 @@ Mutation PngResize(const std::string& file, int width, int height) {
     WriteImage(dir + "/" + file, out);
   };
 }
-// A 32-bit float TIFF under the photo's name (float data comes only from EXR, §5.4).
+// A 32-bit float TIFF under the photo's name (float data comes only from EXR, docs/formats.md §4).
 Mutation FloatTiff(const std::string& file) {
   return [=](const std::string& dir) {
     cv::Mat image = ReadImage(dir + "/" + file), out;
@@ -488,7 +489,7 @@ Mutation ExrHugeHeader(const std::string& file, std::vector<std::string> channel
   };
 }
 
-// --- radiometric calibration (docs/design.md §5.13 - §5.16)
+// --- radiometric calibration (docs/formats.md §13 - §16)
 
 // A frame (a dark, flat or bracketed photo) of width x height RGB pixels, `bits` 8 or 16:
 // `fill` >= 0 sets every code to that fraction of full scale, otherwise a smooth ramp of codes
@@ -1358,7 +1359,7 @@ std::vector<Case> CommandLineCases() {
   v.push_back(C("reconstruct_dataset_not_found")
                   .ReconstructArgs("--dataset nothere --resolution 40")
                   .Names({"nothere/dataset.json"}));
-  // An existing slab of another resolution (§7.4): refused without --force.
+  // An existing slab of another resolution (docs/architecture.md §7.4): refused without --force.
   v.push_back(C("reconstruct_existing_slab_other_resolution")
                   .ReconstructArgs("--dataset ds --resolution 60")
                   .From(Input::kSlab)
@@ -1406,7 +1407,7 @@ std::vector<Case> CommandLineCases() {
            {"negative", "-1"}, {"nan", "nan"}, {"1e12", "1e12"}})
     v.push_back(P("extent_" + value.first, plane + "--size 32x32 --extent " + value.second)
                     .Names({"--extent"}));
-  // 0 is the documented default of both (docs/design.md §4.4): a control that must succeed.
+  // 0 is the documented default of both (docs/method.md §4.4): a control that must succeed.
   v.push_back(P("receiver_plane_0_is_default", plane + "--size 32x32 --receiver-plane 0")
                   .Exit(0)
                   .MayChange("r.exr"));
@@ -1585,7 +1586,7 @@ std::vector<Case> MoreCases() {
                   .Calibrate()
                   .Args("screen --dataset ds/dataset.json")
                   .Names({"ds/dataset.json"}));
-  // Scene meshes for the preview (docs/design.md §4.4: a face naming a vertex the file lacks, or
+  // Scene meshes for the preview (docs/method.md §4.4: a face naming a vertex the file lacks, or
   // a non-finite vertex, is exit 2).
   v.push_back(C("preview_mesh_face_out_of_range")
                   .Preview("--slab ds/slab --scene bad.obj --out r.png --size 32x32")
@@ -1836,10 +1837,10 @@ std::vector<Case> RadiometricCases() {
   return v;
 }
 
-// lumislab-export (docs/design.md §7.8) and the files of the lighting industry it reads and
-// writes (§5.17), and the scene's measured emitters (`distribution`, §5.10), which read the same
-// IES / EULUMDAT files. Every refusal names the file (or the option) and the field, and writes
-// nothing at --out.
+// lumislab-export (docs/architecture.md §7.8) and the files of the lighting industry it reads and
+// writes (docs/formats.md §17), and the scene's measured emitters (`distribution`, docs/formats.md
+// §10), which read the same IES / EULUMDAT files. Every refusal names the file (or the option) and
+// the field, and writes nothing at --out.
 std::vector<Case> PhotometryCases() {
   std::vector<Case> v;
   // info on a bad file: IES, EULUMDAT (anything not IES nor TM-25) and TM-25.
@@ -1985,7 +1986,7 @@ std::vector<Case> PhotometryCases() {
                   .Export("tm25 --slab ds --out nodir/x.ray --rays 10")
                   .Exit(3)
                   .Names({"nodir/x.ray", "cannot"}));
-  // irradiance and polar (§4.9).
+  // irradiance and polar (docs/method.md §4.9).
   auto P = [](const std::string& cmd, const std::string& name, const std::string& flags,
               const std::string& out) {
     return C("export_" + cmd + "_" + name)

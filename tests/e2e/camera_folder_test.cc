@@ -1,4 +1,4 @@
-// lumislab-acquire synth --camera-folder (docs/design.md §5.4) writes a capture as a camera
+// lumislab-acquire synth --camera-folder (docs/formats.md §4) writes a capture as a camera
 // leaves it: camera/IMG_0001.TIF ... in capture order with EXIF, camera/BOARD.PNG, a setup.json
 // with only what a lab knows, truth/, no dataset.json. `acquire import` (--order capture, from
 // EXIF time and exposure, and --manifest) must give a dataset that reconstructs to the slab of

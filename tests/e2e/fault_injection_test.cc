@@ -2,7 +2,8 @@
 // same command is run again, and
 //   (a) the rerun exits 0,
 //   (b) the outputs are byte-identical to those of one uninterrupted run,
-//   (c) no temporary file (a name starting with '.', docs/design.md §7.5) is left anywhere under
+//   (c) no temporary file (a name starting with '.', docs/architecture.md §7.5) is left anywhere
+//   under
 //       the folder the tool writes into.
 // The tools: `lumislab-acquire synth` (3x3 grid, 640x480 photos), `lumislab-calibrate screen`,
 // `lumislab-reconstruct` (60x60) and `lumislab-preview --watch` following a slab that a feeder

@@ -1,5 +1,5 @@
 // The hard cases' chain and checks (tests/e2e/hard_cases_*_test.cc). Hard cases that must stay
-// numerically stable (issue 10, docs/design.md §8.2 "Hard cases"):
+// numerically stable (issue 10, docs/testing.md §2 "Hard cases"):
 // small synthetic captures at the edges of what the method can do, each run through acquire
 // synth -> calibrate screen -> reconstruct and checked against the analytic truth/:
 //
@@ -12,7 +12,7 @@
 //  * a case outside what the method can do is said so (a warning or exit 2), never written as a
 //    confident wrong answer.
 //
-// The bounds (docs/design.md §3.6). The fit matches texel box averages b with the bell stencil
+// The bounds (docs/method.md §3.6). The fit matches texel box averages b with the bell stencil
 // [1/12, 5/6, 1/12] per axis; that stencil's rows and columns sum to 1 (also at mask edges,
 // where a missing neighbour is mirrored), and the first-difference regulariser's columns sum to
 // 0, so the normal equations give sum(c) = sum(b) exactly, up to the CG tolerance (relative
@@ -62,7 +62,7 @@ inline constexpr double kEdgeSpread = 1.25 * 1.25;
 // The CG tolerance's share of the flux (1e-6 x sqrt(texels), texels <= 64^2).
 inline constexpr double kFitFluxTolerance = 1e-4;
 // The CG stops at ||r|| <= 1e-6 ||B^T b||; with the smallest eigenvalue of B^T B + lambda D^T D
-// >= 0.19 (docs/design.md §3.6) and ||B|| <= 1, ||c - c_exact|| <= 1e-6 / 0.19 ||b||: a floor
+// >= 0.19 (docs/method.md §3.6) and ||B|| <= 1, ||c - c_exact|| <= 1e-6 / 0.19 ||b||: a floor
 // of 5.3e-6 of the position's own ||E|| on every part of it.
 inline constexpr double kSolverFloor = 1e-6 / 0.19;
 // Half-float photos: each slide value rounded by at most 2^-12 relative. With one emitter a
@@ -86,7 +86,7 @@ inline const char* kSmallCamera =
         "look_at_mm": [0, 0, 750]})";
 
 std::string Emitter(double x, double y, double z, double i0, double lobe);
-// The default luminaire (§5.10).
+// The default luminaire (docs/formats.md §10).
 std::string DefaultEmitters();
 
 std::string Scene(const Geometry& s, const std::string& emitters, const std::string& camera,
@@ -118,7 +118,7 @@ struct PositionCheck {
   double FluxError() const { return std::abs(flux - truth_flux); }
 };
 
-// The mask (docs/design.md §3.5 step 3, cameras that see the whole screen): a texel is seen when
+// The mask (docs/method.md §3.5 step 3, cameras that see the whole screen): a texel is seen when
 // every photo pixel its samples read lies on the screen. Those reads reach past the texel's edge
 // by at most 2F photo pixels (the bilinear read of the F x F average and the averaged block),
 // F = round(median texel side in px / 3), i.e. about 2/3 of a texel plus a pixel where texels

@@ -54,9 +54,9 @@ TEST(HardCases, PatternRunningOffTheScreenEdge) {
                         Scene(Geometry{}, Emitter(10, 2, -20, 1, 0), kSmallCamera), 64);
 }
 
-// The close-up setup A (§1.5): d = 55 mm, an 18 x 27 mm screen, h = 2.5 mm, here a 1 x 5 grid,
-// the camera 110 mm behind the screen. Emitters far behind S (z = -10^5 mm, the filter imaged
-// 1:1, +-5 mm) and the default ones.
+// The close-up setup A (docs/method.md §1.5): d = 55 mm, an 18 x 27 mm screen, h = 2.5 mm, here a 1
+// x 5 grid, the camera 110 mm behind the screen. Emitters far behind S (z = -10^5 mm, the filter
+// imaged 1:1, +-5 mm) and the default ones.
 const char* kCloseUpCamera =
     R"({"size_px": [300, 400], "focal_px": 1200, "position_mm": [0, -5, 165],
         "look_at_mm": [0, 0, 55]})";
@@ -292,28 +292,28 @@ TEST(HardCases, RandomisedSweep) {
   }
 }
 
-// Receivers very near the sampling plane S (D -> 0, docs/design.md §8.2): the receiver plane at
+// Receivers very near the sampling plane S (D -> 0, docs/testing.md §2): the receiver plane at
 // D = 0.2 d and 0.05 d lit by the built-in luminaire's exact slab (`--write-test-slab`: 9 x 7,
 // h = 5 mm, d = 750 mm, 300 texels), rendered four ways by lumislab-preview: the analytic image
-// straight from the emitters (the truth), the exact reference at N = 8 and N = 1 (§4.5), and
-// OpenGL (eq. 14). The view (--extent) keeps every ray from the emitters to it inside the grid's
-// covered region on S (|u| <= ((9 - 1)/2 - K) h = 15 mm, |v| <= 10 mm; the crossing
-// u = (e D + x z)/(D + z), §4.8), so what is measured is the method, not the coverage.
+// straight from the emitters (the truth), the exact reference at N = 8 and N = 1 (docs/method.md
+// §4.5), and OpenGL (eq. 14). The view (--extent) keeps every ray from the emitters to it inside
+// the grid's covered region on S (|u| <= ((9 - 1)/2 - K) h = 15 mm, |v| <= 10 mm; the crossing u =
+// (e D + x z)/(D + z), docs/method.md §4.8), so what is measured is the method, not the coverage.
 //
 // Bounds, derived:
 //  * Reference (N = 8) against the analytic image: the exact model's parallax error is first
-//    order in a = z/(d + z) |1 - d/D| and bounded pointwise by 2 a sum|c_m| (§4.5; sum|c_m| =
-//    67/39 for K = 1); with the deeper emitter (z = 20 mm) a = 0.104 at 0.2 d: 36 %. Second
-//    order adds (2 a sum|c_m|)^2 / 2 at most (the next Taylor term of the same expansion), so
-//    the bound is B = 2 a S + (2 a S)^2 / 2, 42 % at 0.2 d. At 0.05 d, a = 0.49 and 2 a S = 1.7:
+//    order in a = z/(d + z) |1 - d/D| and bounded pointwise by 2 a sum|c_m| (docs/method.md §4.5;
+//    sum|c_m| = 67/39 for K = 1); with the deeper emitter (z = 20 mm) a = 0.104 at 0.2 d: 36 %.
+//    Second order adds (2 a sum|c_m|)^2 / 2 at most (the next Taylor term of the same expansion),
+//    so the bound is B = 2 a S + (2 a S)^2 / 2, 42 % at 0.2 d. At 0.05 d, a = 0.49 and 2 a S = 1.7:
 //    the expansion does not converge, no bound holds, and lumislab-plan refuses the distance
 //    (exit 0 with its warning); the preview and the reference warn the same way given the
 //    light's depth (--luminaire-depth-mm, or the dataset's truth/luminaire.json).
 //  * OpenGL against the reference at N = 1: both sum one sample per position at c_ij (eq. 14);
 //    they differ by E' = E / g interpolated bilinearly and multiplied by g at the sample
-//    (shift-invariant model, §3.4) against E interpolated: g = d^2 cos^4 over M varies by at
-//    most 4 (a_t / d)^2 ~ 1.6e-4 relative over a texel a_t = 4 mm, plus float rounding in the
-//    GPU sum: bound 10^-3 (the CPU-GL agreement test's at d, §4.5).
+//    (shift-invariant model, docs/method.md §3.4) against E interpolated: g = d^2 cos^4 over M
+//    varies by at most 4 (a_t / d)^2 ~ 1.6e-4 relative over a texel a_t = 4 mm, plus float rounding
+//    in the GPU sum: bound 10^-3 (the CPU-GL agreement test's at d, docs/method.md §4.5).
 //  * Every value finite and the flux of each image positive.
 TEST(HardCases, ReceiverPlaneNearTheSamplingPlane) {
   if (testing::kSanitized)

@@ -165,8 +165,8 @@ TEST(HardCases, TinyFullWellNoiseDominated) {
   CleanUp(noisy);
 }
 
-// sRGBE at its edges (core/srgbe.h, docs/design.md §4.3, §8.2), beyond the unit tests of
-// tests/core/srgbe_test.cc: what the preview's sRGBE accumulation does with it, emulated on the
+// sRGBE at its edges (core/srgbe.h, docs/method.md §4.3, docs/testing.md §2), beyond the unit tests
+// of tests/core/srgbe_test.cc: what the preview's sRGBE accumulation does with it, emulated on the
 // CPU (each light pass decodes the running sum, adds and re-encodes).
 //  * Every word decodes to a finite value within kSrgbeMax, and re-encoding a decoded value gives
 //    the same value back (a pass that adds nothing leaves the image unchanged; no drift).
@@ -175,8 +175,8 @@ TEST(HardCases, TinyFullWellNoiseDominated) {
 //  * At the top, sums saturate at +-kSrgbeMax (no Inf, no NaN), sign kept.
 //  * NaN and +-Inf input are clamped (NaN to 0, Inf to +-kSrgbeMax), never propagated.
 //  * Accumulation: P re-encodings of the running sums S_k leave an error of at most
-//    sum_k max|S_k| / 127.5 per channel (each encode's bound, §4.3); over intensities spanning
-//    10^-30 ... 10^30 the sum of 63 positions stays within it.
+//    sum_k max|S_k| / 127.5 per channel (each encode's bound, docs/method.md §4.3); over
+//    intensities spanning 10^-30 ... 10^30 the sum of 63 positions stays within it.
 TEST(HardCases, SrgbeAtItsEdges) {
   const float inf = std::numeric_limits<float>::infinity();
   const float nan = std::numeric_limits<float>::quiet_NaN();

@@ -1,4 +1,4 @@
-// lumislab-acquire import (docs/design.md §5.3): a synthetic capture is turned into what a camera
+// lumislab-acquire import (docs/formats.md §3): a synthetic capture is turned into what a camera
 // leaves behind (a folder of IMG_0001.PNG ... in capture order, the board photo, no
 // dataset.json) plus a setup file; import, calibrate and reconstruct must then give exactly the
 // slab of the original dataset, the camera's folder must stay untouched, and every way of

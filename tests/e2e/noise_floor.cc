@@ -139,7 +139,7 @@ const JpegSpectrum& TexelJpegSpectrum(double side) {
   return cache[key] = JpegSpectrumOf(TexelPixelWeights(key / 20.0, false));
 }
 
-// Relative variance of calibrate scale's Y+ - Y- (docs/design.md §5.16): per slide, the
+// Relative variance of calibrate scale's Y+ - Y- (docs/formats.md §16): per slide, the
 // photos unclipped over the fit's disc, their exposure-weighted mean of the quadratic fit's
 // constant term, whose variance is [(A^T A)^-1]_00 x a pixel's over the disc's pixels.
 double ScaleRelativeVariance(const ScreenCalibration& cal,

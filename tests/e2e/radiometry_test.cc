@@ -1,4 +1,4 @@
-// Radiometric calibration end to end (docs/design.md §5.13 - §5.16): `acquire synth` writes the
+// Radiometric calibration end to end (docs/formats.md §13 - §16): `acquire synth` writes the
 // calibration captures of a scene, `lumislab-calibrate dark | response | flat | scale` recovers
 // the dark map, the response curve, the flat field and the absolute scale, each compared with
 // the synthetic truth; reconstruct then uses them, and the slab error against truth/ is printed

@@ -61,10 +61,10 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   // Issue 8 asks for 1 % per position and 1.5x the noise floor. Measured: 0.77 % overall,
   // 0.90 % worst position (2,2); the floor with JPEG's coding 0.79 % (0.74 - 0.97 % per
   // position): ratio 0.97 (0.91 - 1.07 per position). Without the coding in the floor (sensor
-  // noise and one rounding of the curve's output) it was 0.47 %, ratio 1.62 (docs/design.md
-  // §5.16). The recovered curve gives what the true curve gives; the decoder keeps the
-  // fractions of JPEG's YCbCr -> RGB conversion (0.87 % / 1.02 % when it rounded them).
-  // The issue's 1 % per position; 0.85 % overall so that a regression shows.
+  // noise and one rounding of the curve's output) it was 0.47 %, ratio 1.62 (docs/formats.md §16).
+  // The recovered curve gives what the true curve gives; the decoder keeps the fractions of JPEG's
+  // YCbCr -> RGB conversion (0.87 % / 1.02 % when it rounded them). The issue's 1 % per position;
+  // 0.85 % overall so that a regression shows.
   for (const auto& p : noisy.positions)
     EXPECT_LE(p.relative_l2, 0.01) << "position " << p.i << "," << p.j;
   EXPECT_LE(noisy.overall_relative_l2, 0.0085);
@@ -99,7 +99,7 @@ TEST_F(RealCamera, DngChainWithinOnePercentOfTruth) {
     EXPECT_LE(p.relative_l2, 0.01) << "position " << p.i << "," << p.j;
   // The camera's hot pixels read as their neighbours' mean: no lit texel is left unseen (before,
   // the texels around each one were masked and showed as black specks in the preview), except
-  // in the band along the screen's edge whose samples read the frame (§3.5 step 3).
+  // in the band along the screen's edge whose samples read the frame (docs/method.md §3.5 step 3).
   for (const auto& p : all.positions)
     EXPECT_EQ(testing::UnseenLitTexelsAwayFromTheEdge(root_ + "/ds_0/slab",
                                                       root_ + "/" + cam_ + "/truth", p.i, p.j),

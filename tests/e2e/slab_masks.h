@@ -1,4 +1,4 @@
-// The slab mask's rule at the screen's edge (docs/design.md §3.5 step 3), for tests that check
+// The slab mask's rule at the screen's edge (docs/method.md §3.5 step 3), for tests that check
 // masks: a texel along the screen's edge whose samples' reads reach past it keeps only its other
 // samples, and is unseen when fewer than a quarter are left, so texels within about one texel
 // of the screen's edge may be unseen.
@@ -19,8 +19,9 @@ bool TexelOnScreen(const SlabLayout& layout, const Eigen::Vector2d& c, double sc
 
 // Texels of position (i, j) that are lit in the truth slab (largest channel magnitude at least
 // `lit_fraction` of the position's largest), on the screen `band` texels or more from its edge
-// (the slab window is the screen's rectangle, §1.4), and yet unseen in the slab: what something
-// other than the screen's edge masked (a saturated or a hot pixel). Same resolution in both.
+// (the slab window is the screen's rectangle, docs/method.md §1.4), and yet unseen in the slab:
+// what something other than the screen's edge masked (a saturated or a hot pixel). Same resolution
+// in both.
 int UnseenLitTexelsAwayFromTheEdge(const std::string& slab_dir, const std::string& truth_dir, int i,
                                    int j, double band = 1, double lit_fraction = 0.01);
 

@@ -1,4 +1,4 @@
-// Stopping on SIGINT and SIGTERM (docs/design.md §7.6): every long-running command, signalled
+// Stopping on SIGINT and SIGTERM (docs/architecture.md §7.6): every long-running command, signalled
 // while it works or while it waits for input (a watcher polling for photos or slab positions, a
 // live capture pausing between positions), ends within kStopLimitS with the exit code of an
 // interrupted run and a valid partial result, and leaves no temporary file:
@@ -39,8 +39,8 @@ using testing::ReadBinaryFile;
 using testing::SnapshotTree;
 using testing::ToolProcess;
 
-// The stop limit of docs/design.md §7.6 is one second; a sanitized build runs the item in hand
-// several times slower, so it gets more.
+// The stop limit of docs/architecture.md §7.6 is one second; a sanitized build runs the item in
+// hand several times slower, so it gets more.
 #ifdef LUMISLAB_SANITIZED
 constexpr double kStopLimitS = 4.0;
 #else

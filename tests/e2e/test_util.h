@@ -56,7 +56,8 @@ using TreeSnapshot = std::map<std::string, std::string>;
 TreeSnapshot SnapshotTree(const std::string& dir);
 // Paths that differ between two snapshots (added, removed or changed), each with what happened.
 std::vector<std::string> DiffSnapshots(const TreeSnapshot& before, const TreeSnapshot& after);
-// Paths in a snapshot one of whose components starts with '.' (temporary names, §7.5).
+// Paths in a snapshot one of whose components starts with '.' (temporary names,
+// docs/architecture.md §7.5).
 std::vector<std::string> TemporaryPaths(const TreeSnapshot& snapshot);
 
 // A tool started in the background: fork + exec of build/bin/<tool> <args> in `cwd`, stdin

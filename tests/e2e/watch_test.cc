@@ -1,11 +1,12 @@
-// lumislab-acquire watch (docs/design.md §5.3): a camera folder filled while the tool watches it,
+// lumislab-acquire watch (docs/formats.md §3): a camera folder filled while the tool watches it,
 // the way tethering software fills it. The test plays the camera: it drops the photos of a
 // synthetic capture into the folder one position at a time (one of them written slowly under
 // its final name, as a plain copy does, plus files with temporary names), and checks that
 // dataset.json grows by whole positions, that the slowly written file is not read before it is
 // complete, that `reconstruct --watch` follows live to the slab of the original photos, and
 // that the final dataset.json is the one `import` writes for the finished folder. Stop signals,
-// the idle timeout and bad photos end the watch with the codes of §7.2, naming the file.
+// the idle timeout and bad photos end the watch with the codes of docs/architecture.md §7.2, naming
+// the file.
 #include <gtest/gtest.h>
 #include <signal.h>
 

@@ -25,7 +25,7 @@ using testing::RunTool;
 using testing::ShellQuote;
 
 // The default scene's emitters 1 and 1.5 mm behind S (the slab's parallax error is then 0.1 %,
-// docs/design.md §4.5) on its 9 x 7 grid at 48 texels: a complete truth slab in a folder.
+// docs/method.md §4.5) on its 9 x 7 grid at 48 texels: a complete truth slab in a folder.
 // ctest runs each test in its own process, in parallel: the folder is the running test's own (one
 // shared name had two processes clearing and refilling it at once).
 struct Fixture {

@@ -1,4 +1,4 @@
-// lumislab-export irradiance and polar (export/cli_plots.h, docs/design.md §4.9) on an exact
+// lumislab-export irradiance and polar (export/cli_plots.h, docs/method.md §4.9) on an exact
 // slab of the built-in synthetic luminaire: the plane's irradiance at D = d against the
 // luminaire's own, the pictures' sizes and contents, and bad input (exit 2, nothing written).
 #include <gtest/gtest.h>
@@ -46,8 +46,8 @@ class ExportPlots : public testing::Test {
 };
 std::filesystem::path ExportPlots::dir_;
 
-// At D = d the exact model gives the luminaire's irradiance where the grid covers it (§4.5):
-// the centre of the plane within 0.5 % (bilinear texels of 20 mm).
+// At D = d the exact model gives the luminaire's irradiance where the grid covers it
+// (docs/method.md §4.5): the centre of the plane within 0.5 % (bilinear texels of 20 mm).
 TEST_F(ExportPlots, IrradianceOnThePlaneAtD) {
   const std::string exr = Out("e.exr"), png = Out("e.png");
   ASSERT_EQ(RunExportWith({"irradiance", "--slab", Slab(), "--distance-mm", "750", "--extent-mm",

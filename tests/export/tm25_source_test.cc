@@ -1,8 +1,9 @@
 // The TM-25 evidence: a TM-25 ray file as the synthetic source (a Lambertian disc 10 mm
 // across, 3 mm behind S) -> lumislab-acquire synth -> calibrate screen -> reconstruct ->
 // lumislab-export tm25: the irradiance the exported rays put on planes at d and 4d against the
-// input rays', binned alike, within what the planner's accuracy model (lumislab-plan, §4.8)
-// predicts for the capture's geometry plus the two ray sets' Monte-Carlo error on the bins.
+// input rays', binned alike, within what the planner's accuracy model (lumislab-plan,
+// docs/method.md §4.8) predicts for the capture's geometry plus the two ray sets' Monte-Carlo error
+// on the bins.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -173,7 +174,7 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
           c.rel_l2 / bound);
       // Within the prediction itself: the exported rays carry the slab's light field, its
       // negative part cancelled within each texel keeping the texel's flux and centroid
-      // (SampleSlabRays, docs/design.md §5.17). Measured 0.5 - 0.6 x at d and 4d (when the rays
+      // (SampleSlabRays, docs/formats.md §17). Measured 0.5 - 0.6 x at d and 4d (when the rays
       // kept only the positive part, 1.12 x and 1.03 x: a +-4 % centre-to-edge pattern).
       EXPECT_LT(c.rel_l2, bound);
       EXPECT_NEAR(c.flux_ratio, 1, bound);

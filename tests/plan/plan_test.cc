@@ -1,4 +1,4 @@
-// lumislab-plan (docs/design.md §4.8): the model's predictions against what lumislab-study
+// lumislab-plan (docs/method.md §4.8): the model's predictions against what lumislab-study
 // measured (docs/study/*/study.csv, end-to-end on synthetic scenes), the recommended grid against
 // GridCovers, out-of-reach targets, the command line.
 #include "plan/plan.h"
@@ -241,7 +241,7 @@ TEST(Plan, ParallaxFloorMakesTargetsAwayFromDOutOfReach) {
   // The same target at d is reachable.
   in.receiver_mm = 0;
   EXPECT_TRUE(MakePlan(in).reachable);
-  // h does not move the parallax term (§4.5).
+  // h does not move the parallax term (docs/method.md §4.5).
   PlanSetting a = p.setting, b = p.setting;
   a.h_mm = 2.5;
   b.h_mm = 10;

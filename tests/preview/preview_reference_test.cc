@@ -1,4 +1,4 @@
-// lumislab-preview --reference and --analytic (docs/design.md §4.5): on the receiver plane at
+// lumislab-preview --reference and --analytic (docs/method.md §4.5): on the receiver plane at
 // D = d the OpenGL render (eq. 14), the exact CPU reference and the analytic image of the built-in
 // luminaire agree; the options are checked (exit 2 naming the option, nothing written).
 #include <gtest/gtest.h>
@@ -72,7 +72,7 @@ TEST(PreviewReference, PlaneAgreesWithOpenGlAndTheAnalyticImage) {
   const ImageF gl = ReadExr(out + "gl.exr", {"R", "G", "B"});
   const ImageF ref = ReadExr(out + "ref.exr", {"R", "G", "B"});
   const ImageF analytic = ReadExr(out + "analytic.exr", {"R", "G", "B"});
-  // At D = d eq. 14 and the exact model both give sum_ij E_ij(x) (§4.5).
+  // At D = d eq. 14 and the exact model both give sum_ij E_ij(x) (docs/method.md §4.5).
   const double gl_vs_ref = RelativeL2(gl, ref, 600);
   // Within 280 mm of the axis every emitter's light crosses S where the grid's duals sum to 1.
   const double ref_vs_analytic = RelativeL2(ref, analytic, 280);
@@ -82,7 +82,7 @@ TEST(PreviewReference, PlaneAgreesWithOpenGlAndTheAnalyticImage) {
   EXPECT_LT(ref_vs_analytic, 2e-3);
 }
 
-// --texture-filter (the knob of docs/design.md §4.6): E' between texel centres read bilinearly
+// --texture-filter (the knob of docs/method.md §4.6): E' between texel centres read bilinearly
 // (the default, the same image as without the flag), from the nearest texel, or Catmull-Rom. On
 // the plane at D = d the image is sum_ij E_ij(x) read straight from the textures, so against the
 // analytic image only the reconstruction between texels differs. A coarse slab (32 texels over
@@ -161,7 +161,7 @@ TEST(PreviewReference, RoomsAgreeWithOpenGl) {
       std::vector<std::string> common = {"--slab", slab,    "--scene",   scene,
                                          "--size", "64x48", "--threads", "2"};
       // The full per-position render (eq. 14 itself): no merged lights, which --no-shadows
-      // would otherwise turn on (§4.2).
+      // would otherwise turn on (docs/method.md §4.2).
       if (!shadows) common.insert(common.end(), {"--no-shadows", "--merge-group", "1"});
       auto run = [&](std::vector<std::string> extra) {
         std::vector<std::string> args = common;

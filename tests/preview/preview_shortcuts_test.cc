@@ -1,4 +1,4 @@
-// The preview's shortcuts (docs/design.md §4.2, "Faster frames") against the full render on the
+// The preview's shortcuts (docs/method.md §4.2, "Faster frames") against the full render on the
 // slab-files fixture (preview_slab_files.h): off is the full per-position render bit for bit, each
 // stays within its bound; shadow culling, the shadow scissor and tiled light culling keep the
 // image; coarse shading and reprojection stay within 1 %, also through live positions, a resize,
@@ -19,14 +19,14 @@
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/scenes.h"
 #include "lib/synthetic/truth.h"
-#include "preview/renderer.h"
 #include "preview/config.h"
+#include "preview/renderer.h"
 #include "preview_slab_files.h"
 
 namespace lumislab {
 namespace {
 
-// The shortcuts of docs/design.md §4.2 ("Faster frames"): off is the full per-position render
+// The shortcuts of docs/method.md §4.2 ("Faster frames"): off is the full per-position render
 // bit for bit (also after they were on), each stays within its bound of it.
 TEST_F(PreviewSlabFiles, ShortcutsStayWithinTheirBoundsAndOffIsTheFullRender) {
   auto full = MakeRenderer();
@@ -237,7 +237,7 @@ TEST_F(PreviewSlabFiles, TiledLightsKeepTheImageBitForBit) {
   EXPECT_EQ(live->Read().data, fresh->Read().data);
 }
 
-// Coarse shading and reprojection (docs/design.md §4.2, "Faster frames") against the full
+// Coarse shading and reprojection (docs/method.md §4.2, "Faster frames") against the full
 // per-position render of the same view: within 1 %, not identical (they really interpolate), the
 // tolerance matters, and reprojection never reuses sums that a pose, a scene or a replaced
 // position made stale.

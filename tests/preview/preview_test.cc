@@ -232,7 +232,7 @@ TEST(PreviewCommandLine, FalseColourView) {
   EXPECT_EQ(picture.rows, 120);
   EXPECT_EQ(picture.cols, 120 + BarPanelWidth(120));
   // The .exr is the irradiance, the same from OpenGL and from the CPU reference (at D = d both
-  // are exact up to the bilinear texels, §4.5).
+  // are exact up to the bilinear texels, docs/method.md §4.5).
   const std::string gl = (dir / "gl.exr").string(), cpu = (dir / "cpu.exr").string();
   for (const auto& [out, extra] :
        {std::pair{gl, std::vector<std::string>{"--no-shadows"}},

@@ -71,7 +71,7 @@ TEST(Study, TinySweepWritesRowsResumesAndMovesErrorsTheKnownWay) {
     EXPECT_DOUBLE_EQ(row.lab_s, row.positions() * 3.0);
     EXPECT_NEAR(row.total_s, row.lab_s + row.reconstruct_s + row.render_s, 1e-3 * row.total_s);
   }
-  // At D = d the exact model gives sum_ij E_ij(x) whatever N (docs/design.md §4.5): N only
+  // At D = d the exact model gives sum_ij E_ij(x) whatever N (docs/method.md §4.5): N only
   // moves the error away from d.
   EXPECT_NEAR(n2.err[0], n1.err[0], 1e-5);
   // Noise-free photos: a finer grid over the same span is not worse at d (measured 1.0 % vs
@@ -218,9 +218,9 @@ TEST(Study, NoiseBracketsLambdaAndThePreviewsKnobs) {
             by["plane2d/opengl/base (shadows 512; float)"].rel_l2);
   EXPECT_GT(by["crypt/texture_filter/cubic"].frame_ms, 0);
   // Merging without shadows against the full render without them: each merged term is within
-  // 5 % of its block's peak beyond z_G (§4.2), a bound per term, not on the image; the image
-  // moved 0.37 - 0.68 % on the default rooms. The error against the reference may move by the
-  // 5 % (triangle inequality on that allowance), not more.
+  // 5 % of its block's peak beyond z_G (docs/method.md §4.2), a bound per term, not on the image;
+  // the image moved 0.37 - 0.68 % on the default rooms. The error against the reference may move by
+  // the 5 % (triangle inequality on that allowance), not more.
   const PreviewRow& off = by["crypt/shadows/off"];
   EXPECT_LE(std::abs(by["crypt/merge/2x2 at 5 %; no shadows"].rel_l2 - off.rel_l2),
             0.05 * (1 + off.rel_l2));

@@ -1,4 +1,4 @@
-// The photometrist's pictures without GL (docs/design.md §4.9): the colour map's ends and its
+// The photometrist's pictures without GL (docs/method.md §4.9): the colour map's ends and its
 // monotone luminance, the scale's ticks and automatic range, iso-lines on a radial ramp at the
 // level they stand for, the bar's range in the picture, the bitmap font, and the polar plot's
 // geometry.

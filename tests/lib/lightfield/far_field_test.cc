@@ -16,7 +16,7 @@ namespace {
 
 // The default scene's setup (d = 750 mm, 9 x 7 grid, h = 5 mm, 1.2 m window) at 120 texels, its
 // two emitters moved to 1 and 1.5 mm behind S: the slab's own parallax error, first order in
-// z_e / (d + z_e) (docs/design.md §4.5), is then 0.1 % (at the scene's 12 and 20 mm it is 3 %
+// z_e / (d + z_e) (docs/method.md §4.5), is then 0.1 % (at the scene's 12 and 20 mm it is 3 %
 // in the far field, the same for any implementation).
 struct Fixture {
   SynthScene scene = DefaultScene();
@@ -62,7 +62,7 @@ TEST(FarField, MatchesTheAnalyticLuminaireWhereTheGridCoversIt) {
       worst = std::max(worst, std::abs(ff.values[k] / f.Truth(c[ic], gamma[ig]) - 1));
     }
   std::printf("far field vs truth, gamma <= 35 deg: worst relative error %.2e\n", worst);
-  // The parallax bound 2 a sum|c_m| (a = 1.5 / 751.5, docs/design.md §4.5) is 0.7 %.
+  // The parallax bound 2 a sum|c_m| (a = 1.5 / 751.5, docs/method.md §4.5) is 0.7 %.
   EXPECT_LT(worst, 5e-3);
   EXPECT_EQ(ff.unseen, int(c.size()));  // the gamma = 95 column
   EXPECT_EQ(ff.behind, int(c.size()));

@@ -1,4 +1,4 @@
-// The exact CPU reference (docs/design.md §4.5) against the analytic truth of the built-in
+// The exact CPU reference (docs/method.md §4.5) against the analytic truth of the built-in
 // synthetic luminaire: agreement on the receiver plane at D = d, convergence with the samples per
 // basis support, visibility against a blocker with a known shadow, and the preview's eq. 14
 // (SpotIrradiance) against it at D = 2d.
@@ -135,7 +135,7 @@ TEST(ReferenceRenderTest, AgreesWithAnalyticTruthOnThePlaneAtD) {
 // much. The truth weighs it by 1 + a per axis, the bell reconstruction by 1 + a (1 + P'(w)),
 // P(w) = sum_m c_m p(w - m), p(y) = sum_k k phi(y - k) - y (the bell reproduces constants but not
 // linear functions; |p'| <= 1), so |error| <= 2 a sum_m |c_m| to first order in a
-// (docs/design.md §4.5).
+// (docs/method.md §4.5).
 TEST(ReferenceRenderTest, ConvergesWithSamplesAt2d) {
   const Fixture& f = Data();
   SceneRequest request;
@@ -227,7 +227,7 @@ TEST(ReferenceRenderTest, BlockerCastsTheExpectedShadow) {
 
 // The preview's eq. 14 (one spot light per position, geometry frozen at c_ij) against the exact
 // model: the same at D = d up to the texture lookups, and off by the shift-invariant error of
-// §3.4 at D = 2d, which is bounded by E_r at the largest angle of the view.
+// docs/method.md §3.4 at D = 2d, which is bounded by E_r at the largest angle of the view.
 TEST(ReferenceRenderTest, PreviewEq14AgainstExactModel) {
   const Fixture& f = Data();
   std::vector<ImageF> intensity;

@@ -1,7 +1,7 @@
-// The radiometric corrections the one decoder applies (docs/design.md §3.5, §5.13 - §5.15): the
-// dark level subtracted before the exposure division, hot pixels read as their neighbours' mean,
-// the flat gain divided out, the calibrated response curve for 8-bit photos; and the calibration
-// files' round trips and checks.
+// The radiometric corrections the one decoder applies (docs/method.md §3.5, docs/formats.md §13 -
+// §15): the dark level subtracted before the exposure division, hot pixels read as their
+// neighbours' mean, the flat gain divided out, the calibrated response curve for 8-bit photos; and
+// the calibration files' round trips and checks.
 #include <gtest/gtest.h>
 
 #include <filesystem>

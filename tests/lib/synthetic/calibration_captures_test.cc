@@ -1,4 +1,4 @@
-// The scene block calibration_captures (docs/design.md §5.10): nothing without it, the slide
+// The scene block calibration_captures (docs/formats.md §10): nothing without it, the slide
 // photos unchanged with it, each kind of frame made through the effects that apply to it, and
 // its members checked naming the field.
 #include "lib/synthetic/calibration_captures.h"

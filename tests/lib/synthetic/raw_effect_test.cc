@@ -1,4 +1,4 @@
-// The `raw` effect (docs/design.md §5.10): photos stored as an RGGB Bayer mosaic in a DNG that
+// The `raw` effect (docs/formats.md §10): photos stored as an RGGB Bayer mosaic in a DNG that
 // the one decoder reads back through LibRaw. Each mosaic sample is the sensor code of its
 // channel's value (black + v (white - black), clipped at white), the decoder gives back
 // (code - black) / (white - black) at every sample site, EXIF gives the exposure, and bad

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "acquire/capture_list.h"
+#include "acquire/settle_tracker.h"
 #include "acquire/photo_naming.h"
 #include "core/error.h"
 #include "core/input_file.h"
@@ -24,54 +25,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-// The folder's files (temporary names left out) and since when each has had its present size
-// and modification time: a file whose copy is in progress keeps changing, so it settles only
-// once the copy is done (or stalled for the settle time, when it is read and refused).
-class SettleTracker {
- public:
-  explicit SettleTracker(double settle_s) : settle_s_(settle_s) {}
-
-  // Looks at the folder once; true when a file appeared, changed or went away.
-  bool Scan(const std::string& dir) {
-    const Clock::time_point now = Clock::now();
-    bool changed = false;
-    std::map<std::string, State> seen;
-    for (const std::string& name : FolderFiles(dir)) {
-      std::error_code size_ec, time_ec;
-      const auto size = fs::file_size(dir + "/" + name, size_ec);
-      const auto time = fs::last_write_time(dir + "/" + name, time_ec);
-      if (size_ec || time_ec) continue;  // gone since the listing: the next look tells
-      State state{size, time, now};
-      const auto it = files_.find(name);
-      if (it != files_.end() && it->second.size == size && it->second.time == time)
-        state.since = it->second.since;
-      else
-        changed = true;
-      seen.emplace(name, state);
-    }
-    changed = changed || seen.size() != files_.size();
-    files_ = std::move(seen);
-    return changed;
-  }
-  // Files in name order, with whether each has settled.
-  std::vector<std::pair<std::string, bool>> Files() const {
-    const Clock::time_point now = Clock::now();
-    std::vector<std::pair<std::string, bool>> out;
-    for (const auto& [name, state] : files_)
-      out.emplace_back(name, Seconds(now - state.since) >= settle_s_);
-    return out;
-  }
-
- private:
-  struct State {
-    uintmax_t size;
-    fs::file_time_type time;
-    Clock::time_point since;  // when this size and time were first seen
-  };
-  double settle_s_;
-  std::map<std::string, State> files_;
-};
 
 // The capture as it arrives: which files were taken, the photo list, and dataset.json.
 class Watcher {

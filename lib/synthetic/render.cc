@@ -34,12 +34,16 @@ PlaneLight ScreenLight(const SynthScene& scene, const DualFilter& filter,
 
 void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int j,
                     double radiometric_scale, ImageF* plus, ImageF* minus) {
+  // Where the stage put the luminaire: the nominal centre plus a listed stage_error's offset.
+  const Eigen::Vector2d c = scene.grid.Centre(i, j) + scene.StageOffsetMm(i, j);
+  RenderAt(scene, view, c, scene.camera.exposure / radiometric_scale, plus, minus);
+}
+
+void RenderAt(const SynthScene& scene, const ScreenView& view, const Eigen::Vector2d& c,
+              double gain, ImageF* plus, ImageF* minus) {
   *plus = ImageF(view.width, view.height, 3);
   *minus = ImageF(view.width, view.height, 3);
   const DualFilter filter = scene.Filter();
-  // Where the stage put the luminaire: the nominal centre plus a listed stage_error's offset.
-  const Eigen::Vector2d c = scene.grid.Centre(i, j) + scene.StageOffsetMm(i, j);
-  const double gain = scene.camera.exposure / radiometric_scale;
   const PlaneLight light = ScreenLight(scene, filter, c);
   Eigen::Vector3d e_plus, e_minus;
   for (size_t k = 0; k < view.pixels.size(); ++k) {

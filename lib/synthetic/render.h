@@ -31,6 +31,10 @@ PlaneLight ScreenLight(const SynthScene& scene, const DualFilter& filter, const 
 // centre plus scene.StageOffsetMm(i, j).
 void RenderPosition(const SynthScene& scene, const ScreenView& view, int i, int j,
                     double radiometric_scale, ImageF* plus, ImageF* minus);
+// The same with the luminaire at the filter centre c (luminaire frame, mm: wherever a stage put
+// it, acquire capture's virtual lab) and values E x gain.
+void RenderAt(const SynthScene& scene, const ScreenView& view, const Eigen::Vector2d& c,
+              double gain, ImageF* plus, ImageF* minus);
 // Largest slide irradiance (W/m^2, any channel, either slide) over all positions, sampling every
 // `stride`-th screen pixel (a cheap pre-pass); divides out to the radiometric scale.
 double MaxSlideIrradiance(const SynthScene& scene, const ScreenView& view, int stride, int threads);

@@ -410,11 +410,22 @@ std::string GrblEmulator::ExecuteGcode(const std::string& line, double t) {
   for (size_t at = 0; at < line.size();) {
     const char letter = line[at++];
     if (letter < 'A' || letter > 'Z') return "error:1";
-    const char* begin = line.c_str() + at;
-    char* end = nullptr;
-    const double number = std::strtod(begin, &end);
-    if (end == begin || std::isnan(number) || std::isinf(number)) return "error:2";
-    at += static_cast<size_t>(end - begin);
+    // GRBL's read_float: a sign, digits and one decimal point (no exponent, no hex: strtod
+    // would read "G0X1" as G 0x1).
+    const size_t begin = at;
+    if (at < line.size() && (line[at] == '-' || line[at] == '+')) ++at;
+    bool digits = false, point = false;
+    for (; at < line.size(); ++at) {
+      if (std::isdigit(static_cast<unsigned char>(line[at]))) {
+        digits = true;
+      } else if (line[at] == '.' && !point) {
+        point = true;
+      } else {
+        break;
+      }
+    }
+    if (!digits) return "error:2";
+    const double number = std::strtod(line.substr(begin, at - begin).c_str(), nullptr);
     const bool integer = number == std::floor(number);
     switch (letter) {
       case 'G': {

@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 
+#include "acquire/devices/serial_port.h"
 #include "core/error.h"
 #include "core/stop_signal.h"
 #include "grbl_emulator.h"
@@ -353,6 +354,93 @@ TEST(GrblStage, ResetDuringAHoldInProgressLosesPosition) {
   EXPECT_NE(std::string(error.what()).find("stopped by a signal"), std::string::npos);
   EXPECT_TRUE(HasEvent(emulator, "< ALARM:3"));
   EXPECT_EQ(emulator.State(), "Alarm");
+}
+
+TEST(GrblStage, MoveNotAtRestInTimeIsHalted) {
+  GrblEmulator emulator;
+  GrblStage stage(Uri(emulator), emulator.SlavePath(), 115200);
+  StageSettings settings = TestSettings();
+  settings.move_timeout_s = 0.3;
+  stage.Connect(settings, nullptr);
+  const auto start = Clock::now();
+  const Error error = Thrown([&] { stage.MoveTo({{'X', 200}}); });
+  EXPECT_LT(Since(start), 0.3 + 0.1 + 1.0);
+  EXPECT_EQ(std::string(error.what()),
+            Uri(emulator) + ": moving to X=200: not at rest within 0.3 s (move_timeout_s); halted");
+  EXPECT_TRUE(HasEvent(emulator, "> !"));
+  EXPECT_TRUE(HasEvent(emulator, "> <0x18>"));
+  EXPECT_NE(emulator.State(), "Run");
+}
+
+TEST(GrblStage, StopSignalDuringHomingResets) {
+  GrblEmulatorOptions options;
+  options.require_homing = true;
+  options.homing_s = 5;
+  GrblEmulator emulator(options);
+  StageSettings settings = TestSettings();
+  settings.home = true;
+  GrblStage stage(Uri(emulator), emulator.SlavePath(), 115200);
+  const StopSignalScope scope;
+  stage.Connect(settings, nullptr);
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    RequestStop();
+  });
+  const auto start = Clock::now();
+  const Error error = Thrown([&] { stage.Home(); });
+  stopper.join();
+  { const StopSignalScope clear; }
+  EXPECT_LT(Since(start), 0.3 + 1.0);
+  EXPECT_EQ(std::string(error.what()), Uri(emulator) + ": homing ($H): stopped by a signal");
+  EXPECT_TRUE(HasEvent(emulator, "< ALARM:6"));  // homing reset, as GRBL reports it
+  EXPECT_FALSE(HasEvent(emulator, "> !"));       // GRBL ignores a feed hold while homing
+}
+
+// The emulator answers as GRBL 1.1 does (doc/markdown/interface.md, commands.md).
+TEST(GrblEmulator, AnswersLikeGrbl) {
+  GrblEmulatorOptions options;
+  options.speed_factor = 50;
+  GrblEmulator emulator(options);
+  SerialPort port("grbl:test", emulator.SlavePath(), 115200);
+  const auto reply = [&](const std::string& bytes) {
+    port.Write(bytes);
+    std::string line;
+    EXPECT_EQ(port.ReadLine(1, &line), SerialPort::Read::kLine) << bytes;
+    return line;
+  };
+  EXPECT_EQ(reply("\x18"), "Grbl 1.1h ['$' for help]");
+  EXPECT_EQ(reply("G21 G90\n"), "ok");
+  EXPECT_EQ(reply("\n"), "ok");                // an empty line, for syncing
+  EXPECT_EQ(reply("G2 X1\n"), "error:20");     // not emulated: unsupported command
+  EXPECT_EQ(reply("G1 X1\n"), "error:22");     // no feed rate yet
+  EXPECT_EQ(reply("G0 G1 X1\n"), "error:21");  // modal group violation
+  EXPECT_EQ(reply("G0 X1 X2\n"), "error:25");  // repeated word
+  EXPECT_EQ(reply("G0 X\n"), "error:2");       // bad number format
+  EXPECT_EQ(reply("1 X\n"), "error:1");        // expected command letter
+  EXPECT_EQ(reply("$Q\n"), "error:3");         // invalid statement
+  EXPECT_EQ(reply("G1 X2 Y3 F6000\n"), "ok");
+  EXPECT_EQ(reply("G91 G0 X1\n"), "ok");  // relative to the planned end
+  for (int i = 0; i < 100 && emulator.State() != "Idle"; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(reply("?"), "<Idle|MPos:3.000,3.000,0.000|FS:0,0|WCO:0.000,0.000,0.000>");
+  EXPECT_EQ(reply("$X\n"), "ok");  // not locked: nothing to say
+  emulator.RequireHoming(true);
+  EXPECT_EQ(reply("G0 X0\n"), "error:9");
+  EXPECT_EQ(reply("$X\n"), "[MSG:Caution: Unlocked]");
+  std::string line;
+  ASSERT_EQ(port.ReadLine(1, &line), SerialPort::Read::kLine);
+  EXPECT_EQ(line, "ok");
+  EXPECT_EQ(reply("G90 G0 X999\n"), "ALARM:2");
+  EXPECT_EQ(port.ReadLine(1, &line), SerialPort::Read::kLine);
+  EXPECT_EQ(line, "[MSG:Reset to continue]");
+  EXPECT_EQ(reply("\x18"), "ok");  // the interrupted line's answer comes after the reset
+  EXPECT_EQ(port.ReadLine(1, &line), SerialPort::Read::kLine);
+  EXPECT_EQ(line, "Grbl 1.1h ['$' for help]");
+  EXPECT_EQ(port.ReadLine(1, &line), SerialPort::Read::kLine);
+  EXPECT_EQ(line, "[MSG:'$H'|'$X' to unlock]");
+  const std::string status = reply("?");
+  EXPECT_EQ(status.rfind("<Alarm|MPos:3.000,3.000,0.000|", 0), 0u) << status;
 }
 
 }  // namespace

@@ -307,7 +307,10 @@ void Gphoto2Camera::Connect(const CameraSettings& settings, DeviceLog* log) {
   gp_context_set_error_func(context_, OnContextText, nullptr);
   gp_context_set_message_func(context_, OnContextText, nullptr);
   gp_context_set_cancel_func(context_, OnCancelQuery, nullptr);
-  log_func_id_ = gp_log_add_func(GP_LOG_ERROR, OnLogLine, nullptr);
+  // One log function for the process (it files each line under the camera whose call runs in
+  // the thread): one per camera would file every line once per camera.
+  static std::once_flag log_func_added;
+  std::call_once(log_func_added, [] { gp_log_add_func(GP_LOG_ERROR, OnLogLine, nullptr); });
 
   gp_abilities_list_new(&abilities_);
   gp_port_info_list_new(&ports_);
@@ -573,8 +576,6 @@ void Gphoto2Camera::Close() noexcept {
   abilities_ = nullptr;
   if (ports_) gp_port_info_list_free(ports_);
   ports_ = nullptr;
-  if (log_func_id_ >= 0) gp_log_remove_func(log_func_id_);
-  log_func_id_ = -1;
   if (context_) gp_context_unref(context_);
   context_ = nullptr;
   shutter_choices_.clear();

@@ -81,7 +81,6 @@ class Gphoto2Camera : public Camera {
   _Camera* camera_ = nullptr;
   _CameraAbilitiesList* abilities_ = nullptr;
   _GPPortInfoList* ports_ = nullptr;
-  int log_func_id_ = -1;
   std::vector<std::pair<double, std::string>> shutter_choices_;  // s ascending, widget choice
   double shutter_s_ = 0;  // the exposure time set through SetShutterSpeed; 0: not set by us
   std::vector<std::string> messages_;

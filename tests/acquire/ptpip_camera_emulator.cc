@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -183,6 +184,10 @@ bool ReadAll(int fd, char* data, size_t size) {
   size_t done = 0;
   while (done < size) {
     if (!WaitFor(fd, POLLIN, kSocketTimeoutS)) return false;
+    // libgphoto2 writes a request and its data in separate packets without TCP_NODELAY: an
+    // acknowledgement at once lets the next one go without waiting for the delayed one.
+    const int yes = 1;
+    ::setsockopt(fd, IPPROTO_TCP, TCP_QUICKACK, &yes, sizeof yes);
     const ssize_t n = ::recv(fd, data + done, size - done, 0);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
@@ -377,6 +382,10 @@ bool PtpipCameraEmulator::AcceptSession(Connection& conn) {
   if (!WaitFor(listen_fd_, POLLIN, 0.05)) return false;
   conn.cmd = ::accept(listen_fd_, nullptr, nullptr);
   if (conn.cmd < 0) return false;
+  // A data phase is three packets written one after another: without this, each waits for the
+  // host's delayed acknowledgement of the one before (Nagle's algorithm).
+  const int yes = 1;
+  ::setsockopt(conn.cmd, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);
   uint32_t type = 0;
   std::string payload;
   if (!ReadPacket(conn.cmd, &type, &payload)) return false;

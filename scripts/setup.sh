@@ -16,6 +16,8 @@ packages=(
   # lib/photo: camera RAW and DNG (LibRaw), EXIF (libexif), PNG, JPEG and TIFF files (libpng,
   # libjpeg-turbo, libtiff; colour JPEGs decoded with their fractional codes)
   libraw-dev libexif-dev libtiff-dev libjpeg-dev libpng-dev zlib1g-dev
+  # acquire: the gphoto2 camera driver (libgphoto2 over USB and PTP/IP)
+  libgphoto2-dev
   # preview: the window's on-screen controls (Dear ImGui 1.86 with its GLFW and OpenGL 3 backends);
   # lib/lightfield: scene files' textures (stb_image)
   libimgui-dev libstb-dev

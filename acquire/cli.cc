@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "acquire/cli_capture.h"
 #include "acquire/cli_filter.h"
 #include "acquire/cli_import.h"
 #include "acquire/cli_synth.h"
@@ -13,8 +14,8 @@ namespace lumislab {
 
 int RunAcquire(int argc, char** argv) {
   CLI::App app{
-      "lumislab-acquire: synthetic capture of a luminaire, import of a camera's photos, and "
-      "filter-slide printing"};
+      "lumislab-acquire: capture with a lab's stage and camera, synthetic capture of a luminaire, "
+      "import of a camera's photos, and filter-slide printing"};
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);
@@ -26,11 +27,14 @@ int RunAcquire(int argc, char** argv) {
   CLI::App* import_cmd = AddImportCommand(app, &import, &common);
   WatchOptions watch;
   CLI::App* watch_cmd = AddWatchCommand(app, &watch, &common);
+  CaptureOptions capture;
+  CLI::App* capture_cmd = AddCaptureCommand(app, &capture, &common);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("acquire", common);
   if (filter_cmd->parsed()) return RunFilter(filter);
   if (import_cmd->parsed()) return RunImportCommand(import);
   if (watch_cmd->parsed()) return RunWatchCommand(watch);
+  if (capture_cmd->parsed()) return RunCaptureCommand(capture);
   // CLI11 requires one subcommand: the one left is synth.
   return RunSynthCommand(synth, threads);
 }

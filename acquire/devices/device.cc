@@ -10,7 +10,8 @@ namespace lumislab {
 DeviceLog::DeviceLog(const std::string& path) : path_(path) {
   if (path_.empty()) return;
   file_ = std::fopen(path_.c_str(), "a");
-  if (!file_) throw IoError(path_, std::string("cannot open the device log: ") + std::strerror(errno));
+  if (!file_)
+    throw IoError(path_, std::string("cannot open the device log: ") + std::strerror(errno));
 }
 
 DeviceLog::~DeviceLog() {

@@ -8,6 +8,7 @@
 // of at most 50 ms, so a stalled device or a Ctrl-C never hangs the capture.
 #pragma once
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -54,16 +55,21 @@ Error DeviceError(const std::string& device, const std::string& doing, const std
 // The capture was stopped by SIGINT/SIGTERM while `device` was `doing` something (exit 1).
 Error DeviceStopped(const std::string& device, const std::string& doing);
 
+// Seconds from now to `end` (negative once past): what every device wait has left of its timeout.
+inline double SecondsLeft(std::chrono::steady_clock::time_point end) {
+  return std::chrono::duration<double>(end - std::chrono::steady_clock::now()).count();
+}
+
 // Stage axes and their targets, in the stage's own frame and unit (mm, absolute): {'X', 12.5}.
 using AxisTargets = std::vector<std::pair<char, double>>;
 
-struct StageSettings {  // setup.json "lab.stage" (docs/formats.md §3)
-  bool home = false;             // home ($H for GRBL) once before the first move
-  double feed_mm_min = 1000;     // feed rate of the moves
-  double tolerance_mm = 0.01;    // read-back position vs. target, per axis
-  double reply_timeout_s = 5;    // a command's reply
-  double move_timeout_s = 120;   // one move, from the command to Idle
-  double settle_s = 0;           // wait after a move before the photo (vibration)
+struct StageSettings {          // setup.json "lab.stage" (docs/formats.md §3)
+  bool home = false;            // home ($H for GRBL) once before the first move
+  double feed_mm_min = 1000;    // feed rate of the moves
+  double tolerance_mm = 0.01;   // read-back position vs. target, per axis
+  double reply_timeout_s = 5;   // a command's reply
+  double move_timeout_s = 120;  // one move, from the command to Idle
+  double settle_s = 0;          // wait after a move before the photo (vibration)
 };
 
 class Stage {
@@ -91,10 +97,10 @@ class Stage {
   std::string uri_;
 };
 
-struct CameraSettings {  // setup.json "lab.camera" (docs/formats.md §3)
-  std::string aperture;        // as the camera's widget spells it ("8", "f/8"); "" leaves it
-  std::string iso;             // "100"; "" leaves it
-  std::string image_format;    // "RAW", "Large Fine JPEG", ...; "" leaves it
+struct CameraSettings {           // setup.json "lab.camera" (docs/formats.md §3)
+  std::string aperture;           // as the camera's widget spells it ("8", "f/8"); "" leaves it
+  std::string iso;                // "100"; "" leaves it
+  std::string image_format;       // "RAW", "Large Fine JPEG", ...; "" leaves it
   bool delete_from_card = false;  // delete each photo from the camera's card once downloaded
   double capture_timeout_s = 60;  // from the trigger to the photo on disk (longest exposure +)
   double connect_timeout_s = 10;  // finding and opening the camera

@@ -19,10 +19,6 @@ constexpr double kPollInterval_s = 0.1;  // status polls during a move (GRBL adv
 constexpr double kHoldWait_s = 0.3;      // feed hold to its completion, before the soft reset
 constexpr double kResetWait_s = 0.5;     // soft reset to the welcome message, while halting
 
-double SecondsLeft(Clock::time_point end) {
-  return std::chrono::duration<double>(end - Clock::now()).count();
-}
-
 Clock::time_point After(double seconds) {
   return Clock::now() +
          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));

@@ -51,10 +51,6 @@ bool BaudConstant(int baud, speed_t* speed) {
   }
 }
 
-double SecondsLeft(Clock::time_point end) {
-  return std::chrono::duration<double>(end - Clock::now()).count();
-}
-
 }  // namespace
 
 SerialPort::SerialPort(const std::string& uri, const std::string& path, int baud)

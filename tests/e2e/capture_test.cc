@@ -11,8 +11,10 @@
 #include <stdlib.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
@@ -147,6 +149,38 @@ TEST_F(Capture, VirtualLabGivesTheSlabErrorOfTheSyntheticCapture) {
   // tenth of it), and the same slab.
   EXPECT_LE(cap_truth.max_relative_l2, synth_truth.max_relative_l2 * 1.1 + 1e-4);
   EXPECT_LE(cap_synth.max_relative_l2, 2e-3);
+}
+
+// A bracket given by the setup whose shortest photo clips: each shot's shortest photo is taken
+// again 2 stops shorter until it does not, and the merge gives the slab of the synthetic capture.
+TEST_F(Capture, AClippingShortestPhotoIsTakenAgainShorter) {
+  StartLab(LabJson(R"("slides": {"axis": "Z", "p_mm": 10, "n_mm": 60},)",
+                   R"({"shutter_s": [1.6, 6], "bracket_stops": 2})"));
+  const auto r = Run("lumislab-acquire", CaptureArgs("cap"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.output, m, std::regex("([0-9]+) taken again shorter")))
+      << r.output;
+  const int reshots = std::stoi(m[1]);
+  EXPECT_GE(reshots, 1);
+  const Dataset cap = Dataset::Load(root_ + "/cap");
+  ASSERT_EQ(cap.photos.size(), 36u);
+  // Exposure t ISO / N^2 from EXIF at f/8, ISO 100: the photos taken again at 0.4 s, the other
+  // shortest ones at 1.6 s (T- is dimmer than T+: not every slide clips), the longest at 6 s.
+  std::map<int, int> by_exposure;  // exposure x 1000 -> photos
+  for (const PhotoEntry& e : cap.photos) ++by_exposure[int(std::lround(e.exposure * 1000))];
+  EXPECT_EQ(by_exposure[625], reshots);
+  EXPECT_EQ(by_exposure[2500], 18 - reshots);
+  EXPECT_EQ(by_exposure[9375], 18);
+  Ok("lumislab-acquire", "synth --scene scene.json --out synth --truth-resolution 40");
+  for (const std::string ds : {"cap", "synth"}) {
+    Ok("lumislab-calibrate", "screen --dataset " + ds);
+    Ok("lumislab-reconstruct", "--dataset " + ds + " --resolution 40");
+  }
+  const SlabComparison c = CompareSlabs(root_ + "/cap/slab", root_ + "/synth/slab", 0.05);
+  std::printf("re-shot bracket vs synth: %s\n", c.Summary().c_str());
+  EXPECT_EQ(c.positions.size(), 9u);
+  EXPECT_LE(c.max_relative_l2, 2e-3);
 }
 
 // Without a slide axis the operator changes the slides: one pass per slide, serpentine rows,

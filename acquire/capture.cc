@@ -1,12 +1,15 @@
 #include "acquire/capture.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -39,8 +42,11 @@ constexpr double kClippedFraction = 1e-5;
 // The test shot puts the brightest light of the shortest bracket here (x saturation level):
 // room for the light to be brighter at another position than at the grid's centre.
 constexpr double kTargetPeak = 0.6;
-// Test shots before giving up on finding an exposure.
+// Test shots before giving up on finding an exposure; re-shots of one clipping photo; the
+// shortest exposure time tried (a camera whose times lumislab cannot set has no list to end).
 constexpr int kMaxTestShots = 12;
+constexpr int kMaxReshoots = 8;
+constexpr double kShortestExposureS = 1e-6;
 
 const char* Slide(bool positive) { return positive ? "p" : "n"; }
 
@@ -70,9 +76,11 @@ double Distance(const AxisTargets& a, const AxisTargets& b) {
 using ShotKey = std::tuple<int, int, bool>;
 
 // capture/shots.csv: what is finished. A shot's photos and its `done` line are appended in one
-// write and synced once the last photo of the shot is checked, so that after a kill the journal
-// holds whole shots only (a line cut short by a crash mid-write is ignored, and its shot taken
-// again).
+// write and synced once every photo of the shot is checked, so that after a kill the journal
+// holds whole shots only. A write cut short (a crash, a full disk) is cut off again: by Append
+// when it sees the short write, by Load when it finds a last line without its newline; photo
+// lines without their `done` (an earlier attempt at the shot) are dropped when the shot's
+// bracket starts again.
 //   photo,<i>,<j>,<p|n>,<bracket>,<exposure time s>,<file>
 //   done,<i>,<j>,<p|n>
 //   board,<exposure time s>,<file>
@@ -87,6 +95,7 @@ class ShotJournal {
   explicit ShotJournal(std::string path) : path_(std::move(path)) {}
 
   void Load() {
+    CutToLastLine();
     std::ifstream in(path_);
     if (!in) return;
     std::map<ShotKey, std::vector<JournalPhoto>> pending;
@@ -94,7 +103,6 @@ class ShotJournal {
     int number = 0;
     while (std::getline(in, line)) {
       ++number;
-      if (in.eof()) break;  // no newline: cut short by a crash, ignored
       std::vector<std::string> f;
       std::stringstream ss(line);
       std::string field;
@@ -106,8 +114,10 @@ class ShotJournal {
       };
       try {
         if (f.size() == 7 && f[0] == "photo" && (f[3] == "p" || f[3] == "n")) {
-          pending[{std::stoi(f[1]), std::stoi(f[2]), f[3] == "p"}].push_back(
-              {std::stoi(f[4]), std::stod(f[5]), f[6]});
+          const ShotKey key{std::stoi(f[1]), std::stoi(f[2]), f[3] == "p"};
+          const int bracket = std::stoi(f[4]);
+          if (bracket == 0) pending[key].clear();
+          pending[key].push_back({bracket, std::stod(f[5]), f[6]});
         } else if (f.size() == 4 && f[0] == "done" && (f[3] == "p" || f[3] == "n")) {
           const ShotKey key{std::stoi(f[1]), std::stoi(f[2]), f[3] == "p"};
           done_[key] = pending[key];
@@ -145,11 +155,27 @@ class ShotJournal {
   void Append(const std::string& text) {
     const int fd = open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
     if (fd < 0) throw IoError(path_, "cannot open the capture journal");
+    const off_t before = lseek(fd, 0, SEEK_END);
     const ssize_t n = write(fd, text.data(), text.size());
     const bool synced = fsync(fd) == 0;
+    if (n != ssize_t(text.size()) || !synced) {
+      const int error = n < 0 ? errno : ENOSPC;
+      if (before >= 0 && ftruncate(fd, before) == 0) fsync(fd);
+      close(fd);
+      throw IoError(path_,
+                    std::string("cannot write the capture journal: ") + std::strerror(error));
+    }
     close(fd);
-    if (n != ssize_t(text.size()) || !synced)
-      throw IoError(path_, "cannot write the capture journal (disk full?)");
+  }
+  // Cuts a last line without its newline (a write a crash cut short) off the file.
+  void CutToLastLine() {
+    std::error_code ec;
+    if (!fs::exists(path_, ec)) return;
+    const std::string text = ReadTextFile(path_);
+    const size_t keep = text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1;
+    if (keep == text.size()) return;
+    fs::resize_file(path_, keep, ec);
+    if (ec) throw IoError(path_, "cannot cut off the journal's unfinished line: " + ec.message());
   }
 
   std::string path_;
@@ -198,21 +224,37 @@ class Capture {
     import_.setup_file = o.setup_file;
     import_.out_dir = o.out_dir;
   }
+  ~Capture() {
+    if (lock_fd_ >= 0) close(lock_fd_);
+  }
+  Capture(const Capture&) = delete;
+  Capture& operator=(const Capture&) = delete;
 
   CaptureReport Run(Stage* stage, Camera* camera) {
     stage_ = stage;
     camera_ = camera;
-    PrepareFolder();
-    log_ = std::make_unique<DeviceLog>(capture_dir_ + "/devices.log");
+    log_ = std::make_unique<DeviceLog>();  // kept in memory until the folder exists
     operator_ = std::make_unique<Operator>(log_.get(), o_.operator_program);
     log_->Note("capture", "started: stage " + stage->uri() + ", camera " + camera->uri());
+    // The devices first: one that cannot be used is refused before the folder is made.
+    try {
+      Connect();
+      PrepareFolder();
+      log_->Open(capture_dir_ + "/devices.log");
+    } catch (...) {
+      Close();
+      throw;
+    }
     CaptureReport report;
     report.shots_resumed = int(journal_.done().size());
     if (report.shots_resumed)
       LogInfo("going on after ", report.shots_resumed, " finished shots of ", plan_.shots.size(),
               " (", capture_dir_, "/shots.csv)");
     try {
-      Connect();
+      if (lab_.stage.home) {
+        LogInfo("homing the stage");
+        stage_->Home();
+      }
       ShootBoard();
       ChooseExposure();
       WriteDataset();
@@ -241,7 +283,9 @@ class Capture {
                       " complete positions"
                 : "no position is complete yet";
       throw Error(e.code(),
-                  std::string(e.what()) + " (" + held + "; the same command goes on from there)");
+                  std::string(e.what()) + " (" + held + "; " +
+                      (o_.force ? "the same command without --force" : "the same command") +
+                      " goes on from there)");
     } catch (...) {
       Close();
       throw;
@@ -258,10 +302,20 @@ class Capture {
   void PrepareFolder() {
     MakeDirectories(photos_dir_);
     MakeDirectories(capture_dir_ + "/test");
+    // One capture at a time into a folder: a second one would take the first one's photos for
+    // an unfinished shot's and remove them. The lock goes with the process, however it ends.
+    const std::string lock = capture_dir_ + "/lock";
+    lock_fd_ = open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (lock_fd_ < 0) throw IoError(lock, std::string("cannot open: ") + std::strerror(errno));
+    if (flock(lock_fd_, LOCK_EX | LOCK_NB) != 0)
+      throw BadInput(o_.out_dir + ": another lumislab-acquire capture is writing this folder (" +
+                     lock + ")");
     const std::string setup_text = ReadTextFile(o_.setup_file);
     const std::string kept = capture_dir_ + "/setup.json";
     if (o_.force) {
+      // dataset.json first: it must never name photos that are gone.
       std::error_code ec;
+      fs::remove(o_.out_dir + "/dataset.json", ec);
       fs::remove(capture_dir_ + "/shots.csv", ec);
       fs::remove(capture_dir_ + "/exposure.json", ec);
     } else if (fs::exists(kept) && ReadTextFile(kept) != setup_text) {
@@ -291,19 +345,38 @@ class Capture {
     camera_->Connect(lab_.camera, log_.get());
     LogInfo("connecting to the stage ", stage_->uri());
     stage_->Connect(lab_.stage, log_.get());
-    // Exposure times the setup gives must be the camera's: refused before anything moves.
+    // The exposure settings, refused before anything moves: times the setup gives must be the
+    // camera's; a camera whose times lumislab cannot set needs them given; a bracket must fit
+    // the camera's range even from its shortest time.
     const std::vector<double> speeds = camera_->ShutterSpeeds();
-    for (double t : lab_.shutter_s) {
+    std::vector<std::pair<std::string, double>> given;
+    for (size_t k = 0; k < lab_.shutter_s.size(); ++k)
+      given.emplace_back("lab.camera.shutter_s[" + std::to_string(k) + "]", lab_.shutter_s[k]);
+    if (lab_.board_shutter_s > 0)
+      given.emplace_back("lab.camera.board_shutter_s", lab_.board_shutter_s);
+    for (const auto& [field, t] : given) {
       const double s = SnapSpeed(speeds, t, false);
       if (std::abs(s / t - 1) > 0.01)
-        throw InputError(o_.setup_file, "lab.camera.shutter_s",
-                         "exposure times " + camera_->uri() + " offers (nearest " + Fmt(s) + " s)",
-                         Fmt(t) + " s");
+        throw InputError(
+            o_.setup_file, field,
+            "an exposure time " + camera_->uri() + " offers (nearest " + Fmt(s) + " s)",
+            Fmt(t) + " s");
     }
-    if (lab_.stage.home) {
-      LogInfo("homing the stage");
-      stage_->Home();
-    }
+    if (speeds.empty() && (lab_.shutter_s.empty() || lab_.board_shutter_s <= 0))
+      throw InputError(
+          o_.setup_file,
+          lab_.shutter_s.empty() ? "lab.camera.shutter_s" : "lab.camera.board_shutter_s",
+          "the exposure times: " + camera_->uri() +
+              " cannot be set by lumislab, so no test shot can choose them",
+          "none");
+    if (!speeds.empty() && lab_.shutter_s.empty() &&
+        speeds.front() * std::pow(2.0, lab_.bracket_stops * (lab_.brackets - 1)) >
+            speeds.back() * 1.01)
+      throw InputError(
+          o_.setup_file, "lab.camera.brackets",
+          "a bracket that fits " + camera_->uri() + "'s exposure times (" + Fmt(speeds.front()) +
+              " to " + Fmt(speeds.back()) + " s)",
+          std::to_string(lab_.brackets) + " exposures " + Fmt(lab_.bracket_stops) + " stops apart");
   }
 
   void Close() {
@@ -353,10 +426,12 @@ class Capture {
     if (t <= 0) t = TestExposure("board", /*slide_photo=*/false);
     LogInfo("board photo at ", Fmt(t), " s");
     const std::string file = TakePhoto("board", t);
-    DecodePhoto(photos_dir_ + "/" + file);  // whole: BadInput naming it otherwise
-    journal_.FinishBoard({0, t, file});
+    CheckPhoto(file);
+    // Journaled once the board is off the screen: a capture stopped before that asks again
+    // for the whole board step, not for slide photos with the board in them.
     operator_->Ask("board", "off", "Take the calibration board off the screen",
                    "removing the board");
+    journal_.FinishBoard({0, t, file});
   }
 
   // Test shots until the brightest light sits near kTargetPeak: returns the exposure time.
@@ -429,11 +504,11 @@ class Capture {
       for (int k = 1; k < lab_.brackets; ++k) {
         const double next = SnapSpeed(speeds, t * std::pow(2.0, lab_.bracket_stops), false);
         if (next <= t * 1.01)
-          throw InputError(
-              o_.setup_file, "lab.camera.brackets",
-              "a bracket the camera's exposure times hold (longest " + Fmt(speeds.back()) + " s)",
-              std::to_string(lab_.brackets) + " exposures " + Fmt(lab_.bracket_stops) +
-                  " stops apart from " + Fmt(shortest) + " s");
+          throw DeviceError(camera_->uri(), "choosing the bracket (lab.camera.brackets)",
+                            std::to_string(lab_.brackets) + " exposures " +
+                                Fmt(lab_.bracket_stops) + " stops apart from " + Fmt(shortest) +
+                                " s go beyond the longest exposure time, " + Fmt(speeds.back()) +
+                                " s: fewer brackets or fewer stops");
         brackets_.push_back(next);
         t = next;
       }
@@ -467,18 +542,17 @@ class Capture {
       std::snprintf(stem, sizeof stem, "pos_%d_%d_%s_%d", shot.i, shot.j, Slide(shot.positive), k);
       double t = brackets_[k];
       std::string file = TakePhoto(stem, t);
-      const std::string path = photos_dir_ + "/" + file;
-      Photo decoded = DecodePhoto(path);  // whole: BadInput naming it otherwise
-      CheckSize(path, decoded.pixels.cols, decoded.pixels.rows);
+      CheckPhoto(file);
       // The shortest photo must hold the brightest light: taken again shorter while it clips.
-      while (k == 0) {
+      for (int again = 0; k == 0; ++again) {
+        const std::string path = photos_dir_ + "/" + file;
         const PhotoLevels levels = MeasurePhotoLevels(setup_, path);
         if (levels.clipped <= kClippedFraction) break;
         const double shorter = ShorterSpeed(speeds, t, std::pow(2.0, lab_.bracket_stops));
-        if (shorter >= t * 0.99) {
-          LogWarning(path, ": ", Fmt(levels.clipped * 100),
-                     " % of the pixels clip at the shortest exposure time ", Fmt(t),
-                     " s; the brightest light of this position is lost");
+        if (shorter >= t * 0.99 || shorter < kShortestExposureS || again == kMaxReshoots) {
+          LogWarning(path, ": ", Fmt(levels.clipped * 100), " % of the pixels clip at ", Fmt(t),
+                     " s, and no shorter time is left to try; the brightest light of this "
+                     "position is lost");
           break;
         }
         LogWarning(path, ": ", Fmt(levels.clipped * 100), " % of the pixels clip at ", Fmt(t),
@@ -487,21 +561,44 @@ class Capture {
         ++report->reshots;
         fs::remove(path);
         file = TakePhoto(stem, t);
+        CheckPhoto(file);
       }
       photos.push_back({k, t, file});
     }
+    // Into the photo list before the journal: a photo the list refuses (another camera, no
+    // exposure, a slide's exposure twice) is taken again by the next run, not kept for ever.
+    try {
+      for (const auto& p : photos) AddToList(shot, p);
+    } catch (const Error& e) {
+      for (const auto& p : photos) fs::remove(photos_dir_ + "/" + p.file);
+      throw DeviceError(camera_->uri(),
+                        "checking the photos of (" + std::to_string(shot.i) + ", " +
+                            std::to_string(shot.j) + ") slide " + Slide(shot.positive),
+                        e.what());
+    }
     journal_.FinishShot(shot, photos);
-    for (const auto& p : photos) AddToList(shot, p);
     if (list_->Complete(shot.i, shot.j, int(brackets_.size()))) WriteDataset();
   }
 
-  void CheckSize(const std::string& path, int width, int height) {
-    if (!size_) size_ = std::make_pair(width, height);
-    if (size_->first != width || size_->second != height)
-      throw DeviceError(camera_->uri(), "checking " + path,
-                        "a photo of " + std::to_string(width) + " x " + std::to_string(height) +
-                            " px where the capture's are " + std::to_string(size_->first) + " x " +
-                            std::to_string(size_->second) + " (the camera's image size changed)");
+  // A photo just downloaded decodes whole and has the capture's image size (the board photo's:
+  // the same camera); a DeviceError naming it otherwise (the camera sent a broken file).
+  void CheckPhoto(const std::string& file) {
+    const std::string path = photos_dir_ + "/" + file;
+    try {
+      const Photo photo = DecodePhoto(path);
+      if (!size_ && journal_.board() && journal_.board()->file != file) {
+        const Photo board = DecodePhoto(photos_dir_ + "/" + journal_.board()->file);
+        size_ = std::make_pair(board.pixels.cols, board.pixels.rows);
+      }
+      if (!size_) size_ = std::make_pair(photo.pixels.cols, photo.pixels.rows);
+      if (size_->first != photo.pixels.cols || size_->second != photo.pixels.rows)
+        throw Failure("a photo of " + std::to_string(photo.pixels.cols) + " x " +
+                      std::to_string(photo.pixels.rows) + " px where the capture's are " +
+                      std::to_string(size_->first) + " x " + std::to_string(size_->second) +
+                      " (the camera's image size changed)");
+    } catch (const Error& e) {
+      throw DeviceError(camera_->uri(), "checking " + path, e.what());
+    }
   }
 
   void AddToList(const CaptureShot& shot, const ShotJournal::JournalPhoto& p) {
@@ -544,7 +641,8 @@ class Capture {
   std::optional<bool> slide_;
   std::vector<double> brackets_;
   bool exposure_from_exif_ = false;
-  std::optional<std::pair<int, int>> size_;
+  std::optional<std::pair<int, int>> size_;  // the capture's image size (px)
+  int lock_fd_ = -1;                         // capture/lock, held while the capture runs
   Dataset ds_;
   std::unique_ptr<CaptureList> list_;
 };

@@ -56,6 +56,7 @@ LAB = {
 }
 
 MOVE_S, EXPOSURE_S = 2.0, 0.5  # lumislab-plan's lab model defaults
+SOURCE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def wait_for(path, proc, timeout):
@@ -99,10 +100,14 @@ def run_format(bin_dir, root, fmt, n):
             sys.exit("capture_latency: the virtual lab did not start; see " + work + "/lab.log")
         camera = open(os.path.join(work, "lab", "camera")).read().strip()
         start = time.time()
+        # The virtual lab's operator puts the board and the slides in (its control files).
+        env["LUMISLAB_LAB_CONTROL"] = os.path.join(work, "lab", "control")
         capture = subprocess.Popen(
             [os.path.join(bin_dir, "lumislab-acquire"), "capture", "--setup", "lab/setup.json",
-             "--stage", "grbl:lab/grbl", "--camera", "gphoto2@" + camera, "--out", "cap"],
-            cwd=work, stdout=logs["capture"], stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+             "--stage", "grbl:lab/grbl", "--camera", "gphoto2@" + camera, "--out", "cap",
+             "--operator", os.path.join(SOURCE_DIR, "tests", "acquire", "lab_operator.sh")],
+            cwd=work, stdout=logs["capture"], stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+            env=env)
         procs.append(capture)
         dataset = os.path.join(work, "cap", "dataset.json")
         if not wait_for(dataset, capture, 3600):
@@ -155,8 +160,8 @@ def main():
     args = ap.parse_args()
     bin_dir = os.path.abspath(os.path.join(args.build, "bin"))
     root = os.path.abspath(args.keep) if args.keep else tempfile.mkdtemp(prefix="capture_latency_")
-    if args.keep and os.path.exists(root):
-        shutil.rmtree(root)
+    if args.keep and os.path.exists(root) and os.listdir(root):
+        sys.exit("capture_latency: --keep %s: not an empty folder" % root)
     os.makedirs(root, exist_ok=True)
     model = MOVE_S + 2 * 3 * EXPOSURE_S
     rows = []

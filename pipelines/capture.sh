@@ -33,13 +33,19 @@ for tool in acquire calibrate reconstruct preview; do
   [[ -x "$bin/lumislab-$tool" ]] || { echo "capture.sh: $bin/lumislab-$tool is not built" >&2; exit 1; }
 done
 
-# The capture talks to the operator on this terminal: it keeps stdin.
+# --force captures again: the screen calibration and the slab are made again too.
+force=()
+for arg in "$@"; do [[ "$arg" == --force ]] && force=(--force); done
+
+# The capture talks to the operator on this terminal: it keeps stdin (a background job of a
+# script would otherwise read /dev/null).
 "$bin/lumislab-acquire" capture --setup "$setup" --stage "$stage" --camera "$camera" \
-  --out "$out" "$@" &
+  --out "$out" "$@" <&0 &
 pids+=($!)
 capture_pid=$!
 
-# dataset.json is first written once the board photo is taken: calibrate the screen then.
+# dataset.json is first written once the board photo is taken and the bracket chosen: calibrate
+# the screen then.
 for _ in $(seq 36000); do
   [[ -f "$out/dataset.json" ]] && break
   kill -0 "$capture_pid" 2>/dev/null || break
@@ -49,11 +55,11 @@ if [[ ! -f "$out/dataset.json" ]]; then
   wait "$capture_pid"  # its exit code and message tell why
   exit 1
 fi
-if [[ ! -f "$out/calib/screen.json" ]]; then
-  "$bin/lumislab-calibrate" screen --dataset "$out"
+if [[ ! -f "$out/calib/screen.json" || ${#force[@]} -gt 0 ]]; then
+  "$bin/lumislab-calibrate" screen --dataset "$out" "${force[@]}"
 fi
 
-"$bin/lumislab-reconstruct" --dataset "$out" --watch &
+"$bin/lumislab-reconstruct" --dataset "$out" --watch "${force[@]}" &
 pids+=($!)
 reconstruct_pid=$!
 

@@ -7,11 +7,17 @@
 
 namespace lumislab {
 
-DeviceLog::DeviceLog(const std::string& path) : path_(path) {
-  if (path_.empty()) return;
-  file_ = std::fopen(path_.c_str(), "a");
-  if (!file_)
-    throw IoError(path_, std::string("cannot open the device log: ") + std::strerror(errno));
+void DeviceLog::Open(const std::string& path) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::FILE* file = std::fopen(path.c_str(), "a");
+  if (!file)
+    throw IoError(path, std::string("cannot open the device log: ") + std::strerror(errno));
+  if (file_) std::fclose(file_);
+  file_ = file;
+  path_ = path;
+  for (const std::string& line : kept_) std::fputs(line.c_str(), file_);
+  kept_.clear();
+  std::fflush(file_);
 }
 
 DeviceLog::~DeviceLog() {
@@ -19,7 +25,6 @@ DeviceLog::~DeviceLog() {
 }
 
 void DeviceLog::Write(const std::string& device, char direction, const std::string& text) {
-  if (!file_) return;
   const auto now = std::chrono::system_clock::now();
   const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
   const int ms = static_cast<int>(
@@ -40,8 +45,15 @@ void DeviceLog::Write(const std::string& device, char direction, const std::stri
       shown += static_cast<char>(c);
     }
   }
+  char head[64];
+  std::snprintf(head, sizeof head, "%s.%03dZ ", stamp, ms);
+  const std::string line = head + device + " " + direction + " " + shown + "\n";
   std::lock_guard<std::mutex> lock(mutex_);
-  std::fprintf(file_, "%s.%03dZ %s %c %s\n", stamp, ms, device.c_str(), direction, shown.c_str());
+  if (!file_) {
+    kept_.push_back(line);
+    return;
+  }
+  std::fputs(line.c_str(), file_);
   std::fflush(file_);
 }
 

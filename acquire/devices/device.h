@@ -26,12 +26,17 @@ namespace lumislab {
 //   2026-12-04T21:40:01.123Z grbl:/dev/ttyUSB0 > G1 X10.000 Y20.000 F1000
 //   2026-12-04T21:40:01.131Z grbl:/dev/ttyUSB0 < ok
 // '>' sent, '<' received, '#' a note (what the capture is doing, a timeout, a retry).
-// Thread-safe. A log with an empty path writes nothing (tests, --dry-run).
+// Thread-safe. A log without a path keeps its lines until Open gives it one (the capture opens
+// its devices before it makes the dataset folder, so that a device it cannot use leaves nothing
+// behind); one never opened writes nothing (tests).
 class DeviceLog {
  public:
   DeviceLog() = default;
-  explicit DeviceLog(const std::string& path);  // IoError naming it when it cannot be opened
+  explicit DeviceLog(const std::string& path) { Open(path); }
   ~DeviceLog();
+  // Appends to `path` from now on, the lines kept so far first; IoError naming it when it
+  // cannot be opened.
+  void Open(const std::string& path);
   DeviceLog(const DeviceLog&) = delete;
   DeviceLog& operator=(const DeviceLog&) = delete;
 
@@ -44,6 +49,7 @@ class DeviceLog {
  private:
   std::string path_;
   std::FILE* file_ = nullptr;
+  std::vector<std::string> kept_;  // lines written before Open
   std::mutex mutex_;
 };
 

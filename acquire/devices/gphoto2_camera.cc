@@ -8,10 +8,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -502,19 +504,47 @@ std::pair<std::string, std::string> Gphoto2Camera::WaitForNewFile() {
 
 void Gphoto2Camera::Download(const std::string& folder, const std::string& name,
                              const std::string& path) {
-  WriteAtomically(path, [&](const std::string& tmp_path) {
-    const int fd = ::open(tmp_path.c_str(), O_CREAT | O_WRONLY | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) throw IoError(tmp_path, "cannot create the photo's temporary file");
-    CameraFile* file = nullptr;
-    gp_file_new_from_fd(&file, fd);  // owns fd from here: gp_file_free closes it
-    const int result = Run("gp_camera_file_get " + folder + "/" + name, [&] {
-      return gp_camera_file_get(camera_, folder.c_str(), name.c_str(), GP_FILE_TYPE_NORMAL, file,
-                                context_);
-    });
+  // Into memory first, then written by us: a write that fails (a full disk) is then an IoError
+  // naming the file and the system's reason, not one of libgphoto2's generic errors.
+  CameraFile* file = nullptr;
+  gp_file_new(&file);
+  const int result = Run("gp_camera_file_get " + folder + "/" + name, [&] {
+    return gp_camera_file_get(camera_, folder.c_str(), name.c_str(), GP_FILE_TYPE_NORMAL, file,
+                              context_);
+  });
+  if (StopRequested() || result < GP_OK) {
     gp_file_free(file);
     if (StopRequested()) throw DeviceStopped(uri(), "downloading " + name);
-    if (result < GP_OK) throw DeviceError(uri(), "downloading " + name, Describe(result));
-  });
+    throw DeviceError(uri(), "downloading " + name, Describe(result));
+  }
+  const char* data = nullptr;
+  unsigned long size = 0;
+  gp_file_get_data_and_size(file, &data, &size);
+  try {
+    WriteAtomically(path, [&](const std::string& tmp_path) {
+      const int fd = ::open(tmp_path.c_str(), O_CREAT | O_WRONLY | O_TRUNC | O_CLOEXEC, 0644);
+      if (fd < 0)
+        throw IoError(tmp_path, std::string("cannot create the photo: ") + std::strerror(errno));
+      size_t done = 0;
+      while (done < size) {
+        const ssize_t n = ::write(fd, data + done, size - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+          const std::string reason = std::strerror(n < 0 ? errno : ENOSPC);
+          ::close(fd);
+          throw IoError(path, "cannot write the downloaded photo: " + reason);
+        }
+        done += size_t(n);
+      }
+      if (::close(fd) != 0)
+        throw IoError(path,
+                      std::string("cannot write the downloaded photo: ") + std::strerror(errno));
+    });
+  } catch (...) {
+    gp_file_free(file);
+    throw;
+  }
+  gp_file_free(file);
 }
 
 // The exposure the camera used, from the photo's EXIF, against the one set: a camera that did

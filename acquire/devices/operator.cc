@@ -1,6 +1,7 @@
 #include "acquire/devices/operator.h"
 
 #include <poll.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -22,6 +23,8 @@ void Operator::Ask(const std::string& action, const std::string& argument,
   }
   const std::string device = "operator";
   if (log_) log_->Sent(device, request);
+  // What was typed before the question is not its answer (an Enter pressed twice).
+  if (isatty(0)) tcflush(0, TCIFLUSH);
   std::fprintf(stderr, "\n>>> %s, then press Enter (Ctrl-C stops the capture)\n", request.c_str());
   std::fflush(stderr);
   std::string line;

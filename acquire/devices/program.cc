@@ -17,14 +17,18 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Ends the child: SIGTERM, then SIGKILL when it is still there a second later; reaps it.
+// Ends the child and whatever it started (its process group): SIGTERM, then SIGKILL when it is
+// still there a second later; reaps it.
 void EndChild(pid_t pid) {
-  kill(pid, SIGTERM);
+  kill(-pid, SIGTERM);
   for (int k = 0; k < 20; ++k) {
-    if (waitpid(pid, nullptr, WNOHANG) == pid) return;
+    if (waitpid(pid, nullptr, WNOHANG) == pid) {
+      kill(-pid, SIGKILL);  // what it started and left behind
+      return;
+    }
     usleep(50000);
   }
-  kill(pid, SIGKILL);
+  kill(-pid, SIGKILL);
   waitpid(pid, nullptr, 0);
 }
 
@@ -50,6 +54,7 @@ std::string RunDeviceProgram(const std::string& device, const std::string& doing
     throw DeviceError(device, doing, std::string("cannot start ") + program);
   }
   if (pid == 0) {
+    setpgid(0, 0);  // its own process group: a timeout or a stop ends what it started too
     const int null_fd = open("/dev/null", O_RDONLY);
     if (null_fd >= 0) dup2(null_fd, 0);
     dup2(pipe_fd[1], 1);
@@ -113,8 +118,12 @@ std::string RunDeviceProgram(const std::string& device, const std::string& doing
           program + " did not finish within " + std::to_string(int(timeout_s)) + " s (killed)");
     }
   }
-  // The rest of what it wrote before it exited.
-  for (;;) {
+  // The rest of what it wrote before it exited, for at most a second: a process it left running
+  // may hold the pipe open for ever.
+  const auto drain_end = Clock::now() + std::chrono::seconds(1);
+  while (open_pipe && Clock::now() < drain_end) {
+    pollfd p{pipe_fd[0], POLLIN, 0};
+    if (poll(&p, 1, 50) <= 0) continue;
     char buffer[4096];
     const ssize_t n = read(pipe_fd[0], buffer, sizeof buffer);
     if (n <= 0) break;

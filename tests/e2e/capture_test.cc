@@ -183,6 +183,27 @@ TEST_F(Capture, AClippingShortestPhotoIsTakenAgainShorter) {
   EXPECT_LE(c.max_relative_l2, 2e-3);
 }
 
+// pipelines/capture.sh: the capture, the screen calibration as soon as the board photo is in,
+// reconstruct --watch and a headless preview --watch, together, to the complete slab and a
+// picture of the scene lit by it.
+TEST_F(Capture, PipelineCapturesReconstructsAndPreviewsTogether) {
+  StartLab();
+  const auto r = testing::RunShell(
+      "cd " + testing::ShellQuote(root_) + " && env -u DISPLAY LUMISLAB_BIN=" +
+      testing::ShellQuote(LUMISLAB_BIN_DIR) + " timeout -k 5 300 bash " +
+      testing::ShellQuote(std::string(LUMISLAB_SOURCE_DIR) + "/pipelines/capture.sh") +
+      " lab/setup.json grbl:lab/grbl " + testing::ShellQuote(camera_) + " cap --operator " +
+      testing::ShellQuote(kLabOperator) + " 2>&1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("capture and reconstruction complete"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(root_ + "/cap/calib/screen.json"));
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      EXPECT_TRUE(fs::exists(root_ + "/cap/slab/pos_" + std::to_string(i) + "_" +
+                             std::to_string(j) + ".exr"));
+  EXPECT_GT(fs::file_size(root_ + "/cap/renders/live.png"), 1000u);
+}
+
 // Without a slide axis the operator changes the slides: one pass per slide, serpentine rows,
 // the second pass backwards; dataset.json grows position by position during the second pass.
 TEST_F(Capture, OperatorSlidesOnePassPerSlideSerpentine) {
@@ -252,6 +273,12 @@ TEST_F(Capture, KilledAnywhereTheRerunFinishesTheSameSlab) {
     ++kills;
   }
   EXPECT_EQ(kills, 10);
+  // A journal line a crash cut short, as a kill during its write leaves it: cut off and taken
+  // again, not a reason to refuse the folder.
+  {
+    std::ofstream journal(root_ + "/killed/capture/shots.csv", std::ios::app);
+    journal << "photo,1,1,p,0,0.4,pos_1_";
+  }
   const auto r = Run("lumislab-acquire", CaptureArgs("killed"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Dataset killed = Dataset::Load(root_ + "/killed");
@@ -346,6 +373,29 @@ TEST_F(Capture, StageAlarmAndCameraGoneMidRunNameTheDevice) {
   StartLab(LabJson(), 20);
   Ok("lumislab-acquire", CaptureArgs("cap"));
   EXPECT_FALSE(Dataset::Load(root_ + "/cap").Partial());
+}
+
+// A full disk: exit 3 naming the file that could not be written, nothing half-written kept;
+// once there is room the same command finishes. The disk is a small tmpfs (mounting needs root,
+// which CI has; elsewhere the test says it is skipped).
+TEST_F(Capture, AFullDiskStopsTheCaptureAndTheRerunFinishesIt) {
+  const std::string disk = root_ + "/disk";
+  fs::create_directories(disk);
+  if (testing::RunShell("mount -t tmpfs -o size=1500k tmpfs " + disk + " 2>&1").exit_code != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs here (not root?)";
+  struct Unmount {
+    std::string dir;
+    ~Unmount() { testing::RunShell("umount " + dir + " 2>&1"); }
+  } unmount{disk};
+  StartLab();
+  const auto full = Run("lumislab-acquire", CaptureArgs("disk/cap"));
+  EXPECT_EQ(full.exit_code, 3) << full.output;
+  EXPECT_NE(full.output.find("disk/cap/"), std::string::npos) << full.output;
+  EXPECT_TRUE(testing::TemporaryPaths(testing::SnapshotTree(disk + "/cap/photos")).empty());
+  ASSERT_EQ(testing::RunShell("mount -o remount,size=20m " + disk + " 2>&1").exit_code, 0);
+  Ok("lumislab-acquire", CaptureArgs("disk/cap"));
+  EXPECT_FALSE(Dataset::Load(disk + "/cap").Partial());
+  EXPECT_EQ(Dataset::Load(disk + "/cap").photos.size(), 18u);
 }
 
 // Setups and devices that cannot work: exit 2 naming the device or the field, before anything

@@ -1611,8 +1611,8 @@ std::vector<Case> MoreCases() {
   v.push_back(C("cli_filter_out_missing").Filter("").Args("filter --k-max 1").Names({"--out"}));
   v.push_back(C("cli_acquire_unknown_subcommand")
                   .Synth()
-                  .Args("capture --scene scene.json --out out")
-                  .Names({"capture"}));
+                  .Args("shoot --scene scene.json --out out")
+                  .Names({"shoot"}));
   v.push_back(C("cli_calibrate_unknown_option").Calibrate("--bogus").Names({"--bogus"}));
   v.push_back(C("cli_calibrate_dataset_missing").Calibrate().Args("screen").Names({"--dataset"}));
   v.push_back(C("cli_reconstruct_unknown_option").Reconstruct("--bogus").Names({"--bogus"}));
@@ -2073,11 +2073,76 @@ std::vector<Case> PhotometryCases() {
   return v;
 }
 
+// lumislab-acquire capture: setups and devices it cannot work with, refused before any device
+// moves and before the dataset folder is made (docs/formats.md §3, "Capturing with lumislab").
+// The devices that need an emulator to answer (a silent stage, a camera not found, an exposure
+// time the camera lacks) are tested in tests/e2e/capture_test.cc.
+std::vector<Case> CaptureCases() {
+  std::vector<Case> v;
+  const std::string lab =
+      R"({"stage": {"origin_mm": [150, 150], "travel_mm": {"X": [0, 300], "Y": [0, 300]}},
+          "camera": {"brackets": 1, "shutter_s": [0.5], "board_shutter_s": 0.1}})";
+  auto K = [&](const std::string& name, const std::string& stage, const std::string& camera) {
+    return C("capture_" + name)
+        .Args("capture --setup ds/dataset.json --stage " + stage + " --camera " + camera +
+              " --out cap")
+        .From(Input::kDataset)
+        .Do(SetRaw(kDs, "/lab", lab))
+        .MustNotExist("cap");
+  };
+  auto tool = [](C c) {
+    Case k = c;
+    k.tool = "lumislab-acquire";
+    return k;
+  };
+  v.push_back(tool(C("capture_setup_without_lab")
+                       .Args("capture --setup ds/dataset.json --stage manual --camera folder:ds "
+                             "--out cap")
+                       .From(Input::kDataset)
+                       .MustNotExist("cap")
+                       .Names({kDs, "lab"})));
+  v.push_back(tool(K("unknown_stage_scheme", "usb:/dev/ttyUSB0", "folder:ds")
+                       .Names({"--stage", "usb:/dev/ttyUSB0"})));
+  v.push_back(
+      tool(K("unknown_camera_scheme", "manual", "webcam:0").Names({"--camera", "webcam:0"})));
+  v.push_back(
+      tool(K("bad_baud", "grbl:ds/ttyUSB0?baud=12", "folder:ds").Names({"--stage", "baud"})));
+  v.push_back(tool(K("stage_port_not_a_tty", "grbl:ds/dataset.json", "folder:ds")
+                       .Names({"grbl:ds/dataset.json", "tty"})));
+  v.push_back(tool(K("stage_port_missing", "grbl:ds/ttyUSB9", "folder:ds").Names({"ds/ttyUSB9"})));
+  v.push_back(tool(K("stage_program_missing", "command:ds/mover", "folder:ds")
+                       .Names({"command:ds/mover", "not an executable"})));
+  v.push_back(tool(K("camera_folder_missing", "manual", "folder:ds/tether")
+                       .Names({"folder:ds/tether", "not found"})));
+  v.push_back(tool(K("grid_beyond_soft_limits", "manual", "folder:ds")
+                       .Do(SetRaw(kDs, "/lab/stage/travel_mm/X", "[0, 151]"))
+                       .Names({kDs, "lab.stage.travel_mm.X"})));
+  v.push_back(tool(K("axis_without_travel", "manual", "folder:ds")
+                       .Do(SetRaw(kDs, "/lab/stage/travel_mm", R"({"X": [0, 300]})"))
+                       .Names({kDs, "lab.stage.travel_mm.Y"})));
+  v.push_back(tool(K("brackets_zero", "manual", "folder:ds")
+                       .Do(SetRaw(kDs, "/lab/camera/brackets", "0"))
+                       .Names({kDs, "lab.camera.brackets"})));
+  v.push_back(tool(K("slide_axis_is_a_grid_axis", "manual", "folder:ds")
+                       .Do(SetRaw(kDs, "/lab/slides", R"({"axis": "X", "p_mm": 0, "n_mm": 50})"))
+                       .Names({kDs, "lab.slides.axis"})));
+  // A camera whose exposure times lumislab cannot set, without the times given.
+  v.push_back(tool(K("folder_camera_without_times", "command:/bin/true", "folder:ds")
+                       .Do(SetRaw(kDs, "/lab/camera", R"({"brackets": 1})"))
+                       .Names({kDs, "lab.camera.shutter_s"})));
+  v.push_back(
+      tool(K("bad_order", "manual", "folder:ds")
+               .Args("capture --setup ds/dataset.json --stage manual --camera folder:ds --out "
+                     "cap --order random")
+               .Names({"--order", "random"})));
+  return v;
+}
+
 std::vector<Case> AllCases() {
   std::vector<Case> all;
   for (auto part :
        {DatasetCases(), ScreenCalibrationCases(), PhotoCases(), SceneCases(), CommandLineCases(),
-        SlabCases(), MoreCases(), RadiometricCases(), PhotometryCases()})
+        SlabCases(), MoreCases(), RadiometricCases(), PhotometryCases(), CaptureCases()})
     all.insert(all.end(), part.begin(), part.end());
   return all;
 }

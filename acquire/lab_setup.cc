@@ -42,7 +42,9 @@ void LabSetup::CheckTravel(const SamplingGrid& grid, const std::string& file) co
     targets.push_back(SlideTargets(false));
   }
   for (const AxisTargets& t : targets) {
-    for (const auto& [axis, mm] : t) {
+    for (const auto& target : t) {
+      const char axis = target.first;
+      const double mm = target.second;
       const auto it = std::find_if(travel.begin(), travel.end(),
                                    [&](const Travel& tr) { return tr.axis == axis; });
       const std::string field = std::string("lab.stage.travel_mm.") + axis;

@@ -9,8 +9,8 @@
 #include <set>
 
 #include "acquire/capture_list.h"
-#include "acquire/settle_tracker.h"
 #include "acquire/photo_naming.h"
+#include "acquire/settle_tracker.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/log.h"

@@ -574,7 +574,9 @@ std::string Gphoto2Camera::Capture(const std::string& path_stem) {
   const int result = Run("gp_camera_trigger_capture",
                          [&] { return gp_camera_trigger_capture(camera_, context_); });
   if (result < GP_OK) throw DeviceError(uri(), "capturing", Describe(result));
-  const auto [folder, name] = WaitForNewFile();
+  // Named copies, not structured bindings: clang 14 cannot capture those in a lambda.
+  const std::pair<std::string, std::string> file = WaitForNewFile();
+  const std::string folder = file.first, name = file.second;
   const size_t dot = name.rfind('.');
   const std::string extension = dot == std::string::npos ? "" : Lower(name.substr(dot + 1));
   if (extension.empty())

@@ -117,8 +117,7 @@ TEST(LabSetup, FieldsAreChecked) {
            "shutter_s": [0.1]}})",
        "lab.camera.shutter_s"},
   };
-  for (const auto& [json, field] : cases)
-    ExpectBadInput([&] { Lab(json); }, "setup.json: " + field);
+  for (const auto& c : cases) ExpectBadInput([&] { Lab(c.first); }, "setup.json: " + c.second);
 }
 
 TEST(CapturePlan, SlidePassIsSerpentineAndComesBackPositionAlternatesSlides) {

@@ -1,5 +1,6 @@
 #include "acquire/devices/gphoto2_camera.h"
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <gphoto2/gphoto2.h>
 #include <pthread.h>
@@ -330,6 +331,16 @@ void Gphoto2Camera::Connect(const CameraSettings& settings, DeviceLog* log) {
   gp_abilities_list_get_abilities(
       abilities_, gp_abilities_list_lookup_model(abilities_, model.c_str()), &abilities);
   gp_camera_set_abilities(camera_, abilities);
+#ifdef LUMISLAB_SANITIZED
+  // Under LeakSanitizer only: when gp_camera_init fails, libgphoto2 unloads the camera driver
+  // without its camera_exit, leaking what the driver allocated (a plain C program connecting to a
+  // closed PTP/IP port leaks the same). Kept loaded, its frames keep the module name that
+  // fuzz/sanitizers/lsan.supp matches.
+  // (The abilities name it without the extension libltdl adds.)
+  const std::string camlib = abilities.library;
+  if (!dlopen(camlib.c_str(), RTLD_NOW | RTLD_NODELETE))
+    dlopen((camlib + ".so").c_str(), RTLD_NOW | RTLD_NODELETE);
+#endif
   GPPortInfo info;
   gp_port_info_list_get_info(ports_, gp_port_info_list_lookup_path(ports_, port.c_str()), &info);
   gp_camera_set_port_info(camera_, info);

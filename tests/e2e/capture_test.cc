@@ -132,6 +132,16 @@ TEST_F(Capture, VirtualLabGivesTheSlabErrorOfTheSyntheticCapture) {
   EXPECT_NE(log.find("> G1 X"), std::string::npos);
   EXPECT_NE(log.find("<Idle|"), std::string::npos);
   EXPECT_NE(log.find("gphoto2@ptpip"), std::string::npos);
+  // The capture's folder is a camera folder `acquire import` reads to the same photos.
+  Ok("lumislab-acquire",
+     "import --photos cap/photos --setup lab/setup.json --out imported --pattern "
+     "'pos_{i}_{j}_{slide}_{bracket}.tif' --brackets 1");
+  const Dataset imported = Dataset::Load(root_ + "/imported");
+  ASSERT_EQ(imported.photos.size(), cap.photos.size());
+  for (size_t k = 0; k < cap.photos.size(); ++k) {
+    EXPECT_EQ(imported.photos[k].file, cap.photos[k].file);
+    EXPECT_DOUBLE_EQ(imported.photos[k].exposure, cap.photos[k].exposure);
+  }
 
   Ok("lumislab-acquire", "synth --scene scene.json --out synth --truth-resolution 40");
   for (const std::string ds : {"cap", "synth"}) {

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -25,6 +26,28 @@
 
 namespace lumislab {
 namespace {
+
+// Under the sanitizers only (the sanitizer build's tests): libgphoto2 loads every camera and port
+// driver to list them and unloads them again, and loads the camera's driver again to connect.
+// What those drivers and the libraries they pull in allocate and never free (libheif's
+// constructor through libgd; libusb's device list through usb1.so; ptp2.so's parameters when
+// gp_camera_init fails, which skips its camera_exit: each reproduced by a plain C program) then
+// has no module name for fuzz/sanitizers/lsan.supp to match, and LeakSanitizer's thread tracer
+// crashed on the dynamic TLS the unloaded libraries left behind. Loaded here once for good
+// (RTLD_NODELETE), libgphoto2's own loads find them resident and never unload them.
+void KeepDriversLoaded() {
+#if defined(LUMISLAB_SANITIZED) && defined(LUMISLAB_GPHOTO2_CAMLIBS)
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (const char* dir : {LUMISLAB_GPHOTO2_IOLIBS, LUMISLAB_GPHOTO2_CAMLIBS}) {
+      std::error_code ec;
+      for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+        if (entry.path().extension() == ".so")
+          dlopen(entry.path().c_str(), RTLD_LAZY | RTLD_LOCAL | RTLD_NODELETE);
+    }
+  });
+#endif
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -315,6 +338,7 @@ void Gphoto2Camera::Connect(const CameraSettings& settings, DeviceLog* log) {
   static std::once_flag log_func_added;
   std::call_once(log_func_added, [] { gp_log_add_func(GP_LOG_ERROR, OnLogLine, nullptr); });
 
+  KeepDriversLoaded();
   gp_abilities_list_new(&abilities_);
   gp_port_info_list_new(&ports_);
   if (Run("gp_abilities_list_load", [&] { return gp_abilities_list_load(abilities_, context_); }) <
@@ -331,16 +355,6 @@ void Gphoto2Camera::Connect(const CameraSettings& settings, DeviceLog* log) {
   gp_abilities_list_get_abilities(
       abilities_, gp_abilities_list_lookup_model(abilities_, model.c_str()), &abilities);
   gp_camera_set_abilities(camera_, abilities);
-#ifdef LUMISLAB_SANITIZED
-  // Under LeakSanitizer only: when gp_camera_init fails, libgphoto2 unloads the camera driver
-  // without its camera_exit, leaking what the driver allocated (a plain C program connecting to a
-  // closed PTP/IP port leaks the same). Kept loaded, its frames keep the module name that
-  // fuzz/sanitizers/lsan.supp matches.
-  // (The abilities name it without the extension libltdl adds.)
-  const std::string camlib = abilities.library;
-  if (!dlopen(camlib.c_str(), RTLD_NOW | RTLD_NODELETE))
-    dlopen((camlib + ".so").c_str(), RTLD_NOW | RTLD_NODELETE);
-#endif
   GPPortInfo info;
   gp_port_info_list_get_info(ports_, gp_port_info_list_lookup_path(ports_, port.c_str()), &info);
   gp_camera_set_port_info(camera_, info);

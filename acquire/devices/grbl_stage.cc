@@ -109,7 +109,10 @@ void GrblStage::LogStatus(const std::string& report) {
   throw DeviceStopped(uri(), doing);
 }
 
-std::string GrblStage::Reply(const std::string& sent, const std::string& doing, double timeout_s) {
+// `timeout_s` is what is left of the wait; `stated_s` the timeout the message names (the whole
+// wait's, not what was left of it when this reply was awaited).
+std::string GrblStage::Reply(const std::string& sent, const std::string& doing, double timeout_s,
+                             double stated_s) {
   const auto end = After(timeout_s);
   for (;;) {
     std::string line;
@@ -117,7 +120,7 @@ std::string GrblStage::Reply(const std::string& sent, const std::string& doing, 
       case SerialPort::Read::kStopped:
         Stopped(doing);
       case SerialPort::Read::kTimeout:
-        throw Fail(doing, "no reply to '" + sent + "' within " + Number(timeout_s) + " s");
+        throw Fail(doing, "no reply to '" + sent + "' within " + Number(stated_s) + " s");
       case SerialPort::Read::kLine:
         break;
     }
@@ -143,7 +146,7 @@ void GrblStage::Command(const std::string& line, const std::string& doing, doubl
   const auto end = After(timeout_s);
   for (;;) {
     // The timeout runs from the command, whatever else arrives meanwhile.
-    const std::string reply = Reply(line, doing, std::max(0.0, SecondsLeft(end)));
+    const std::string reply = Reply(line, doing, std::max(0.0, SecondsLeft(end)), timeout_s);
     if (reply == "ok") return;
     if (StartsWith(reply, "error:")) {
       throw Fail(doing, "'" + line + "' answered " + reply + " " + GrblErrorText(Code(reply)));
@@ -156,7 +159,8 @@ GrblStage::Status GrblStage::Query(const std::string& doing) {
   SendRealTime('?');
   const auto end = After(settings_.reply_timeout_s);
   for (;;) {
-    const std::string reply = Reply("?", doing, std::max(0.0, SecondsLeft(end)));
+    const std::string reply =
+        Reply("?", doing, std::max(0.0, SecondsLeft(end)), settings_.reply_timeout_s);
     if (reply[0] != '<') continue;  // a stray ok/error, already logged
     LogStatus(reply);
     return ParseStatus(reply, doing);

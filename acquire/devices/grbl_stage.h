@@ -39,7 +39,8 @@ class GrblStage : public Stage {
   Status Query(const std::string& doing);
   // The next line within `timeout_s` after `sent` was sent; handles push messages (alarms, a
   // reset) and throws on silence or the stop signal.
-  std::string Reply(const std::string& sent, const std::string& doing, double timeout_s);
+  std::string Reply(const std::string& sent, const std::string& doing, double timeout_s,
+                    double stated_s);
   Status ParseStatus(const std::string& report, const std::string& doing);
   // Feed hold, a short wait for the hold to complete, soft reset: the stage stops with its
   // position kept when the hold completes in time. Never throws.

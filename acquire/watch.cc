@@ -1,5 +1,9 @@
 #include "acquire/watch.h"
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +29,19 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// A watch reads and decodes one photo after another for as long as the capture lasts. glibc
+// serves a buffer above its mmap threshold (the file read, the pixels) from a mapping of its own,
+// but raises that threshold to the largest such buffer freed: from then on the photo buffers come
+// from the heap, and the small long-lived allocations made between two photos (the photo list,
+// dataset.json) land in the holes they leave, so that the heap grows by about a photo per photo
+// taken and is never given back (400 x 300 16-bit TIFFs: +0.19 MB a photo, 86 MB after 500). A
+// fixed threshold keeps every buffer of 128 kB or more in its own mapping, returned when freed.
+void KeepPhotoBuffersOutOfTheHeap() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
+}
 
 // The capture as it arrives: which files were taken, the photo list, and dataset.json.
 class Watcher {
@@ -220,6 +237,7 @@ void WatchOptions::Check() const {
 
 WatchReport RunWatch(const WatchOptions& w) {
   w.Check();
+  KeepPhotoBuffersOutOfTheHeap();
   const ImportOptions& o = w.import;
   if (!fs::is_directory(o.photos_dir)) throw BadInput(o.photos_dir + ": photo folder not found");
   WatchReport report;

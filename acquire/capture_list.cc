@@ -49,11 +49,7 @@ void CaptureList::CheckImageSize(const std::string& path, int width, int height)
 }
 
 void CaptureList::Add(const NamedPhoto& n) {
-  if (n.i >= grid_.nu || n.j >= grid_.nv)
-    throw InputError(n.where, "position",
-                     "i < " + std::to_string(grid_.nu) + " and j < " + std::to_string(grid_.nv) +
-                         " (the setup's grid)",
-                     "(" + std::to_string(n.i) + ", " + std::to_string(n.j) + ")");
+  CheckInGrid(n, grid_);
   const std::string path = options_.photos_dir + "/" + n.file;
   const PhotoExif& exif = headers_.Of(path);
   SameCamera(path, "EXIF camera make", exif.make);

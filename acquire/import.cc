@@ -107,6 +107,12 @@ std::pair<int, int> ScanPosition(const SamplingGrid& grid, const std::string& sc
   return {scan == "serpentine" && j % 2 == 1 ? grid.nu - 1 - along : along, j};
 }
 
+bool IsDatasetFile(const ImportOptions& o, const std::string& name) {
+  if (name != "dataset.json") return false;
+  std::error_code ec;
+  return fs::equivalent(o.photos_dir, o.out_dir, ec) && !ec;
+}
+
 void ImportOptions::Check() const {
   const int ways = !manifest.empty() + !pattern.empty() + !order.empty();
   if (ways != 1)
@@ -170,7 +176,7 @@ ImportReport RunImport(const ImportOptions& o) {
   DetectPhotoFormat(calibration);
   std::vector<std::string> files;
   for (const std::string& f : FolderFiles(o.photos_dir))
-    if (f != ds.calibration.photo) files.push_back(f);
+    if (f != ds.calibration.photo && !IsDatasetFile(o, f)) files.push_back(f);
 
   CaptureList list(o, ds.grid);
   if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files, list.headers());
@@ -178,6 +184,8 @@ ImportReport RunImport(const ImportOptions& o) {
                                         : !o.pattern.empty() ? FromPattern(o.pattern, files)
                                                              : FromOrder(o, ds.grid, files);
   for (const NamedPhoto& n : named) list.Add(n);
+  // Watch makes the same check before any photo arrives (the message names the manifest).
+  if (!o.manifest.empty() && !o.partial) CheckManifestCompletes(o.manifest, named, ds.grid);
   ds.photos = CompleteEntries(list, o, ds.grid, &ds.missing_positions);
   std::set<std::string> used;
   for (const auto& e : ds.photos) used.insert(e.file);

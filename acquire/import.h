@@ -62,6 +62,12 @@ Dataset ImportSkeleton(const ImportOptions& options);
 // <out_dir>/dataset.json (atomic).
 void WriteImportedDataset(const Dataset& dataset, const std::string& out_dir);
 
+// Whether `name`, a file of the photo folder, is one lumislab writes into the dataset folder
+// (dataset.json) while the photo folder is the dataset folder (--photos F --out F): such a file is
+// never a photo. (Its temporaries have a leading '.' and the stages write into subfolders, which
+// FolderFiles never lists.)
+bool IsDatasetFile(const ImportOptions& options, const std::string& name);
+
 // The grid position of the k-th photo position of a scan (rows: i fastest; serpentine: rows,
 // every other one reversed; columns: j fastest).
 std::pair<int, int> ScanPosition(const SamplingGrid& grid, const std::string& scan, int k);

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <sstream>
+#include <tuple>
 
 #include "core/error.h"
 #include "core/input_file.h"
@@ -95,6 +97,37 @@ std::vector<NamedPhoto> ManifestPhotos(const std::string& manifest) {
   }
   if (out.empty()) throw InputError(manifest, "rows", "at least one photo row", "none");
   return out;
+}
+
+void CheckInGrid(const NamedPhoto& n, const SamplingGrid& grid) {
+  if (n.i >= grid.nu || n.j >= grid.nv)
+    throw InputError(n.where, "position",
+                     "i < " + std::to_string(grid.nu) + " and j < " + std::to_string(grid.nv) +
+                         " (the setup's grid)",
+                     "(" + std::to_string(n.i) + ", " + std::to_string(n.j) + ")");
+}
+
+int CheckManifestCompletes(const std::string& manifest, const std::vector<NamedPhoto>& rows,
+                           const SamplingGrid& grid) {
+  std::map<std::tuple<int, int, bool>, int> count;
+  int per_slide = 0;
+  for (const NamedPhoto& n : rows) {
+    CheckInGrid(n, grid);
+    per_slide = std::max(per_slide, ++count[{n.i, n.j, n.positive}]);
+  }
+  for (int j = 0; j < grid.nv; ++j)
+    for (int i = 0; i < grid.nu; ++i)
+      for (const bool positive : {true, false}) {
+        const auto it = count.find({i, j, positive});
+        const int got = it == count.end() ? 0 : it->second;
+        if (got != per_slide)
+          throw InputError(manifest, "rows",
+                           std::to_string(per_slide) + " row(s) for slide " +
+                               (positive ? "p" : "n") + " at every position of the setup's grid",
+                           std::to_string(got) + " at position (" + std::to_string(i) + ", " +
+                               std::to_string(j) + ")");
+      }
+  return per_slide;
 }
 
 // The template's placeholders become capture groups; the rest matches literally.

@@ -28,6 +28,15 @@ struct NamedPhoto {
 // The rows of a manifest (CSV: i,j,slide,file[,exposure]); BadInput naming the line.
 std::vector<NamedPhoto> ManifestPhotos(const std::string& manifest);
 
+// The photo's position is inside the setup's grid: BadInput naming photo.where otherwise.
+void CheckInGrid(const NamedPhoto& photo, const SamplingGrid& grid);
+// The manifest's rows can complete the grid: every row inside it (CheckInGrid), and both slides
+// of every position with as many rows as the fullest slide. BadInput naming the manifest and the
+// first position (grid order: j, then i) they cannot complete otherwise: import would refuse the
+// folder, and watch would wait for it forever. Returns the rows per slide.
+int CheckManifestCompletes(const std::string& manifest, const std::vector<NamedPhoto>& rows,
+                           const SamplingGrid& grid);
+
 // A file-name template: {i} {j} {slide}, optional {exposure} and {bracket}, the rest literal.
 class FilePattern {
  public:

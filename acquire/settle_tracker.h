@@ -26,7 +26,7 @@ class SettleTracker {
   bool Scan(const std::string& dir) {
     const std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now();
     bool changed = false;
-    std::map<std::string, State> seen;
+    std::map<std::string, State, NameOrder> seen;
     for (const std::string& name : FolderFiles(dir)) {
       std::error_code size_ec, time_ec;
       const auto size = std::filesystem::file_size(dir + "/" + name, size_ec);
@@ -44,7 +44,9 @@ class SettleTracker {
     files_ = std::move(seen);
     return changed;
   }
-  // Files in name order, with whether each has settled.
+  // Whether the last look saw the file.
+  bool Has(const std::string& name) const { return files_.count(name) > 0; }
+  // Files in name order (NameOrderLess), with whether each has settled.
   std::vector<std::pair<std::string, bool>> Files() const {
     const std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now();
     std::vector<std::pair<std::string, bool>> out;
@@ -60,7 +62,7 @@ class SettleTracker {
     std::chrono::steady_clock::time_point since;  // when this size and time were first seen
   };
   double settle_s_;
-  std::map<std::string, State> files_;
+  std::map<std::string, State, NameOrder> files_;
 };
 
 }  // namespace lumislab

@@ -237,5 +237,34 @@ TEST_F(Batch, ConvertsReportsTheBrokenDatasetAndResumes) {
             (std::set<std::string>{"reconstruct broken", "export broken", "preview broken"}));
 }
 
+// A dataset folder named x'$(touch PWNED)' and config values with an apostrophe, "$(...)" and
+// backquotes: the Snakefile passes each to the tools as it is written (every rule converts the
+// dataset, the IES file holds the values), and nothing in them is run.
+TEST_F(Batch, SnakefileQuotesFolderNamesAndConfigValues) {
+  if (!HaveSnakemake())
+    GTEST_SKIP() << "snakemake is not installed (Debian: apt install snakemake)";
+  const std::string name = "x'$(touch PWNED)'";
+  const auto synth =
+      testing::RunTool("lumislab-acquire", "synth --scene " + ShellQuote(root_ + "/scene.json") +
+                                               " --out " + ShellQuote(root_ + "/odd/" + name));
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const std::string lab = "O'Brien's lab", manufacturer = "ACME $(touch PWNED) `touch PWNED`";
+  const CommandResult run =
+      RunIn(root_, "snakemake -s " + ShellQuote(Pipelines() + "/Snakefile") +
+                       " --config 'datasets=[odd]' out=odd_out " + ShellQuote("lab=" + lab) + " " +
+                       ShellQuote("manufacturer=" + manufacturer) + " --cores 2");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  const std::string ies = testing::ReadBinaryFile(root_ + "/odd_out/" + name + "/" + name + ".ies");
+  EXPECT_NE(ies.find("[TESTLAB] " + lab), std::string::npos) << run.output;
+  EXPECT_NE(ies.find("[MANUFAC] " + manufacturer), std::string::npos) << run.output;
+  for (const char* file : {"polar.png", "preview.png"})
+    EXPECT_TRUE(fs::is_regular_file(root_ + "/odd_out/" + name + "/" + file)) << file;
+  EXPECT_EQ(ReadSummary(root_ + "/odd_out/summary.csv")[name]["status"], "ok");
+  std::vector<std::string> ran;
+  for (const auto& entry : fs::recursive_directory_iterator(root_))
+    if (entry.path().filename() == "PWNED") ran.push_back(entry.path().string());
+  EXPECT_TRUE(ran.empty()) << ran.front();
+}
+
 }  // namespace
 }  // namespace lumislab

@@ -280,7 +280,7 @@ TEST_F(Import, BadFoldersAndDescriptionsAreRefused) {
   Refused("--manifest bad.csv", {"bad.csv: line 1", "position"});
   testing::WriteFile(root_ + "/bad.csv",
                      manifest_.substr(0, manifest_.rfind('\n', manifest_.size() - 2) + 1));
-  Refused("--manifest bad.csv", {"camera", "slide n", "position (2, 1)"});
+  Refused("--manifest bad.csv", {"bad.csv: rows", "slide n", "position (2, 1)"});
   testing::WriteFile(root_ + "/bad.csv", manifest_ + manifest_.substr(0, manifest_.find('\n') + 1));
   Refused("--manifest bad.csv",
           {"bad.csv: line 13", names_[0] + ", named before by bad.csv: line 1"});

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/log.h"
 #include "core/stop_signal.h"
+#include "lib/synthetic/camera_views.h"
 
 namespace lumislab {
 namespace {
@@ -50,8 +51,12 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
                 "response, DNG with raw) ... in capture order with EXIF, camera/BOARD.PNG, "
                 "setup.json and truth/, no dataset.json (acquire import makes it)");
   cmd->add_option("--calibration-views", o.calibration_views,
-                  "also write N photos of a free-standing 9x6 chessboard (30 mm squares) in "
-                  "varied poses, for lumislab-calibrate camera, into calibration/camera/")
+                  "also write N photos of a free-standing chessboard of " +
+                      std::to_string(kViewBoardInnerCols) + "x" +
+                      std::to_string(kViewBoardInnerRows) + " inner corners (" +
+                      Num(kViewBoardSquareMm, 6) +
+                      " mm squares) in varied poses, for lumislab-calibrate camera, into "
+                      "calibration/camera/")
       ->check(CLI::Range(0, kMaxCalibrationViews))
       ->capture_default_str();
   cmd->add_flag("--print-scene", c->print_scene,

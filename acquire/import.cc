@@ -155,7 +155,7 @@ Dataset ImportSkeleton(const ImportOptions& o) {
 void WriteImportedDataset(const Dataset& ds, const std::string& out_dir) {
   const std::string out_json = out_dir + "/dataset.json";
   const nlohmann::json json = ds.ToJson();
-  Dataset::Parse(JsonDocument::Parse(json.dump(2), out_json), out_dir);
+  Dataset::Parse(JsonDocument::Parse(DumpJson(json, out_json), out_json), out_dir);
   MakeDirectories(out_dir);
   WriteJsonAtomically(out_json, json);
 }

@@ -149,9 +149,13 @@ void WriteCameraViews(const SynthScene& scene, const Dataset& dataset, const std
                 {"inner_corners", {kViewBoardInnerCols, kViewBoardInnerRows}},
                 {"square_mm", kViewBoardSquareMm}};
   j["views"] = views;
+  // Inner corner (c, r) lies (c + 1) squares from the board's corner, the board centred on the
+  // frame's origin (ViewBoardTarget).
   j["note"] =
       "camera_from_board poses (angle-axis rad, mm) of the board views; board corner (c, r) is "
-      "at ((c + 1 - 5) s, (r + 1 - 3.5) s, 0) mm in the board frame, s = square_mm";
+      "at ((c + 1 - " +
+      Num((kViewBoardInnerCols + 1) / 2.0, 6) + ") s, (r + 1 - " +
+      Num((kViewBoardInnerRows + 1) / 2.0, 6) + ") s, 0) mm in the board frame, s = square_mm";
   WriteJsonAtomically(dir + "/truth/camera_views.json", j);
   LogInfo("calibration views: ", count, " photo(s) of a ", kViewBoardInnerCols, "x",
           kViewBoardInnerRows, " board of ", kViewBoardSquareMm,

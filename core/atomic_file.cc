@@ -1,6 +1,7 @@
 #include "core/atomic_file.h"
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -58,6 +59,23 @@ int RemoveOrphanedTemporaries(const std::string& dir) {
   return removed;
 }
 
+void CheckOutputPath(const std::string& path) {
+  struct stat st {};
+  if (path.empty() || lstat(path.c_str(), &st) != 0) return;  // missing: the writer creates it
+  if (S_ISREG(st.st_mode)) return;
+  if (S_ISLNK(st.st_mode))
+    throw BadInput(path +
+                   ": is a symbolic link; lumislab does not replace links: give the target's path");
+  if (S_ISDIR(st.st_mode)) throw IoError(path, "cannot write a file where a folder is");
+  const char* kind = S_ISCHR(st.st_mode)    ? "a character device"
+                     : S_ISBLK(st.st_mode)  ? "a block device"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISSOCK(st.st_mode) ? "a socket"
+                                            : "a special file";
+  throw BadInput(path + ": not a regular file (" + kind + "); lumislab writes outputs only as " +
+                 "regular files");
+}
+
 void WriteAtomically(const std::string& final_path,
                      const std::function<void(const std::string& tmp_path)>& write) {
   const std::string tmp = TemporaryPathFor(final_path);
@@ -65,6 +83,7 @@ void WriteAtomically(const std::string& final_path,
     write(tmp);
     std::error_code ec;
     if (!fs::exists(tmp, ec)) throw IoError(final_path, "writer produced no file");
+    CheckOutputPath(final_path);  // the last check: the path may have changed while writing
     fs::rename(tmp, final_path, ec);
     if (ec) throw IoError(final_path, "cannot rename into place: " + ec.message());
   } catch (...) {

@@ -15,8 +15,16 @@ std::string TemporaryPathFor(const std::string& final_path);
 // longer run (killed mid-write): names of TemporaryPathFor's form whose pid is gone. Returns how
 // many.
 int RemoveOrphanedTemporaries(const std::string& dir);
-// Calls write(tmp_path), then renames tmp_path onto final_path. On any exception the temporary
-// file is removed and the exception rethrown; a failed rename is an IoError (exit 3).
+// Refuses an output path that a file must not replace (docs/architecture.md §7.5): a symbolic
+// link (BadInput: lumislab does not replace links, nor writes through them), a device node, FIFO
+// or socket (BadInput: not a regular file; as root, renaming over /dev/null replaces it), a
+// folder (IoError: a file cannot take its place). A missing path or a regular file passes. Tools
+// call it where they parse --out, so that they refuse before long work; WriteAtomically checks
+// again just before its rename.
+void CheckOutputPath(const std::string& path);
+// Calls write(tmp_path), checks final_path (CheckOutputPath), then renames tmp_path onto it. On
+// any exception the temporary file is removed and the exception rethrown; a failed rename is an
+// IoError (exit 3).
 void WriteAtomically(const std::string& final_path,
                      const std::function<void(const std::string& tmp_path)>& write);
 void WriteTextAtomically(const std::string& final_path, const std::string& text);

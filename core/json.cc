@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -223,8 +224,66 @@ void JsonDocument::CheckSchemaVersion(int max_supported) const {
         std::to_string(v));
 }
 
+namespace {
+bool IsUtf8(const std::string& s) {
+  try {
+    (void)nlohmann::json(s).dump();
+    return true;
+  } catch (const nlohmann::json::type_error&) {
+    return false;
+  }
+}
+
+// The string with bytes outside printable ASCII as \xHH.
+std::string Printable(const std::string& s) {
+  std::string out;
+  for (const unsigned char ch : s) {
+    if (ch >= 0x20 && ch < 0x7f) {
+      out += char(ch);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", ch);
+      out += hex;
+    }
+  }
+  return out;
+}
+
+// The first string (member name or value) under `value` that is not UTF-8: throws naming it.
+void CheckUtf8(const nlohmann::json& value, const std::string& field, const std::string& file) {
+  const auto fail = [&](const std::string& where, const std::string& text) {
+    throw InputError(file, where.empty() ? "(the document)" : where,
+                     "UTF-8 text (JSON holds nothing else: rename the file or folder, e.g. with "
+                     "convmv -f latin1 -t utf8)",
+                     "\"" + Printable(text) + "\"");
+  };
+  if (value.is_string()) {
+    if (!IsUtf8(value.get_ref<const std::string&>())) fail(field, value.get<std::string>());
+  } else if (value.is_object()) {
+    for (auto it = value.begin(); it != value.end(); ++it) {
+      const std::string member = field.empty() ? it.key() : field + "." + it.key();
+      if (!IsUtf8(it.key())) fail(field.empty() ? "a member name" : field, it.key());
+      CheckUtf8(it.value(), member, file);
+    }
+  } else if (value.is_array()) {
+    for (size_t k = 0; k < value.size(); ++k)
+      CheckUtf8(value[k], field + "[" + std::to_string(k) + "]", file);
+  }
+}
+}  // namespace
+
+std::string DumpJson(const nlohmann::json& value, const std::string& file) {
+  try {
+    return value.dump(2);
+  } catch (const nlohmann::json::type_error& e) {
+    if (e.id != 316) throw;
+    CheckUtf8(value, "", file);
+    throw;  // not found again: the library's own message
+  }
+}
+
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
-  WriteTextAtomically(path, value.dump(2) + "\n");
+  WriteTextAtomically(path, DumpJson(value, path) + "\n");
 }
 
 }  // namespace lumislab

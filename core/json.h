@@ -73,7 +73,12 @@ class JsonDocument {
   std::shared_ptr<const std::string> file_;
 };
 
-// Pretty JSON written atomically.
+// value.dump(2) for `file`. JSON holds only UTF-8 text: a string that is not (a file name in
+// Latin-1, say) is exit 2 naming `file`, the field and the value with its odd bytes as \xHH,
+// rather than the JSON library's own exception (exit 1); it is not replaced, since a path with
+// U+FFFD in it would name another file.
+std::string DumpJson(const nlohmann::json& value, const std::string& file);
+// Pretty JSON (DumpJson) written atomically.
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value);
 
 }  // namespace lumislab

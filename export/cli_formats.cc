@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/json.h"
@@ -160,10 +161,24 @@ struct FarFieldCommand {
   Keywords keywords;
 };
 
-std::vector<double> Steps(double step, double last, const std::string& option) {
+// The largest direction grid written: 721 C planes (0.5 degree steps over [0, 360]) and 361
+// gamma angles (0.5 degrees over [0, 180]; --gamma-step spans [0, 90], so 0.25 degrees there). The
+// photometric files in circulation, goniophotometer measurements included, use 1 to 5 degrees
+// (EULUMDAT's usual 24 or 36 C planes, IES files of 73 x 37); 0.5 degrees is already finer than
+// that, the far field's memory and time grow with the count of directions (a 0.01 degree grid is
+// 324 million of them), and a grid finer than the slab resolves adds nothing but file size.
+constexpr int kMaxCPlanes = 721;
+constexpr int kMaxGammaAngles = 361;
+
+std::vector<double> Steps(double step, double last, const std::string& option, int max_count) {
   if (!(step > 0) || !(step <= last) || std::abs(last / step - std::round(last / step)) > 1e-9)
     throw BadInput(option + ": expected a step in (0, " + Num(last, 6) + "] that divides " +
                    Num(last, 6) + ", got " + Num(step, 8));
+  if (last / step + 1 > max_count + 1e-6)
+    throw BadInput(option + ": expected a step that gives at most " + std::to_string(max_count) +
+                   " angles over [0, " + Num(last, 6) + "] (at least " +
+                   Num(last / (max_count - 1), 6) + " degrees), got " + Num(step, 8) + " (" +
+                   Num(std::round(last / step) + 1, 12) + " angles)");
   std::vector<double> v;
   const int n = int(std::round(last / step));
   for (int k = 0; k <= n; ++k) v.push_back(k * step);
@@ -172,13 +187,27 @@ std::vector<double> Steps(double step, double last, const std::string& option) {
 
 // The far field of the slab on the requested grid, with the file's keywords: the distribution
 // the writers take.
-IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& slab, int threads) {
+// The requested C/gamma grid, checked (kMaxCPlanes, kMaxGammaAngles) before any work: a
+// distribution of zeros the far field fills in.
+IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
   IntensityDistribution d;
-  d.c_deg = c.c_angles.empty() ? Steps(c.c_step, 360, "--c-step") : c.c_angles;
-  d.gamma_deg = c.gamma_angles.empty() ? Steps(c.gamma_step, 90, "--gamma-step") : c.gamma_angles;
+  d.c_deg = c.c_angles.empty() ? Steps(c.c_step, 360, "--c-step", kMaxCPlanes) : c.c_angles;
+  d.gamma_deg = c.gamma_angles.empty() ? Steps(c.gamma_step, 90, "--gamma-step", kMaxGammaAngles)
+                                       : c.gamma_angles;
+  if (d.c_deg.size() > size_t(kMaxCPlanes))
+    throw BadInput("--c-angles: expected at most " + std::to_string(kMaxCPlanes) +
+                   " C planes, got " + std::to_string(d.c_deg.size()));
+  if (d.gamma_deg.size() > size_t(kMaxGammaAngles))
+    throw BadInput("--gamma-angles: expected at most " + std::to_string(kMaxGammaAngles) +
+                   " gamma angles, got " + std::to_string(d.gamma_deg.size()));
   d.values.assign(d.c_deg.size() * d.gamma_deg.size(), 0.0);
   d.Check(c.c_angles.empty() && c.gamma_angles.empty() ? "--c-step/--gamma-step"
                                                        : "--c-angles/--gamma-angles");
+  return d;
+}
+
+IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& slab, int threads) {
+  IntensityDistribution d = DirectionGrid(c);
   FarFieldOptions options;
   options.samples = c.samples;
   options.threads = threads;
@@ -212,11 +241,13 @@ int RunFarField(const FarFieldCommand& c, int threads) {
           " gamma_step=", c.gamma_step, " c_angles=", c.c_angles.size(),
           " gamma_angles=", c.gamma_angles.size(), " samples=", c.samples,
           " metadata=", c.keywords.metadata, " force=", c.force ? "yes" : "no");
+  CheckOutputPath(c.out);
   if (!c.force && std::filesystem::exists(c.out)) {
     LogInfo(c.out, " exists: skipped (--force rewrites it)");
     std::printf("%s: %s\n", c.format.c_str(), c.out.c_str());
     return 0;
   }
+  DirectionGrid(c);  // refuses a bad grid before the slab is read
   const Slab slab = LoadCompleteSlab(c.slab, threads);
   const IntensityDistribution d = SlabDistribution(c, slab, threads);
   if (c.format == "ies")
@@ -269,6 +300,7 @@ struct RayCommand {
 int RunRays(const RayCommand& c, int threads) {
   LogInfo("parameters: slab=", c.slab, " out=", c.out, " rays=", c.rays, " seed=", c.seed,
           " force=", c.force ? "yes" : "no");
+  CheckOutputPath(c.out);
   if (!c.force && std::filesystem::exists(c.out)) {
     LogInfo(c.out, " exists: skipped (--force rewrites it)");
     std::printf("tm25: %s\n", c.out.c_str());

@@ -7,10 +7,11 @@
 #       [--lab L] [--manufacturer M] [--metadata meta.json] [--dry-run] [--summary-only]
 #
 # A dataset is a folder with dataset.json; any other folder stands for the datasets directly in it.
-# --jobs N: the cores to use (default: all); min(N, datasets) datasets run at once, each stage
-#   with N / that many threads. Resumable: a stage runs only when one of its outputs is missing
-#   or older than one of its inputs (or, for reconstruct, the slab is partial), so a rerun does
-#   only what is missing or stale; --dry-run lists those stages ("<stage> <dataset>") and stops.
+# A dataset named summary.csv is refused (exit 2): the summary is <out>/summary.csv.
+# --jobs N: the cores to use (default, and at most: all there are; more is all, with a notice);
+#   min(N, datasets) datasets run at once, each stage with N / that many threads. Resumable: a
+#   stage runs only when one of its outputs is missing or older than one of its inputs (or, for
+#   reconstruct, the slab is partial), so a rerun does only what is missing or stale; --dry-run lists those stages ("<stage> <dataset>") and stops.
 # A failing stage stops its dataset only: the others carry on, and the summary names the stage
 # and the last lines of its log. Exit code 1 when any dataset failed (2: bad arguments).
 # Writes <out>/<name>/ (the exports, preview.png), <out>/log/<name>/<stage>.log and .time, and
@@ -49,6 +50,12 @@ done
 cores=$(nproc)
 [ -n "$jobs" ] || jobs=$cores
 [[ "$jobs" =~ ^[1-9][0-9]{0,3}$ ]] || { echo "$0: --jobs: expected an integer in [1, 9999], got $jobs" >&2; exit 2; }
+# More jobs than cores would only hand the tools more threads than there are cores (and above
+# their limit of 256, exit 2): the cores are what the batch uses.
+if [ "$jobs" -gt "$cores" ]; then
+  echo "$0: --jobs $jobs is more than the $cores core(s) here: using $cores" >&2
+  jobs=$cores
+fi
 
 # The datasets, in the order given (a folder's in name order); names must be unique, since
 # outputs and logs are filed under them.
@@ -70,6 +77,11 @@ declare -A seen=()
 for ds in "${datasets[@]}"; do
   name="$(basename "$ds")"
   [ -z "${seen[$name]:-}" ] || { echo "$0: two datasets named $name: ${seen[$name]} and $ds" >&2; exit 2; }
+  # <out>/summary.csv is the batch's own file: a dataset of that name would take its place.
+  [ "$name" != summary.csv ] || {
+    echo "$0: $ds: a dataset cannot be named summary.csv (the batch writes <out>/summary.csv): rename its folder" >&2
+    exit 2
+  }
   seen[$name]="$ds"
 done
 
@@ -151,6 +163,7 @@ for ds in "${datasets[@]}"; do : >"$ran/$(basename "$ds")"; done
 if [ $summary_only = 0 ]; then
   parallel=$((jobs < ${#datasets[@]} ? jobs : ${#datasets[@]}))
   threads=$((jobs / parallel))
+  [ $threads -le 256 ] || threads=256  # the tools' --threads limit (core/parallel.h)
   batch_start=$(date +%s.%N)
   running=0
   for ds in "${datasets[@]}"; do

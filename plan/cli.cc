@@ -157,6 +157,7 @@ int RunPlan(int argc, char** argv) {
     in.roi_w_mm = w;
     in.roi_h_mm = hh;
   }
+  if (!json_out.empty()) CheckOutputPath(json_out);
   LogInfo("parameters: scene=", scene.empty() ? "-" : scene, " aperture=", aperture,
           " depth_mm=", in.depth_mm, " d=", in.distance_mm, " screen=", in.screen_w_mm, "x",
           in.screen_h_mm, " D=", in.D(), " target=", in.target, " k_max=", in.k_max);

@@ -256,6 +256,7 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   if (!window && config.out.empty() && !config.bench) {
     throw BadInput("headless mode needs --out <file.exr|.png> (or --bench, or --window)");
   }
+  if (!config.out.empty()) CheckOutputPath(config.out);
   // 0 means "the default" for the plane; anything else must be a distance a lab could mean.
   auto length = [](const char* option, double v) {
     if (v != 0 && !(v >= 1 && v <= kMaxDistanceMm))

@@ -14,8 +14,8 @@ namespace lumislab {
 
 struct SynthScene;
 
-// The board: 10 x 7 squares of 30 mm, i.e. 9 x 6 inner corners as OpenCV counts them
-// (`calibrate camera --board 9x6 --square-mm 30`), centred on its frame's origin, no dot,
+// The board: 13 x 10 squares of 25 mm, i.e. 12 x 9 inner corners as OpenCV counts them
+// (`calibrate camera --board 12x9 --square-mm 25`), centred on its frame's origin, no dot,
 // printed with a one-square white margin on a grey (reflectance 0.25) sheet that fills the view.
 constexpr int kViewBoardInnerCols = 12, kViewBoardInnerRows = 9;
 constexpr double kViewBoardSquareMm = 25;

@@ -4,6 +4,8 @@
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +15,9 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/dataset.h"
@@ -284,6 +289,74 @@ TEST_F(IoTest, TemporaryNamesFitAndOrphansOfDeadProcessesAreRemoved) {
   EXPECT_FALSE(fs::exists(dir_ / ".pos_1_2.tmp999999999_3.exr"));
   EXPECT_TRUE(fs::exists(mine));
   EXPECT_TRUE(fs::exists(dir_ / ".hidden_but_not_ours"));
+}
+
+// The exit code and message of what `f` throws; {0, ""} when it throws nothing.
+std::pair<int, std::string> Thrown(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return {e.exit_code(), e.what()};
+  }
+  return {0, ""};
+}
+
+// docs/architecture.md §7.5: an output replaces only a regular file. A link is refused (neither
+// replaced nor written through), a FIFO or device is refused, and nothing changes.
+TEST_F(IoTest, OutputsRefuseLinksAndSpecialFiles) {
+  const std::string target = (dir_ / "target.ies").string();
+  WriteTextAtomically(target, "the target");
+  const std::string link = (dir_ / "link.ies").string();
+  ASSERT_EQ(symlink(target.c_str(), link.c_str()), 0);
+  for (const auto& attempt : std::vector<std::function<void()>>{
+           [&] { CheckOutputPath(link); }, [&] { WriteTextAtomically(link, "new"); }}) {
+    const auto [code, message] = Thrown(attempt);
+    EXPECT_EQ(code, 2);
+    EXPECT_NE(message.find(link + ": is a symbolic link"), std::string::npos) << message;
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+    EXPECT_EQ(ReadTextFile(target), "the target");
+  }
+  const std::string fifo = (dir_ / "fifo.ies").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  for (const auto& attempt : std::vector<std::function<void()>>{
+           [&] { CheckOutputPath(fifo); }, [&] { WriteTextAtomically(fifo, "new"); }}) {
+    const auto [code, message] = Thrown(attempt);
+    EXPECT_EQ(code, 2);
+    EXPECT_NE(message.find(fifo + ": not a regular file (a FIFO)"), std::string::npos) << message;
+    EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  }
+  // A character device: only checked (writing beside it would write into /dev), and left as is.
+  struct stat before {
+  }, after{};
+  ASSERT_EQ(stat("/dev/null", &before), 0);
+  ASSERT_TRUE(S_ISCHR(before.st_mode));
+  const auto [code, message] = Thrown([] { CheckOutputPath("/dev/null"); });
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(message.find("/dev/null: not a regular file (a character device)"), std::string::npos)
+      << message;
+  ASSERT_EQ(stat("/dev/null", &after), 0);
+  EXPECT_TRUE(S_ISCHR(after.st_mode));
+  EXPECT_EQ(before.st_rdev, after.st_rdev);
+  EXPECT_EQ(before.st_ino, after.st_ino);
+  // A folder cannot be replaced by a file (exit 3); a missing path or a regular file passes.
+  fs::create_directories(dir_ / "folder.ies");
+  EXPECT_EQ(Thrown([&] { CheckOutputPath((dir_ / "folder.ies").string()); }).first, 3);
+  EXPECT_EQ(Thrown([&] { CheckOutputPath((dir_ / "new.ies").string()); }).first, 0);
+  EXPECT_EQ(Thrown([&] { CheckOutputPath(target); }).first, 0);
+  // The last line: a link that appears while the output is being written is refused at the
+  // rename, and the temporary file is removed.
+  const std::string late = (dir_ / "late.ies").string();
+  const auto [late_code, late_message] = Thrown([&] {
+    WriteAtomically(late, [&](const std::string& tmp) {
+      std::ofstream(tmp) << "x";
+      ASSERT_EQ(symlink(target.c_str(), late.c_str()), 0);
+    });
+  });
+  EXPECT_EQ(late_code, 2) << late_message;
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(late)));
+  EXPECT_EQ(ReadTextFile(target), "the target");
+  for (auto& e : fs::directory_iterator(dir_))
+    EXPECT_FALSE(IsTemporaryName(e.path().string())) << e.path();
 }
 
 TEST_F(IoTest, SlabRefusesNonFiniteValues) {

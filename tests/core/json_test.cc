@@ -63,6 +63,29 @@ TEST(JsonTest, ParseErrorsAndMissingFilesAreBadInput) {
             std::string::npos);
 }
 
+// JSON holds only UTF-8 text: a Latin-1 file name in a document is exit 2 naming the file, the
+// field and the value (odd bytes as \xHH), not the JSON library's exception; UTF-8 passes.
+TEST(JsonTest, TextThatIsNotUtf8IsRefusedNamingTheField) {
+  nlohmann::json j = {{"photo_folder", "../caf\xc3\xa9"}, {"photos", {{{"file", "a.png"}}}}};
+  EXPECT_NE(DumpJson(j, "ds/dataset.json").find("caf\xc3\xa9"), std::string::npos);
+  j["photos"][0]["file"] = "caf\xe9.png";
+  try {
+    DumpJson(j, "ds/dataset.json");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_STREQ(e.what(),
+                 "ds/dataset.json: photos[0].file: expected UTF-8 text (JSON holds nothing else: "
+                 "rename the file or folder, e.g. with convmv -f latin1 -t utf8), got "
+                 "\"caf\\xE9.png\"");
+  }
+  const std::string dir = ::testing::TempDir() + "/lumislab_json_utf8";
+  std::filesystem::create_directories(dir);
+  EXPECT_THROW(WriteJsonAtomically(dir + "/x.json", j), Error);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.json"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(JsonTest, SchemaVersionIsChecked) {
   EXPECT_NE(MessageOf([] {
               JsonDocument::Parse("{}", "s.json").CheckSchemaVersion(1);

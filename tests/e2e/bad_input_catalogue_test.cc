@@ -248,6 +248,13 @@ Mutation MakeFifo(const std::string& path) {
     if (mkfifo((dir + "/" + path).c_str(), 0644) != 0) throw std::runtime_error("mkfifo failed");
   };
 }
+// `path` becomes a symbolic link to `target` (as written: relative to the link's folder).
+Mutation MakeSymlink(const std::string& path, const std::string& target) {
+  return [=](const std::string& dir) {
+    fs::remove_all(dir + "/" + path);
+    fs::create_symlink(target, dir + "/" + path);
+  };
+}
 Mutation CopyPath(const std::string& from, const std::string& to) {
   return [=](const std::string& dir) {
     fs::remove_all(dir + "/" + to);
@@ -628,6 +635,13 @@ class C {
     c_.tool = "lumislab-export";
     c_.args = args;
     c_.input = Input::kSlab;
+    return *this;
+  }
+  // lumislab-plan (all its arguments), next to scene.json.
+  C& Plan(const std::string& args) {
+    c_.tool = "lumislab-plan";
+    c_.args = args;
+    c_.input = Input::kScene;
     return *this;
   }
   C& Args(const std::string& args) {
@@ -1605,6 +1619,31 @@ std::vector<Case> MoreCases() {
                   .Preview("--slab ds/slab --scene plane --size 32x32 --out nodir/r.exr")
                   .Exit(3)
                   .Names({"nodir/r.exr"}));
+  // An output onto a special file or a link (docs/architecture.md §7.5): refused, exit 2, the
+  // FIFO, the link and its target left as they were.
+  v.push_back(C("preview_out_is_a_fifo")
+                  .Preview()
+                  .Do(MakeFifo("r.exr"))
+                  .Names({"r.exr", "not a regular file"}));
+  v.push_back(C("preview_out_is_a_symlink")
+                  .Preview()
+                  .Do(WriteText("target.exr", "not an image"))
+                  .Do(MakeSymlink("r.exr", "target.exr"))
+                  .Names({"r.exr", "symbolic link"}));
+  v.push_back(C("preview_out_is_a_dangling_symlink")
+                  .Preview()
+                  .Do(MakeSymlink("r.exr", "nowhere/r.exr"))
+                  .Names({"r.exr", "symbolic link"}));
+  const std::string plan = "--aperture-mm 40,40 --depth-mm 20 --json plan.json";
+  v.push_back(C("plan_json_onto_a_fifo")
+                  .Plan(plan)
+                  .Do(MakeFifo("plan.json"))
+                  .Names({"plan.json", "not a regular file"}));
+  v.push_back(C("plan_json_onto_a_symlink")
+                  .Plan(plan)
+                  .Do(WriteText("target.json", "{}"))
+                  .Do(MakeSymlink("plan.json", "target.json"))
+                  .Names({"plan.json", "symbolic link"}));
   // Unknown options and missing required ones (CLI11, exit 2, naming the option).
   v.push_back(C("cli_synth_unknown_option").Synth("--bogus 1").Names({"--bogus"}));
   v.push_back(C("cli_synth_scene_missing").Synth().Args("synth --out out").Names({"--scene"}));
@@ -1934,6 +1973,11 @@ std::vector<Case> PhotometryCases() {
     v.push_back(F(format, "samples_zero", "--samples 0").Names({"--samples"}));
     v.push_back(F(format, "opening_two_values", "--opening-mm 10,20").Names({"--opening-mm"}));
     v.push_back(F(format, "opening_nan", "--opening-mm nan,20,0").Names({"--opening-mm"}));
+    // 324 million directions: refused before any work, naming the option and the bound.
+    v.push_back(F(format, "grid_0_01_degrees", "--c-step 0.01 --gamma-step 0.01")
+                    .Names({"--c-step", "at most 721"}));
+    v.push_back(F(format, "gamma_step_0_01", "--gamma-step 0.01").Names({"--gamma-step", "361"}));
+    v.push_back(F(format, "c_step_tiny", "--c-step 1e-9").Names({"--c-step"}));
   }
   v.push_back(F("ies", "no_test_keyword", "")
                   .Args("ies --slab ds --out x.ies --lab L --manufacturer M")
@@ -1964,6 +2008,42 @@ std::vector<Case> PhotometryCases() {
                   .Export("ies --slab ds --out nodir/x.ies" + keywords)
                   .Exit(3)
                   .Names({"nodir/x.ies", "cannot"}));
+  // An output onto a special file or a link (docs/architecture.md §7.5), with and without
+  // --force: exit 2 before the slab is read, the FIFO, the link and its target unchanged.
+  for (const std::string force : {"", " --force"}) {
+    const std::string tag = force.empty() ? "" : "_force";
+    v.push_back(C("export_ies_out_is_a_fifo" + tag)
+                    .Export("ies --slab ds --out x.ies" + keywords + force)
+                    .Do(MakeFifo("x.ies"))
+                    .Names({"x.ies", "not a regular file"}));
+    v.push_back(C("export_ies_out_is_a_symlink" + tag)
+                    .Export("ies --slab ds --out x.ies" + keywords + force)
+                    .Do(WriteText("target.ies", "IESNA:LM-63-2019\n"))
+                    .Do(MakeSymlink("x.ies", "target.ies"))
+                    .Names({"x.ies", "symbolic link", "target's path"}));
+  }
+  v.push_back(C("export_ies_out_is_a_dangling_symlink")
+                  .Export("ies --slab ds --out x.ies" + keywords)
+                  .Do(MakeSymlink("x.ies", "nowhere.ies"))
+                  .Names({"x.ies", "symbolic link"}));
+  v.push_back(C("export_ldt_out_is_a_fifo")
+                  .Export("ldt --slab ds --out x.ldt --force")
+                  .Do(MakeFifo("x.ldt"))
+                  .Names({"x.ldt", "not a regular file"}));
+  v.push_back(C("export_tm25_out_is_a_symlink")
+                  .Export("tm25 --slab ds --out x.ray --rays 10 --force")
+                  .Do(WriteText("target.ray", "rays"))
+                  .Do(MakeSymlink("x.ray", "target.ray"))
+                  .Names({"x.ray", "symbolic link"}));
+  v.push_back(C("export_polar_out_is_a_fifo")
+                  .Export("polar --slab ds/slab --out p.svg")
+                  .Do(MakeFifo("p.svg"))
+                  .Names({"p.svg", "not a regular file"}));
+  v.push_back(C("export_irradiance_out_is_a_symlink")
+                  .Export("irradiance --slab ds/slab --distance-mm 1000 --out i.png")
+                  .Do(WriteText("target.png", "not a picture"))
+                  .Do(MakeSymlink("i.png", "target.png"))
+                  .Names({"i.png", "symbolic link"}));
   v.push_back(C("export_ldt_out_is_a_folder")
                   .Export("ldt --slab ds --out x.ldt --force")
                   .Do(MakeFolder("x.ldt"))

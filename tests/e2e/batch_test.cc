@@ -266,5 +266,34 @@ TEST_F(Batch, SnakefileQuotesFolderNamesAndConfigValues) {
   EXPECT_TRUE(ran.empty()) << ran.front();
 }
 
+// issue 28: a dataset named summary.csv would take the summary's place: refused (exit 2) naming
+// it, nothing written. --jobs above the core count uses the cores, with a notice, so that no tool
+// gets more threads than it accepts; a dataset named in Latin-1 converts like any other.
+TEST_F(Batch, RefusesTheSummarysNameAndClampsJobs) {
+  if (testing::kSanitized)
+    GTEST_SKIP() << "runs the tools many times over; the Release build's (the tools' own tests "
+                    "run sanitized)";
+  const std::string dir = root_ + "/names";
+  fs::create_directories(dir + "/in");
+  fs::copy(root_ + "/data/lamp_a", dir + "/in/summary.csv", fs::copy_options::recursive);
+  const CommandResult clash = RunIn(dir, BatchConvert() + " in --out out");
+  EXPECT_EQ(clash.exit_code, 2) << clash.output;
+  EXPECT_NE(clash.output.find("in/summary.csv: a dataset cannot be named summary.csv"),
+            std::string::npos)
+      << clash.output;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+
+  const std::string latin1 = "lamp_caf\xe9";
+  fs::create_directories(dir + "/l1");
+  fs::copy(root_ + "/data/lamp_a", dir + "/l1/" + latin1, fs::copy_options::recursive);
+  const CommandResult run = RunIn(dir, BatchConvert() + " l1 --out out1 --jobs 9999");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("--jobs 9999 is more than the"), std::string::npos) << run.output;
+  auto rows = ReadSummary(dir + "/out1/summary.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[latin1]["status"], "ok");
+  EXPECT_TRUE(fs::exists(dir + "/out1/" + latin1 + "/" + latin1 + ".ies"));
+}
+
 }  // namespace
 }  // namespace lumislab

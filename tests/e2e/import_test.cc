@@ -262,6 +262,29 @@ TEST(ImportScan, ScanOrders) {
   }
 }
 
+// A photo folder named in Latin-1 (an old camera card, a file server): dataset.json, which is
+// JSON and so UTF-8, cannot name it; exit 2 naming dataset.json, the field and the name, nothing
+// written. The same name in UTF-8 is imported.
+TEST_F(Import, FolderNameThatIsNotUtf8IsRefusedNamingIt) {
+  fs::rename(root_ + "/camera", root_ + "/cam\xe9ra");
+  const auto before = SnapshotTree(root_);
+  auto r = RunToolIn(root_, "lumislab-acquire",
+                     "import --photos 'cam\xe9ra' --setup setup.json --out ds --order name "
+                     "--exposure 1",
+                     60);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  for (const char* name : {"ds/dataset.json: photo_folder", "cam\\xE9ra", "UTF-8"})
+    EXPECT_NE(r.output.find(name), std::string::npos) << name << "\n" << r.output;
+  EXPECT_EQ(r.output.find("json.exception"), std::string::npos) << r.output;
+  EXPECT_EQ(testing::DiffSnapshots(before, SnapshotTree(root_)), std::vector<std::string>{});
+  fs::rename(root_ + "/cam\xe9ra", root_ + "/cam\xc3\xa9ra");
+  r = RunToolIn(root_, "lumislab-acquire",
+                "import --photos 'cam\xc3\xa9ra' --setup setup.json --out ds --order name "
+                "--exposure 1",
+                60);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
 TEST_F(Import, BadFoldersAndDescriptionsAreRefused) {
   // A photo missing from the folder: the count and the first missing position.
   fs::rename(root_ + "/camera/" + names_.back(), root_ + "/" + names_.back());

@@ -3,6 +3,7 @@
 // code 1; a rerun rewrites nothing; Snakemake plans the same jobs and runs them.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -111,7 +112,8 @@ std::set<std::string> SnakemakeJobs(const std::string& dry_run) {
 class Batch : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = testing::FreshDir("batch");
+    // One folder per process: ctest runs each test in its own process, side by side.
+    root_ = testing::FreshDir("batch_" + std::to_string(getpid()));
     testing::WriteFile(root_ + "/scene.json", kTinyScene);
     for (const char* name : {"lamp_a", "lamp_b", "broken"}) {
       const auto r =

@@ -50,12 +50,6 @@ constexpr double kShortestExposureS = 1e-6;
 
 const char* Slide(bool positive) { return positive ? "p" : "n"; }
 
-std::string Fmt(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", v);
-  return buffer;
-}
-
 std::string Duration(double s) {
   const long t = std::lround(std::max(0.0, s));
   char buffer[32];
@@ -140,14 +134,14 @@ class ShotJournal {
     std::string text;
     for (const JournalPhoto& p : photos)
       text += "photo," + std::to_string(s.i) + "," + std::to_string(s.j) + "," + Slide(s.positive) +
-              "," + std::to_string(p.bracket) + "," + Fmt(p.shutter_s) + "," + p.file + "\n";
+              "," + std::to_string(p.bracket) + "," + Num(p.shutter_s, 6) + "," + p.file + "\n";
     text +=
         "done," + std::to_string(s.i) + "," + std::to_string(s.j) + "," + Slide(s.positive) + "\n";
     Append(text);
     done_[{s.i, s.j, s.positive}] = photos;
   }
   void FinishBoard(const JournalPhoto& photo) {
-    Append("board," + Fmt(photo.shutter_s) + "," + photo.file + "\n");
+    Append("board," + Num(photo.shutter_s, 6) + "," + photo.file + "\n");
     board_ = photo;
   }
 
@@ -359,8 +353,8 @@ class Capture {
       if (std::abs(s / t - 1) > 0.01)
         throw InputError(
             o_.setup_file, field,
-            "an exposure time " + camera_->uri() + " offers (nearest " + Fmt(s) + " s)",
-            Fmt(t) + " s");
+            "an exposure time " + camera_->uri() + " offers (nearest " + Num(s, 6) + " s)",
+            Num(t, 6) + " s");
     }
     if (speeds.empty() && (lab_.shutter_s.empty() || lab_.board_shutter_s <= 0))
       throw InputError(
@@ -372,11 +366,11 @@ class Capture {
     if (!speeds.empty() && lab_.shutter_s.empty() &&
         speeds.front() * std::pow(2.0, lab_.bracket_stops * (lab_.brackets - 1)) >
             speeds.back() * 1.01)
-      throw InputError(
-          o_.setup_file, "lab.camera.brackets",
-          "a bracket that fits " + camera_->uri() + "'s exposure times (" + Fmt(speeds.front()) +
-              " to " + Fmt(speeds.back()) + " s)",
-          std::to_string(lab_.brackets) + " exposures " + Fmt(lab_.bracket_stops) + " stops apart");
+      throw InputError(o_.setup_file, "lab.camera.brackets",
+                       "a bracket that fits " + camera_->uri() + "'s exposure times (" +
+                           Num(speeds.front(), 6) + " to " + Num(speeds.back(), 6) + " s)",
+                       std::to_string(lab_.brackets) + " exposures " + Num(lab_.bracket_stops, 6) +
+                           " stops apart");
   }
 
   void Close() {
@@ -420,11 +414,11 @@ class Capture {
                    "Put the calibration board on the screen (" +
                        std::to_string(setup_.calibration.squares_x) + " x " +
                        std::to_string(setup_.calibration.squares_y) + " squares of " +
-                       Fmt(setup_.calibration.square_mm) + " mm)",
+                       Num(setup_.calibration.square_mm, 6) + " mm)",
                    "placing the board");
     double t = lab_.board_shutter_s;
     if (t <= 0) t = TestExposure("board", /*slide_photo=*/false);
-    LogInfo("board photo at ", Fmt(t), " s");
+    LogInfo("board photo at ", Num(t, 6), " s");
     const std::string file = TakePhoto("board", t);
     CheckPhoto(file);
     // Journaled once the board is off the screen: a capture stopped before that asks again
@@ -450,13 +444,13 @@ class Capture {
       const std::string path =
           camera_->Capture(capture_dir_ + "/test/" + what + "_" + std::to_string(shot));
       const PhotoLevels levels = MeasurePhotoLevels(setup_, path);
-      log_->Note("capture", "test shot " + path + " at " + Fmt(t) + " s: peak " + Fmt(levels.peak) +
-                                ", clipped " + Fmt(levels.clipped));
+      log_->Note("capture", "test shot " + path + " at " + Num(t, 6) + " s: peak " +
+                                Num(levels.peak, 6) + ", clipped " + Num(levels.clipped, 6));
       if (levels.clipped > kClippedFraction) {
         const double shorter = ShorterSpeed(speeds, t, 8);
         if (shorter == t)
           throw DeviceError(camera_->uri(), "choosing the exposure of the " + what,
-                            "the photo clips even at the shortest exposure time " + Fmt(t) +
+                            "the photo clips even at the shortest exposure time " + Num(t, 6) +
                                 " s: close the aperture or lower the ISO (lab.camera)");
         t = shorter;
         continue;
@@ -506,9 +500,9 @@ class Capture {
         if (next <= t * 1.01)
           throw DeviceError(camera_->uri(), "choosing the bracket (lab.camera.brackets)",
                             std::to_string(lab_.brackets) + " exposures " +
-                                Fmt(lab_.bracket_stops) + " stops apart from " + Fmt(shortest) +
-                                " s go beyond the longest exposure time, " + Fmt(speeds.back()) +
-                                " s: fewer brackets or fewer stops");
+                                Num(lab_.bracket_stops, 6) + " stops apart from " +
+                                Num(shortest, 6) + " s go beyond the longest exposure time, " +
+                                Num(speeds.back(), 6) + " s: fewer brackets or fewer stops");
         brackets_.push_back(next);
         t = next;
       }
@@ -527,7 +521,7 @@ class Capture {
     }
     WriteJsonAtomically(path, json);
     std::string list;
-    for (double b : brackets_) list += (list.empty() ? "" : ", ") + Fmt(b) + " s";
+    for (double b : brackets_) list += (list.empty() ? "" : ", ") + Num(b, 6) + " s";
     LogInfo("bracket: ", list, " (each photo's exposure from ",
             exposure_from_exif_ ? "its EXIF" : "the time set", ")");
   }
@@ -542,26 +536,27 @@ class Capture {
       std::snprintf(stem, sizeof stem, "pos_%d_%d_%s_%d", shot.i, shot.j, Slide(shot.positive), k);
       double t = brackets_[k];
       std::string file = TakePhoto(stem, t);
-      CheckPhoto(file);
+      Photo photo = CheckPhoto(file);
       // The shortest photo must hold the brightest light: taken again shorter while it clips.
       for (int again = 0; k == 0; ++again) {
         const std::string path = photos_dir_ + "/" + file;
-        const PhotoLevels levels = MeasurePhotoLevels(setup_, path);
+        const PhotoLevels levels = MeasurePhotoLevels(photo);
         if (levels.clipped <= kClippedFraction) break;
         const double shorter = ShorterSpeed(speeds, t, std::pow(2.0, lab_.bracket_stops));
         if (shorter >= t * 0.99 || shorter < kShortestExposureS || again == kMaxReshoots) {
-          LogWarning(path, ": ", Fmt(levels.clipped * 100), " % of the pixels clip at ", Fmt(t),
+          LogWarning(path, ": ", Num(levels.clipped * 100, 6), " % of the pixels clip at ",
+                     Num(t, 6),
                      " s, and no shorter time is left to try; the brightest light of this "
                      "position is lost");
           break;
         }
-        LogWarning(path, ": ", Fmt(levels.clipped * 100), " % of the pixels clip at ", Fmt(t),
-                   " s; taking it again at ", Fmt(shorter), " s");
+        LogWarning(path, ": ", Num(levels.clipped * 100, 6), " % of the pixels clip at ", Num(t, 6),
+                   " s; taking it again at ", Num(shorter, 6), " s");
         t = shorter;
         ++report->reshots;
         fs::remove(path);
         file = TakePhoto(stem, t);
-        CheckPhoto(file);
+        photo = CheckPhoto(file);
       }
       photos.push_back({k, t, file});
     }
@@ -581,11 +576,12 @@ class Capture {
   }
 
   // A photo just downloaded decodes whole and has the capture's image size (the board photo's:
-  // the same camera); a DeviceError naming it otherwise (the camera sent a broken file).
-  void CheckPhoto(const std::string& file) {
+  // the same camera); a DeviceError naming it otherwise (the camera sent a broken file). Returns
+  // it decoded as MeasurePhotoLevels reads it, so that the clipping check decodes nothing again.
+  Photo CheckPhoto(const std::string& file) {
     const std::string path = photos_dir_ + "/" + file;
     try {
-      const Photo photo = DecodePhoto(path);
+      Photo photo = DecodeForLevels(setup_, path);
       if (!size_ && journal_.board() && journal_.board()->file != file) {
         const Photo board = DecodePhoto(photos_dir_ + "/" + journal_.board()->file);
         size_ = std::make_pair(board.pixels.cols, board.pixels.rows);
@@ -596,6 +592,7 @@ class Capture {
                       std::to_string(photo.pixels.rows) + " px where the capture's are " +
                       std::to_string(size_->first) + " x " + std::to_string(size_->second) +
                       " (the camera's image size changed)");
+      return photo;
     } catch (const Error& e) {
       throw DeviceError(camera_->uri(), "checking " + path, e.what());
     }
@@ -711,21 +708,28 @@ std::string DescribePlan(const SamplingGrid& grid, const LabSetup& lab, const Ca
      << lab.origin_mm.x() << ", " << lab.origin_mm.y() << ") mm\n";
   os << "shots: " << plan.shots.size() << " (position x slide), photos: " << plan.photos << " ("
      << lab.brackets << " per shot) + 1 board photo + test shots\n";
-  os << "stage moves: " << plan.moves << ", travel " << Fmt(plan.travel_mm) << " mm\n";
+  os << "stage moves: " << plan.moves << ", travel " << Num(plan.travel_mm, 6) << " mm\n";
   os << "slide changes: " << plan.slide_swaps
      << (lab.slide_axis ? std::string(" (slide axis ") + lab.slide_axis->axis + ")"
                         : std::string(" (by the operator)"))
      << "\n";
   os << "predicted lab time: " << Duration(plan.lab_s) << " (" << plan.moves << " moves x "
-     << Fmt(model.move_s) << " s + " << plan.photos << " photos x " << Fmt(model.exposure_s)
+     << Num(model.move_s, 6) << " s + " << plan.photos << " photos x " << Num(model.exposure_s, 6)
      << " s: lumislab-plan's lab model, --move-s and --exposure-s)\n";
   return os.str();
 }
 
-PhotoLevels MeasurePhotoLevels(const Dataset& setup, const std::string& path) {
+Photo DecodeForLevels(const Dataset& setup, const std::string& path) {
   PhotoEntry entry;
   entry.exposure = 1;
-  const Photo photo = DecodePhoto(path, PhotoSpecOf(setup, entry));
+  return DecodePhoto(path, PhotoSpecOf(setup, entry));
+}
+
+PhotoLevels MeasurePhotoLevels(const Dataset& setup, const std::string& path) {
+  return MeasurePhotoLevels(DecodeForLevels(setup, path));
+}
+
+PhotoLevels MeasurePhotoLevels(const Photo& photo) {
   const LinearReader reader(photo);
   const int w = photo.pixels.cols, h = photo.pixels.rows;
   // About a million samples: the levels of a 24-megapixel photo without reading all of it.

@@ -25,6 +25,7 @@
 #include "acquire/lab_setup.h"
 #include "core/dataset.h"
 #include "core/lab_model.h"
+#include "lib/photo/photo_io.h"
 
 namespace lumislab {
 
@@ -91,5 +92,8 @@ struct PhotoLevels {
   double clipped = 0;
 };
 PhotoLevels MeasurePhotoLevels(const Dataset& setup, const std::string& path);
+// The same of a photo decoded with DecodeForLevels: the setup's transfer and levels, exposure 1.
+PhotoLevels MeasurePhotoLevels(const Photo& photo);
+Photo DecodeForLevels(const Dataset& setup, const std::string& path);
 
 }  // namespace lumislab

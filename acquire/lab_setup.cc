@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/json.h"
+#include "core/log.h"
 
 namespace lumislab {
 namespace {
@@ -14,11 +15,7 @@ const std::vector<std::string> kAxes = {"X", "Y", "Z", "A", "B", "C"};
 
 char ParseAxis(const JsonView& v) { return v.OneOf(kAxes)[0]; }
 
-std::string Mm(double v) {
-  std::ostringstream s;
-  s << v << " mm";
-  return s.str();
-}
+std::string Mm(double v) { return Num(v, 6) + " mm"; }
 
 }  // namespace
 

@@ -10,6 +10,7 @@
 #include "acquire/devices/program.h"
 #include "acquire/settle_tracker.h"
 #include "core/atomic_file.h"
+#include "core/log.h"
 #include "core/stop_signal.h"
 #include "lib/photo/photo_format.h"
 
@@ -17,12 +18,6 @@ namespace fs = std::filesystem;
 
 namespace lumislab {
 namespace {
-
-std::string Seconds(double s) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", s);
-  return buffer;
-}
 
 // Renames `tmp` to `stem`.<its extension>; IoError naming the target when it cannot.
 std::string PlacePhoto(const std::string& tmp, const std::string& stem,
@@ -53,7 +48,7 @@ class CommandCamera : public Camera {
     const std::string tmp = TemporaryPathFor(stem + ".photo");
     try {
       RunDeviceProgram(uri(), "capturing " + fs::path(stem).filename().string(), program_,
-                       {"capture", tmp, Seconds(shutter_s_)}, settings_.capture_timeout_s, log_);
+                       {"capture", tmp, Num(shutter_s_, 6)}, settings_.capture_timeout_s, log_);
       if (!fs::is_regular_file(tmp))
         throw DeviceError(uri(), "capturing", program_ + " exited 0 but wrote no photo at " + tmp);
       return PlacePhoto(tmp, stem, "");
@@ -86,13 +81,13 @@ class FolderCamera : public Camera {
   std::vector<double> ShutterSpeeds() override { return {}; }
   void SetShutterSpeed(double seconds) override {
     shutter_s_ = seconds;
-    if (log_) log_->Note(uri(), "exposure time wanted: " + Seconds(seconds) + " s");
+    if (log_) log_->Note(uri(), "exposure time wanted: " + Num(seconds, 6) + " s");
   }
   std::string Capture(const std::string& stem) override {
     const std::string name = fs::path(stem).filename().string();
     std::fprintf(stderr, "lumislab-acquire: waiting for photo %s (%s s) in %s\n", name.c_str(),
-                 Seconds(shutter_s_).c_str(), dir_.c_str());
-    if (log_) log_->Note(uri(), "waiting for " + name + " (" + Seconds(shutter_s_) + " s)");
+                 Num(shutter_s_, 6).c_str(), dir_.c_str());
+    if (log_) log_->Note(uri(), "waiting for " + name + " (" + Num(shutter_s_, 6) + " s)");
     const auto start = std::chrono::steady_clock::now();
     for (;;) {
       tracker_.Scan(dir_);

@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "core/atomic_file.h"
+#include "core/log.h"
 #include "core/stop_signal.h"
 #include "lib/photo/exif.h"
 
@@ -68,11 +69,7 @@ std::string Join(const std::vector<std::string>& items, const std::string& none 
   return text;
 }
 
-std::string FormatSeconds(double s) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g s", s);
-  return text;
-}
+std::string FormatSeconds(double s) { return Num(s, 6) + " s"; }
 
 // libgphoto2's ptpip code writes to sockets with write(), so a camera that went away raises
 // SIGPIPE, which would end the process. While a call runs, SIGPIPE is blocked in this thread and

@@ -95,10 +95,17 @@ class Capture : public ::testing::Test {
     while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
     return s;
   }
+  // The capture of the virtual lab into `out`: as words, and as a command line for sh.
+  std::vector<std::string> CaptureArgv(const std::string& out) const {
+    return {"capture",   "--setup", "lab/setup.json", "--stage", "grbl:lab/grbl",
+            "--camera",  camera_,   "--out",          out,       "--operator",
+            kLabOperator};
+  }
   std::string CaptureArgs(const std::string& out, const std::string& extra = "") const {
-    return "capture --setup lab/setup.json --stage grbl:lab/grbl --camera " +
-           testing::ShellQuote(camera_) + " --out " + out + " --operator " +
-           testing::ShellQuote(kLabOperator) + (extra.empty() ? "" : " " + extra);
+    std::string line;
+    for (const std::string& word : CaptureArgv(out))
+      line += (line.empty() ? "" : " ") + testing::ShellQuote(word);
+    return line + (extra.empty() ? "" : " " + extra);
   }
   testing::CommandResult Run(const std::string& tool, const std::string& args,
                              double timeout_s = kWaitS) {
@@ -287,10 +294,7 @@ TEST_F(Capture, KilledAnywhereTheRerunFinishesTheSameSlab) {
   std::uniform_real_distribution<double> delay(0.2, 3.0);
   int kills = 0;
   for (int attempt = 0; attempt < 30 && kills < 10; ++attempt) {
-    ToolProcess capture(root_, "lumislab-acquire",
-                        {"capture", "--setup", "lab/setup.json", "--stage", "grbl:lab/grbl",
-                         "--camera", camera_, "--out", "killed", "--operator", kLabOperator},
-                        root_ + "/killed.log");
+    ToolProcess capture(root_, "lumislab-acquire", CaptureArgv("killed"), root_ + "/killed.log");
     const double at = delay(random);
     WaitUntil([&] { return !capture.Running(); }, at);
     if (!capture.Running()) {
@@ -340,10 +344,7 @@ TEST_F(Capture, KilledAnywhereTheRerunFinishesTheSameSlab) {
 // same command goes on.
 TEST_F(Capture, StopSignalHoldsTheStageWithinASecond) {
   StartLab(LabJson(), 0.2);  // slow motion: the moves take seconds
-  ToolProcess capture(root_, "lumislab-acquire",
-                      {"capture", "--setup", "lab/setup.json", "--stage", "grbl:lab/grbl",
-                       "--camera", camera_, "--out", "cap", "--operator", kLabOperator},
-                      root_ + "/cap.log");
+  ToolProcess capture(root_, "lumislab-acquire", CaptureArgv("cap"), root_ + "/cap.log");
   ASSERT_TRUE(WaitUntil([&] { return Log("cap").find("> G1 X") != std::string::npos; }, kWaitS))
       << ReadBinaryFile(root_ + "/cap.log");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
@@ -368,10 +369,7 @@ TEST_F(Capture, StopSignalHoldsTheStageWithinASecond) {
 TEST_F(Capture, StageAlarmAndCameraGoneMidRunNameTheDevice) {
   StartLab(LabJson(), 2);
   {
-    ToolProcess capture(root_, "lumislab-acquire",
-                        {"capture", "--setup", "lab/setup.json", "--stage", "grbl:lab/grbl",
-                         "--camera", camera_, "--out", "cap", "--operator", kLabOperator},
-                        root_ + "/alarm.log");
+    ToolProcess capture(root_, "lumislab-acquire", CaptureArgv("cap"), root_ + "/alarm.log");
     ASSERT_TRUE(WaitUntil(
         [&] {
           std::ifstream in(root_ + "/cap/capture/shots.csv");
@@ -390,10 +388,7 @@ TEST_F(Capture, StageAlarmAndCameraGoneMidRunNameTheDevice) {
   // A new lab (the controller reset), then the camera switched off mid-run.
   StartLab(LabJson(), 2);
   {
-    ToolProcess capture(root_, "lumislab-acquire",
-                        {"capture", "--setup", "lab/setup.json", "--stage", "grbl:lab/grbl",
-                         "--camera", camera_, "--out", "cap", "--operator", kLabOperator},
-                        root_ + "/gone.log");
+    ToolProcess capture(root_, "lumislab-acquire", CaptureArgv("cap"), root_ + "/gone.log");
     ASSERT_TRUE(WaitUntil(
         [&] { return Log("cap").find("gphoto2", 0) != std::string::npos || !capture.Running(); },
         kWaitS));

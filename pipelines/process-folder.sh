@@ -23,7 +23,7 @@
 # each stage verified about the capture, docs/verifies.md) is printed.
 set -euo pipefail
 usage() {
-  sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//' >&2
+  awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0" >&2
   exit 2
 }
 [ $# -ge 1 ] || usage

@@ -21,18 +21,23 @@ constexpr double kMinOrderFraction = 0;
 // noise-only positions have both about equal) and its negative flux exceeds this share of the
 // brightest position's positive flux. The bound for a legitimate capture: a point source seen
 // through the dual filter gives position (i, j) the flux Phi~(u0 - c_ij) times its light, and
-// min Phi~ / max Phi~ over the grid is at most 0.152 (K = 1), 0.160 (K = 2), 0.156 (K = 3) for
-// any source position; wider sources mix positions and give less. Measured: up to 0.135 on the
-// legitimate captures (hard cases' point sources); 1.5 or more (every position negative: no
-// positive flux at all) on swapped ones.
+// -min Phi~ / max Phi~ over the grid is at most 0.152 (K = 1), 0.160 (K = 2), 0.156 (K = 3) for
+// any source position a grid of 2 x 2 or more covers; wider sources mix positions and give
+// less. Measured on legitimate captures: up to 0.152 (the hard cases' point sources, randomised
+// sweep), 0.033 (the demo scene), 0 (the real-camera, camera-folder, capture, live and watch
+// chains); on broken ones: 1.06 (the brightest positions' slides exchanged in dataset.json),
+// 1.09 and 30.5 (the demo with one or every position swapped), no positive position at all (a
+// stray photo first: every photo one place late).
 constexpr double kMaxNegativeShare = 0.5;
 constexpr double kNegativeDominance = 2;
 
 // positions.shift: positions compared are lit (magnitude >= 10 % of the brightest's): the
 // centroid of a faint position is noise. A neighbour pair warns when the centroid moves against
-// the grid by more than half a spacing.
+// the grid by more than this many spacings. Measured: the smallest step on legitimate captures
+// -1.12 spacings (a hard-case sweep's point sources under the negative lobes), 2.6 (demo), 31 ...
+// 38 (the test scenes); two neighbours exchanged: -41.6 (demo), -31.9 (the test scene).
 constexpr double kLitShare = 0.1;
-constexpr double kMaxBackwardSpacings = 0.5;
+constexpr double kMaxBackwardSpacings = 4;
 
 std::string Text(double v) {
   std::ostringstream os;
@@ -152,29 +157,38 @@ void CaptureChecks::CheckSlideSigns() {
     swapped += share > kMaxNegativeShare;
     if (!worst || share > worst_share) worst = &l, worst_share = share;
   }
-  const double shown = std::isfinite(worst_share) ? worst_share : 1e300;
-  const nlohmann::json values = {
-      {"positions", light_.size()},
-      {"mostly_negative_positions", dominated},
-      {"swapped_looking_positions", swapped},
-      {"largest_negative_share", shown},
-      {"max_negative_share", kMaxNegativeShare},
-      {"total_flux", total}};
+  // (No position with positive light: the share is unbounded, recorded as null.)
+  const nlohmann::json shown =
+      std::isfinite(worst_share) ? nlohmann::json(worst_share) : nlohmann::json();
+  const nlohmann::json values = {{"positions", light_.size()},
+                                 {"mostly_negative_positions", dominated},
+                                 {"swapped_looking_positions", swapped},
+                                 {"largest_negative_share", shown},
+                                 {"max_negative_share", kMaxNegativeShare},
+                                 {"total_flux", total}};
   if (worst && worst_share > kMaxNegativeShare) {
     const bool all = brightest <= 0;
-    log_.Fail("slides.sign",
-              SlidePhotos(worst->i, worst->j) + ": slides: expected T+ and T- of one light (the " +
-                  "light through p minus n negative at most " + Text(kMaxNegativeShare) +
-                  " of the brightest position's), got " +
-                  (all ? std::string("a negative total at every position")
-                       : Text(worst_share) + " of it negative at position " +
-                             PositionName(worst->i, worst->j)) +
-                  ": the two slides look swapped" +
-                  (swapped > 1 ? " (at " + std::to_string(swapped) +
-                                       " positions: the photo list shifted by one photo, e.g. a "
-                                       "stray test shot first?)"
-                                 : std::string(" (p and n exchanged in dataset.json?)")),
-              values);
+    const std::string message =
+        SlidePhotos(worst->i, worst->j) + ": slides: expected T+ and T- of one light (the " +
+        "light through p minus n negative at most " + Text(kMaxNegativeShare) +
+        " of the brightest position's), got " +
+        (all ? std::string("a negative total at every position")
+             : Text(worst_share) + " of it negative at position " +
+                   PositionName(worst->i, worst->j)) +
+        ": the two slides look swapped" +
+        (swapped > 1 ? " (at " + std::to_string(swapped) +
+                           " positions: the photo list shifted by one photo, e.g. a stray test "
+                           "shot first?)"
+                     : std::string(" (p and n exchanged in dataset.json?)"));
+    // A grid one position wide does not cover a luminaire across it: light beyond the grid is
+    // seen through the filter's negative lobes only, at every position (the hard cases' sweep
+    // has such captures), so there the sign cannot tell and is a warning.
+    if (dataset_.grid.nu < 2 || dataset_.grid.nv < 2) {
+      log_.Warn("slides.sign", message + "; or the light lies beyond a grid one position wide",
+                values);
+      return;
+    }
+    log_.Fail("slides.sign", message, values);
   }
   log_.Pass("slides.sign",
             std::to_string(light_.size()) + " position(s): light through p minus n positive (" +
@@ -193,8 +207,8 @@ void CaptureChecks::CheckNeighbours() {
   std::vector<std::string> backward;
   for (const auto& [key, a] : light_)
     for (const bool along_i : {true, false}) {
-      const auto it = light_.find(along_i ? std::make_pair(a.j, a.i + 1)
-                                          : std::make_pair(a.j + 1, a.i));
+      const auto it =
+          light_.find(along_i ? std::make_pair(a.j, a.i + 1) : std::make_pair(a.j + 1, a.i));
       if (it == light_.end()) continue;
       const PositionLight& b = it->second;
       if (a.Magnitude() < kLitShare * lit || b.Magnitude() < kLitShare * lit) continue;
@@ -203,8 +217,8 @@ void CaptureChecks::CheckNeighbours() {
       const std::string where = PositionName(a.i, a.j) + " -> " + PositionName(b.i, b.j);
       if (step < least) least = step, least_where = where;
       if (step < -kMaxBackwardSpacings)
-        backward.push_back(where + " (" + Text(step) + " spacings along " +
-                           (along_i ? "s" : "t") + ")");
+        backward.push_back(where + " (" + Text(step) + " spacings along " + (along_i ? "s" : "t") +
+                           ")");
     }
   if (pairs == 0) return;
   const nlohmann::json values = {{"pairs", pairs},

@@ -9,14 +9,16 @@
 //  * slides.sign: the two slides of a position are T+ and T- of the same light (docs/method.md
 //    §2.5), so E = peak (E+ - E-) summed over the screen is the light through Phi~_ij: positive
 //    at the positions that carry the luminaire's light, negative only under the filter's
-//    negative lobes, and there at most 0.16 of the brightest position's (below). A position
-//    whose light is mostly negative and larger than that is exit 2, naming its two photos: the
-//    slides look swapped (in dataset.json, or every photo shifted by one in the import).
+//    negative lobes, and there at most 0.16 of the brightest position's. A position whose light
+//    is mostly negative and more than 0.5 of that is exit 2, naming its two photos: the slides
+//    look swapped (in dataset.json, or every photo shifted by one in the import). A grid one
+//    position wide cannot tell (light beyond it is negative everywhere): a warning there.
 //  * positions.shift: neighbouring positions see shifted copies of one light field, to first
 //    order: the light through a filter centre c lands around c + d tan(its direction), so its
 //    centroid on the screen (luminaire frame) moves with the grid index. A neighbour pair whose
-//    centroid moves against the grid by more than half a spacing is a warning (photos of
-//    another position?); a converging luminaire could mean it.
+//    centroid moves against the grid by more than 4 spacings is a warning (photos of another
+//    position?); a converging luminaire could mean it. (A list shifted by a whole position
+//    shows only where the scan wraps, and only where those positions are lit.)
 #pragma once
 
 #include <map>

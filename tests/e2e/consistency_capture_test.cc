@@ -75,7 +75,8 @@ class ConsistencyCapture : public ::testing::Test {
   std::string Refused(const std::string& ds, const std::vector<std::string>& parts) {
     const auto r = RunToolIn(root_, "lumislab-reconstruct", "--dataset " + ds + " --resolution 40");
     EXPECT_EQ(r.exit_code, 2) << r.output;
-    for (const auto& p : parts) EXPECT_NE(r.output.find(p), std::string::npos) << p << "\n" << r.output;
+    for (const auto& p : parts)
+      EXPECT_NE(r.output.find(p), std::string::npos) << p << "\n" << r.output;
     return r.output;
   }
   // The outcome of `check` in <ds>/checks.json's stage `stage` ("" when absent).
@@ -153,6 +154,20 @@ TEST_F(ConsistencyCapture, SwappedSlidesInDatasetJsonAreRefused) {
   EXPECT_EQ(Outcome("swapped", "reconstruct", "slides.sign"), "failed");
 }
 
+// dataset.json with two neighbouring positions' photos exchanged: the light moves against the
+// grid between them, a warning (positions.shift), the slab still written.
+TEST_F(ConsistencyCapture, NeighboursExchangedWarn) {
+  std::vector<std::string> photos = taken_;
+  std::swap(photos[0], photos[2]), std::swap(photos[1], photos[3]);  // (0, 0) <-> (1, 0)
+  CameraFolder("camera", photos, "IMG_%04d.PNG");
+  Chain("camera", "ds");
+  const auto r = RunToolIn(root_, "lumislab-reconstruct", "--dataset ds --resolution 40");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("moves against the grid"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(0, 0) -> (1, 0)"), std::string::npos) << r.output;
+  EXPECT_EQ(Outcome("ds", "reconstruct", "positions.shift"), "warning");
+}
+
 // A bracket of two exposures per slide made from the capture (the photo and a copy at a quarter
 // of its values): recorded in the right order it passes (brackets.exposure_order recorded as
 // passed); with the two exposures exchanged in the manifest it is refused naming both photos.
@@ -161,16 +176,16 @@ TEST_F(ConsistencyCapture, BracketWithItsExposuresExchangedIsRefused) {
   std::string right = "i,j,slide,file,exposure\n", wrong = right;
   const Dataset ds = Dataset::Load(root_ + "/original");
   for (const PhotoEntry& e : ds.photos) {
-    const std::string stem = "pos" + std::to_string(e.i) + std::to_string(e.j) +
-                             (e.positive ? "p" : "n");
+    const std::string stem =
+        "pos" + std::to_string(e.i) + std::to_string(e.j) + (e.positive ? "p" : "n");
     const cv::Mat full = cv::imread(ds.PhotoPath(e.file), cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(full.empty()) << e.file;
     cv::Mat quarter;
     full.convertTo(quarter, full.type(), 0.25);
     cv::imwrite(root_ + "/bracket/" + stem + "_long.png", full);
     cv::imwrite(root_ + "/bracket/" + stem + "_short.png", quarter);
-    const std::string row = std::to_string(e.i) + "," + std::to_string(e.j) + "," +
-                            (e.positive ? "p" : "n") + ",";
+    const std::string row =
+        std::to_string(e.i) + "," + std::to_string(e.j) + "," + (e.positive ? "p" : "n") + ",";
     right += row + stem + "_long.png,4\n" + row + stem + "_short.png,1\n";
     wrong += row + stem + "_long.png," + (e.i == 1 && e.j == 0 ? "1" : "4") + "\n" + row + stem +
              "_short.png," + (e.i == 1 && e.j == 0 ? "4" : "1") + "\n";
@@ -182,8 +197,7 @@ TEST_F(ConsistencyCapture, BracketWithItsExposuresExchangedIsRefused) {
     Ok("lumislab-acquire", std::string("import --photos bracket --setup setup.json --out ") + name +
                                " --manifest " + name + ".csv");
     fs::create_directories(root_ + "/" + name + "/calib");
-    fs::copy_file(root_ + "/original/calib/screen.json",
-                  root_ + "/" + name + "/calib/screen.json");
+    fs::copy_file(root_ + "/original/calib/screen.json", root_ + "/" + name + "/calib/screen.json");
   }
   Ok("lumislab-reconstruct", "--dataset right --resolution 40");
   EXPECT_EQ(Outcome("right", "reconstruct", "brackets.exposure_order"), "passed");

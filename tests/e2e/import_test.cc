@@ -191,11 +191,12 @@ TEST_F(Import, ExifGivesOrderExposureAndCamera) {
   // naming the first pair taken the other way round (order.names_and_times), nothing written.
   // (By name DSC_0001, taken last, comes first: DSC_0002 is the first photo taken before the one
   // named before it.)
-  const auto n = RunToolIn(root_, "lumislab-acquire",
-                           "import --photos jpeg --setup setup.json --out by_name --order name", 60);
+  const auto n =
+      RunToolIn(root_, "lumislab-acquire",
+                "import --photos jpeg --setup setup.json --out by_name --order name", 60);
   EXPECT_EQ(n.exit_code, 2) << n.output;
   for (const std::string& part : {"jpeg/" + jpegs[10] + ": EXIF DateTimeOriginal",
-                                  "taken after " + jpegs[11], "--order capture"})
+                                  "taken after " + jpegs[11], std::string("--order capture")})
     EXPECT_NE(n.output.find(part), std::string::npos) << part << "\n" << n.output;
   EXPECT_FALSE(fs::exists(root_ + "/by_name"));
   // --order capture records the names' disagreement as a warning (a counter that wrapped).

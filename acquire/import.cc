@@ -8,6 +8,7 @@
 #include "acquire/capture_list.h"
 #include "acquire/photo_naming.h"
 #include "core/atomic_file.h"
+#include "core/checks.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/json.h"
@@ -41,6 +42,47 @@ std::vector<std::string> ByCaptureTime(const std::string& dir,
   return out;
 }
 
+// How the photos' name order and their EXIF time order agree (order.names_and_times): the
+// photos with a time, compared in name order; the first pair whose times run backwards.
+struct OrderAgreement {
+  int timed = 0;        // photos with an EXIF time
+  int equal_times = 0;  // consecutive (in name order) photos with the same time, to the second
+  std::string earlier, later, earlier_time, later_time;  // the first backward pair, by name
+  bool Agree() const { return earlier.empty(); }
+};
+
+// `files` in name order (FolderFiles, NameOrderLess: capt2 before capt10).
+OrderAgreement CompareNameAndTimeOrder(const std::string& dir,
+                                       const std::vector<std::string>& files,
+                                       PhotoHeaders& headers) {
+  OrderAgreement out;
+  const std::string* previous = nullptr;
+  std::string previous_time;
+  for (const std::string& f : files) {
+    const PhotoExif& exif = headers.Of(dir + "/" + f);
+    if (!exif.date_time) continue;
+    ++out.timed;
+    if (previous) {
+      out.equal_times += *exif.date_time == previous_time;
+      if (*exif.date_time < previous_time && out.Agree()) {
+        out.earlier = *previous, out.later = f;
+        out.earlier_time = previous_time, out.later_time = *exif.date_time;
+      }
+    }
+    previous = &f;
+    previous_time = *exif.date_time;
+  }
+  return out;
+}
+
+// A photo count one more than the capture's: name the candidates (a stray test shot is the
+// first or the last photo).
+std::string StrayHint(const std::vector<std::string>& files, size_t expected) {
+  if (files.size() != expected + 1 || files.size() < 3) return "";
+  return "; one photo more than the capture: a stray test shot? (the first photo is " +
+         files.front() + ", the last " + files.back() + ")";
+}
+
 // The files in the order of the capture (their name order, or their EXIF time order). All of
 // them, or with --partial a capture that stopped early: the positions after the last photo are
 // missing.
@@ -60,7 +102,7 @@ std::vector<NamedPhoto> FromOrder(const ImportOptions& o, const SamplingGrid& gr
     throw InputError(o.photos_dir, "photos",
                      std::to_string(expected) + " photos (" + std::to_string(grid.count()) +
                          " positions x 2 slides x " + std::to_string(per_slide) + " exposure(s))",
-                     got.str());
+                     got.str() + StrayHint(files, expected));
   }
   std::vector<NamedPhoto> out;
   for (size_t k = 0; k < files.size(); ++k) out.push_back(OrderedPhoto(o, grid, k, files[k]));
@@ -179,6 +221,23 @@ ImportReport RunImport(const ImportOptions& o) {
     if (f != ds.calibration.photo && !IsDatasetFile(o, f)) files.push_back(f);
 
   CaptureList list(o, ds.grid);
+  // Every order the folder states, cross-checked where there are two: with --order, the names'
+  // and the EXIF times'. --order name against times that run backwards is refused (a photo in
+  // the wrong place shifts every later one); --order capture against names that do is a warning
+  // (a camera's counter wraps at 9999, two cards).
+  OrderAgreement agreement;
+  if (!o.order.empty()) {
+    agreement = CompareNameAndTimeOrder(o.photos_dir, files, list.headers());
+    if (o.order == "name" && !agreement.Agree())
+      CheckLog(fs::is_directory(o.out_dir) ? o.out_dir : "", "acquire import")
+          .Fail("order.names_and_times",
+                o.photos_dir + "/" + agreement.later + ": EXIF DateTimeOriginal: expected " +
+                    agreement.earlier_time + " or later (--order name: taken after " +
+                    agreement.earlier + "), got " + agreement.later_time +
+                    ": the name order is not the capture order (--order capture follows the "
+                    "EXIF time)",
+                {{"earlier", agreement.earlier}, {"later", agreement.later}});
+  }
   if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files, list.headers());
   const std::vector<NamedPhoto> named = !o.manifest.empty()  ? ManifestPhotos(o.manifest)
                                         : !o.pattern.empty() ? FromPattern(o.pattern, files)
@@ -193,6 +252,26 @@ ImportReport RunImport(const ImportOptions& o) {
     if (!used.count(f)) report.unused.push_back(f);
 
   WriteImportedDataset(ds, o.out_dir);
+  if (agreement.timed > 1) {  // (no record where nothing was compared)
+    CheckLog checks(o.out_dir, "acquire import");
+    const nlohmann::json values = {{"photos_with_time", agreement.timed},
+                                   {"equal_consecutive_times", agreement.equal_times}};
+    if (agreement.Agree())
+      checks.Pass("order.names_and_times",
+                  std::to_string(agreement.timed) +
+                      " photos: name order and EXIF time order agree (" +
+                      std::to_string(agreement.equal_times) +
+                      " consecutive pairs with the same time, to the second)",
+                  values);
+    else
+      checks.Warn("order.names_and_times",
+                  o.photos_dir + "/" + agreement.later + ": EXIF time " + agreement.later_time +
+                      " is before that of " + agreement.earlier + " (" + agreement.earlier_time +
+                      "), which comes before it by name: the photos were ordered by their time "
+                      "(--order capture)",
+                  values);
+    checks.Save();
+  }
   report.photos = int(ds.photos.size());
   report.brackets = ds.photos.empty() ? 0 : list.MostPerSlide();
   report.missing = ds.missing_positions;

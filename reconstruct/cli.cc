@@ -17,6 +17,7 @@
 #include "core/progress.h"
 #include "core/slab_compare.h"
 #include "core/stop_signal.h"
+#include "reconstruct/capture_checks.h"
 #include "reconstruct/reconstructor.h"
 #include "reconstruct/slab_writer.h"
 
@@ -100,11 +101,14 @@ void ReportBrackets(const Position& position, const PositionReport& r, const Run
 
 // Reconstructs one position and writes it into the slab.
 void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibration,
-                     SlabWriter& writer, const Position& position, const RunConfig& config) {
+                     SlabWriter& writer, const Position& position, const RunConfig& config,
+                     CaptureChecks& checks) {
   const auto [i, j] = position;
   PositionReport r;
   const SlabPosition pos =
       ReconstructPosition(dataset, calibration, writer.info(), i, j, config.options, &r);
+  if (r.exposures > 1) ReportBrackets(position, r, config);
+  checks.AddPosition(pos, writer.info().layout, r);  // a bracket in the wrong order: exit 2
   const auto t0 = std::chrono::steady_clock::now();
   writer.Write(pos);
   r.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -113,7 +117,6 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
   if (r.saturated_pixels > 0)
     LogWarning("position ", Name(position), ": ", r.saturated_pixels, " saturated photo pixels; ",
                r.saturated_texels, " texels left out of the fit (mask 0)");
-  if (r.exposures > 1) ReportBrackets(position, r, config);
   // Outside what the slab can say: no light at all (a slab of zeros is not a measurement of
   // this luminaire), or light that varies within a texel (the bell basis needs light smooth
   // over a few texels, kUnresolvedLight).
@@ -138,13 +141,13 @@ void ProcessPosition(const Dataset& dataset, const ScreenCalibration& calibratio
 // rethrown after the positions in flight have finished. Stops picking new positions on a signal.
 void ProcessPositions(const Dataset& dataset, const ScreenCalibration& calibration,
                       SlabWriter& writer, const std::vector<Position>& todo,
-                      const RunConfig& config, Progress* progress) {
+                      const RunConfig& config, CaptureChecks& checks, Progress* progress) {
   if (todo.empty()) return;
   const int workers = std::max(1, std::min<int>(config.threads, int(todo.size())));
   cv::setNumThreads(std::max(1, config.threads / workers));
   ParallelFor(int(todo.size()), workers, [&](int k) {
     if (StopRequested()) return;
-    ProcessPosition(dataset, calibration, writer, todo[k], config);
+    ProcessPosition(dataset, calibration, writer, todo[k], config, checks);
     if (progress) progress->Advance(1, "pos " + Name(todo[k]));
   });
 }
@@ -171,8 +174,12 @@ bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, cons
   if (skipped > 0)
     LogInfo(skipped, " position(s) already in ", writer.dir(), " (use --force to redo them)");
   Progress progress("reconstruct", int(todo.size()));
-  ProcessPositions(dataset, calibration, writer, todo, config, &progress);
+  CaptureChecks checks(dataset);
+  ProcessPositions(dataset, calibration, writer, todo, config, checks, &progress);
   progress.Finish();
+  // The photos checked against each other over the whole slab (exit 2 before a staged slab
+  // replaces the previous one).
+  if (!StopRequested()) checks.Finish(writer.dir(), writer.info());
   if (StopRequested() && dir == dataset.Path("slab"))
     LogWarning("interrupted: slab is partial (", writer.PresentCount(), "/", dataset.grid.count(),
                " positions); run again to continue");
@@ -261,6 +268,7 @@ int RunWatch(RunConfig config) {
   SlabWriter writer(dataset, config.options.resolution, config.force, "",
                     config.options.radiometry->units);
   Progress progress("reconstruct --watch", dataset.grid.count());
+  CaptureChecks checks(dataset);
   progress.Advance(writer.PresentCount());
   auto last_new = std::chrono::steady_clock::now();
   while (!writer.Complete() && !StopRequested()) {
@@ -275,7 +283,7 @@ int RunWatch(RunConfig config) {
     for (const auto& p : Missing(dataset, writer))
       if (PhotosReady(dataset, p.first, p.second)) ready.push_back(p);
     if (!ready.empty()) {
-      ProcessPositions(dataset, calibration, writer, ready, config, &progress);
+      ProcessPositions(dataset, calibration, writer, ready, config, checks, &progress);
       last_new = std::chrono::steady_clock::now();
       continue;
     }
@@ -293,6 +301,7 @@ int RunWatch(RunConfig config) {
                " positions); run again to continue");
     return 1;
   }
+  checks.Finish(writer.dir(), writer.info());
   LogInfo("slab: ", writer.dir(), " (complete, ", dataset.grid.count(), " positions)");
   ReportAgainstTruth(config.dataset_dir, writer.dir());
   return 0;

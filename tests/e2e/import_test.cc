@@ -187,13 +187,22 @@ TEST_F(Import, ExifGivesOrderExposureAndCamera) {
     EXPECT_EQ(e.positive, k % 2 == 0) << e.file;
     EXPECT_EQ(std::make_pair(e.i, e.j), ScanPosition(ds.grid, "rows", int(k / 2))) << e.file;
   }
-  // Name order is not the capture order: the same photos by name land elsewhere.
-  Ok("lumislab-acquire", "import --photos jpeg --setup setup.json --out by_name --order name");
-  const Dataset by_name = Dataset::Load(root_ + "/by_name");
-  size_t differ = 0;
-  for (size_t k = 0; k < names_.size(); ++k)
-    differ += by_name.photos[k].file != imported.photos[k].file;
-  EXPECT_EQ(differ, names_.size());
+  // Name order is not the capture order, and the EXIF times say so: --order name is refused
+  // naming the first pair taken the other way round (order.names_and_times), nothing written.
+  // (By name DSC_0001, taken last, comes first: DSC_0002 is the first photo taken before the one
+  // named before it.)
+  const auto n =
+      RunToolIn(root_, "lumislab-acquire",
+                "import --photos jpeg --setup setup.json --out by_name --order name", 60);
+  EXPECT_EQ(n.exit_code, 2) << n.output;
+  for (const std::string& part : {"jpeg/" + jpegs[10] + ": EXIF DateTimeOriginal",
+                                  "taken after " + jpegs[11], std::string("--order capture")})
+    EXPECT_NE(n.output.find(part), std::string::npos) << part << "\n" << n.output;
+  EXPECT_FALSE(fs::exists(root_ + "/by_name"));
+  // --order capture records the names' disagreement as a warning (a counter that wrapped).
+  const std::string checks = ReadBinaryFile(root_ + "/ds/checks.json");
+  EXPECT_NE(checks.find("order.names_and_times"), std::string::npos) << checks;
+  EXPECT_NE(checks.find("\"warning\""), std::string::npos) << checks;
 
   // Another camera model among them.
   exif.model = "Synthetic 2";

@@ -1,0 +1,73 @@
+// The photos of a capture checked against each other while reconstruct reads them
+// (docs/verifies.md, "The photos of a capture"), recorded in <dataset>/checks.json under the
+// stage "reconstruct" (core/checks.h):
+//
+//  * brackets.exposure_order: within a slide's bracket the longer recorded exposure has the
+//    larger values at the pixels well exposed in both (the ratio the merge estimates from the
+//    pixels, reconstruct/bracket_ratios.h); a bracket whose pixels say the other order is
+//    exit 2, naming the two photos.
+//  * slides.sign: the two slides of a position are T+ and T- of the same light (docs/method.md
+//    §2.5), so E = peak (E+ - E-) summed over the screen is the light through Phi~_ij: positive
+//    at the positions that carry the luminaire's light, negative only under the filter's
+//    negative lobes, and there at most 0.16 of the brightest position's. A position whose light
+//    is mostly negative and more than 0.5 of that is exit 2, naming its two photos: the slides
+//    look swapped (in dataset.json, or every photo shifted by one in the import). A grid one
+//    position wide cannot tell (light beyond it is negative everywhere): a warning there.
+//  * positions.shift: neighbouring positions see shifted copies of one light field, to first
+//    order: the light through a filter centre c lands around c + d tan(its direction), so its
+//    centroid on the screen (luminaire frame) moves with the grid index. A neighbour pair whose
+//    centroid moves against the grid by more than 4 spacings is a warning (photos of another
+//    position?); a converging luminaire could mean it. (A list shifted by a whole position
+//    shows only where the scan wraps, and only where those positions are lit.)
+#pragma once
+
+#include <map>
+#include <mutex>
+#include <string>
+#include <utility>
+
+#include "core/checks.h"
+#include "core/dataset.h"
+#include "core/slab.h"
+#include "reconstruct/reconstructor.h"
+
+namespace lumislab {
+
+// The light of one position's slab image, over its seen texels, channels summed.
+struct PositionLight {
+  int i = 0, j = 0;
+  double positive = 0, negative = 0;  // sums of E above 0 and of -E below 0 (E x texels)
+  double centre_s = 0, centre_t = 0;  // mm, luminaire frame: the |E|-weighted centroid
+  double Flux() const { return positive - negative; }
+  double Magnitude() const { return positive + negative; }
+};
+PositionLight MeasureLight(const SlabPosition& position, const SlabLayout& layout);
+
+class CaptureChecks {
+ public:
+  explicit CaptureChecks(const Dataset& dataset);
+  // One position reconstructed (from any thread): its brackets' order checked at once (exit 2
+  // naming the photos), its light kept for Finish.
+  void AddPosition(const SlabPosition& position, const SlabLayout& layout,
+                   const PositionReport& report);
+  // The positions of `slab_dir` that an earlier run reconstructed read back (so that a run
+  // resumed after a failure checks them again), slides.sign and positions.shift over all
+  // positions, and the record saved.
+  void Finish(const std::string& slab_dir, const SlabInfo& info);
+
+ private:
+  void CheckSlideSigns();
+  void CheckNeighbours();
+  std::string SlidePhotos(int i, int j) const;  // "<p photo> and <n photo>"
+
+  const Dataset& dataset_;
+  CheckLog log_;
+  std::mutex mutex_;
+  std::map<std::pair<int, int>, PositionLight> light_;  // (j, i): grid order
+  // brackets.exposure_order: the smallest log(estimated) / log(recorded) ratio met, where.
+  double order_fraction_ = 1e300;
+  std::string order_where_;
+  int brackets_ = 0;
+};
+
+}  // namespace lumislab

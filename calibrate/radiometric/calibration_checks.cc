@@ -125,8 +125,10 @@ constexpr double kFlatStructureWarn = 0.01;
 
 // The reference point's signal (Y+ - Y-) against the position's peak luminance through T+.
 // Measured: 0.5 - 1 at the synthetic and real-camera reference points (the centre of the
-// luminaire's pattern). At a point under 2 % of the peak the difference is the photos' noise.
-constexpr double kPointMinFraction = 0.02;
+// luminaire's pattern); a point in the pattern's dark surround (500, 500 mm on the real-camera
+// JPEG capture): 0.0003, a scale 1000 times too large. Under 2 % of the peak the photos' noise
+// and ambient light weigh in the difference (warned); under 0.2 % the difference is noise.
+constexpr double kPointWarnFraction = 0.02, kPointFailFraction = 0.002;
 // The brackets of one slide at the point (per unit exposure, those above kBracketMinLevel of full
 // scale at capture): largest over smallest. Measured: 1.00 - 1.02 on the real-camera JPEG and
 // RAW chains. A response curve or dark map that does not fit the photos shows here first.
@@ -351,12 +353,19 @@ void CheckScale(const nlohmann::json& report, double scale, CheckLog* checks) {
                     {"value_p", value_p},
                     {"value_n", value_n},
                     {"peak_value_p", peak},
-                    {"warn_below", kPointMinFraction}};
-  if (fraction < kPointMinFraction)
+                    {"warn_below", kPointWarnFraction},
+                    {"fail_below", kPointFailFraction}};
+  const std::string weak = reference + ": point_mm: the photos' signal there (Y+ - Y-) is " +
+                           Num(100 * fraction, 3) + " % of the position's peak";
+  if (fraction < kPointFailFraction)
+    checks->Fail("scale.point_lit",
+                 weak + ": the photos see no light of the luminaire there, the scale would be "
+                        "their noise; take the reading where the light is strong",
+                 lit);
+  if (fraction < kPointWarnFraction)
     checks->Warn("scale.point_lit",
-                 reference + ": point_mm: the photos' signal there (Y+ - Y-) is " +
-                     Num(100 * fraction, 3) + " % of the position's peak: the scale rests on "
-                     "the photos' noise; take the reading where the light is strong",
+                 weak + ": noise and ambient light weigh in the scale; take the reading where "
+                        "the light is strong",
                  lit);
   else
     checks->Pass("scale.point_lit",

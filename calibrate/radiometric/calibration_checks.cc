@@ -150,9 +150,8 @@ constexpr double kDatasetScaleWarn = 2;
 void CheckExposureOrder(const std::vector<CalibrationFrame>& frames, CheckLog* checks) {
   std::vector<size_t> order(frames.size());
   for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return frames[a].exposure < frames[b].exposure;
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return frames[a].exposure < frames[b].exposure; });
   std::vector<cv::Mat> values(frames.size());
   for (size_t k = 0; k < frames.size(); ++k) values[k] = SampledValues(frames[k].photo);
   json pairs = json::array();
@@ -177,7 +176,8 @@ void CheckExposureOrder(const std::vector<CalibrationFrame>& frames, CheckLog* c
   if (worst >= kOrderWarn) {
     checks->Pass("response.exposure_order",
                  "the frames' pixels get brighter in the order of the stated exposures (worst "
-                 "pair: " + Num(100 * worst, 3) + " % of the changing pixels)",
+                 "pair: " +
+                     Num(100 * worst, 3) + " % of the changing pixels)",
                  values_json);
     return;
   }
@@ -212,8 +212,10 @@ void CheckExposureOrder(const std::vector<CalibrationFrame>& frames, CheckLog* c
   }
   values_json["implied_order"] = implied_json;
   checks->Fail("response.exposure_order",
-               message + ": the stated exposures contradict the pixels, which put the frames in "
-                         "the order (darkest first) " + implied_text +
+               message +
+                   ": the stated exposures contradict the pixels, which put the frames in "
+                   "the order (darkest first) " +
+                   implied_text +
                    " (were --exposures given in another order than --frames, e.g. a shell "
                    "glob's ev+1 before ev-1?)",
                values_json);
@@ -237,17 +239,18 @@ void CheckResponseFit(const nlohmann::json& report, CheckLog* checks) {
     return;
   }
   const json& p = *worst_pair;
-  const std::string message =
-      p["brighter"].get<std::string>() + ": exposure: the frames linearised by the fitted curve "
-      "give it " + Num(p["implied_ratio"].get<double>()) + " times the exposure of " +
-      p["darker"].get<std::string>() + ", stated " + Num(p["stated_ratio"].get<double>()) +
-      " (report.pairs of calib/response.json lists every pair)";
+  const std::string message = p["brighter"].get<std::string>() +
+                              ": exposure: the frames linearised by the fitted curve "
+                              "give it " +
+                              Num(p["implied_ratio"].get<double>()) + " times the exposure of " +
+                              p["darker"].get<std::string>() + ", stated " +
+                              Num(p["stated_ratio"].get<double>()) +
+                              " (report.pairs of calib/response.json lists every pair)";
   if (worst > kFitFail)
     checks->Fail("response.fit_explains_frames",
                  message + ": no curve explains these frames with these exposures", values);
   checks->Warn("response.fit_explains_frames",
-               message + ": the curve sits off its own data; check the stated exposures",
-               values);
+               message + ": the curve sits off its own data; check the stated exposures", values);
 }
 
 void CheckDarkFrames(const std::vector<CalibrationFrame>& frames, CheckLog* checks) {
@@ -257,14 +260,14 @@ void CheckDarkFrames(const std::vector<CalibrationFrame>& frames, CheckLog* chec
   for (const CalibrationFrame& f : frames) {
     cv::Mat gray = LinearGray(f.photo), filtered, blocks;
     cv::medianBlur(gray, filtered, 5);
-    cv::resize(filtered, blocks,
-               cv::Size(std::max(1, gray.cols / kDarkBlockPx), std::max(1, gray.rows / kDarkBlockPx)),
-               0, 0, cv::INTER_AREA);
+    cv::resize(
+        filtered, blocks,
+        cv::Size(std::max(1, gray.cols / kDarkBlockPx), std::max(1, gray.rows / kDarkBlockPx)), 0,
+        0, cv::INTER_AREA);
     const std::vector<float> b(blocks.begin<float>(), blocks.end<float>());
     const double level = Percentile(b, 0.5), structure = Percentile(b, 0.99) - level;
     per_frame.push_back({{"file", f.photo.path}, {"level", level}, {"structure", structure}});
-    if (!worst_frame || level > worst_level || structure > worst_structure)
-      worst_frame = &f;
+    if (!worst_frame || level > worst_level || structure > worst_structure) worst_frame = &f;
     worst_level = std::max(worst_level, level);
     worst_structure = std::max(worst_structure, structure);
   }
@@ -309,8 +312,8 @@ void CheckFlatSignal(const std::string& file, double level, CheckLog* checks) {
   if (!(level >= kFlatMinLevel))
     checks->Fail("flat.has_signal",
                  file + ": pixel data: expected a lit screen (mean level at least " +
-                     Num(100 * kFlatMinLevel, 2) + " % of full scale), got " +
-                     Num(100 * level, 3) + " %: a dark frame, not a flat",
+                     Num(100 * kFlatMinLevel, 2) + " % of full scale), got " + Num(100 * level, 3) +
+                     " %: a dark frame, not a flat",
                  values);
   checks->Pass("flat.has_signal",
                "flat frames at " + Num(100 * level, 3) + " % of full scale on the screen", values);
@@ -335,9 +338,10 @@ void CheckFlat(const nlohmann::json& report, CheckLog* checks) {
   if (!(spread <= kFlatSpreadFail))
     checks->Fail("flat.is_flat",
                  first + ": pixel data: expected a uniformly lit screen, got a gain that spans " +
-                     Num(spread, 3) + " times over the screen (vignetting and a screen's "
-                     "non-uniformity stay within " + Num(kFlatSpreadFail) +
-                     "): a pattern of light (a slide photo?), not a flat",
+                     Num(spread, 3) +
+                     " times over the screen (vignetting and a screen's "
+                     "non-uniformity stay within " +
+                     Num(kFlatSpreadFail) + "): a pattern of light (a slide photo?), not a flat",
                  values);
   if (spread > kFlatSpreadWarn || structured > kFlatStructureWarn) {
     checks->Warn("flat.is_flat",
@@ -366,19 +370,21 @@ void CheckScale(const nlohmann::json& report, double scale, CheckLog* checks) {
                            Num(100 * fraction, 3) + " % of the position's peak";
   if (fraction < kPointFailFraction)
     checks->Fail("scale.point_lit",
-                 weak + ": the photos see no light of the luminaire there, the scale would be "
-                        "their noise; take the reading where the light is strong",
+                 weak +
+                     ": the photos see no light of the luminaire there, the scale would be "
+                     "their noise; take the reading where the light is strong",
                  lit);
   if (fraction < kPointWarnFraction)
     checks->Warn("scale.point_lit",
-                 weak + ": noise and ambient light weigh in the scale; take the reading where "
-                        "the light is strong",
+                 weak +
+                     ": noise and ambient light weigh in the scale; take the reading where "
+                     "the light is strong",
                  lit);
   else
-    checks->Pass("scale.point_lit",
-                 "signal at the reference point " + Num(100 * fraction, 3) +
-                     " % of the position's peak",
-                 lit);
+    checks->Pass(
+        "scale.point_lit",
+        "signal at the reference point " + Num(100 * fraction, 3) + " % of the position's peak",
+        lit);
   double spread = 1;
   for (const char* slide : {"bracket_values_p", "bracket_values_n"}) {
     double lo = 0, hi = 0;
@@ -395,14 +401,16 @@ void CheckScale(const nlohmann::json& report, double scale, CheckLog* checks) {
                          {"n", report["bracket_values_n"]}};
   if (spread > kBracketWarn)
     checks->Warn("scale.brackets_agree",
-                 reference + ": the brackets of one slide disagree at the reference point by a "
-                 "factor " + Num(spread) + " per unit exposure: the response curve or dark map "
-                 "does not fit these photos",
+                 reference +
+                     ": the brackets of one slide disagree at the reference point by a "
+                     "factor " +
+                     Num(spread) +
+                     " per unit exposure: the response curve or dark map "
+                     "does not fit these photos",
                  brackets);
   else
     checks->Pass("scale.brackets_agree",
-                 "the brackets agree at the reference point to a factor " + Num(spread),
-                 brackets);
+                 "the brackets agree at the reference point to a factor " + Num(spread), brackets);
   if (report.contains("dataset_scale_w_m2")) {
     const double expected = report["dataset_scale_w_m2"];
     const double ratio = scale / expected;

@@ -27,7 +27,7 @@ namespace lumislab {
 // `checks` (optional): flat.has_signal is checked there before the gain is formed
 // (calibration_checks.h); a frame without light fails it.
 FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset& dataset,
-                      const ScreenCalibration& screen, nlohmann::json* report,
-                      double smooth_px = 0, CheckLog* checks = nullptr);
+                      const ScreenCalibration& screen, nlohmann::json* report, double smooth_px = 0,
+                      CheckLog* checks = nullptr);
 
 }  // namespace lumislab

@@ -113,8 +113,6 @@ double PeakLuminance(const Photo& photo) {
 
 }  // namespace
 
-
-
 RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration& screen,
                                 const ScaleReference& reference,
                                 const std::shared_ptr<const PhotoCorrections>& corrections,

@@ -31,7 +31,8 @@ CalibrationFrame Frame(const std::string& name, double e, double spot = 0, doubl
       const double ramp = base >= 0 ? base : 0.02 + 0.28 * x / 95.0;
       const bool in_spot = std::hypot(x - 48, y - 32) < 14;
       for (int c = 0; c < 3; ++c)
-        img.data[(size_t(y) * 96 + x) * 3 + c] = float(std::min(1.0, (ramp + (in_spot ? spot : 0)) * e));
+        img.data[(size_t(y) * 96 + x) * 3 + c] =
+            float(std::min(1.0, (ramp + (in_spot ? spot : 0)) * e));
     }
   const std::string path = dir + "/" + name + ".png";
   WritePhoto(path, img, PhotoEncoding::kLinear16Png);

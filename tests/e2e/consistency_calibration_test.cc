@@ -54,8 +54,8 @@ class ConsistencyCalibration : public ::testing::Test {
               SceneJson(3, 3, kCamera,
                         std::string(kEffects) + ", \"calibration_captures\": " + kCaptures));
     ds_ = dir_ + "/ds";
-    const auto r = RunTool("lumislab-acquire", "synth --scene " + dir_ + "/scene.json --out " + ds_ +
-                                                   " --truth-resolution 20");
+    const auto r = RunTool("lumislab-acquire", "synth --scene " + dir_ + "/scene.json --out " +
+                                                   ds_ + " --truth-resolution 20");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     // A JPEG camera clips at 0.95 of full scale (tests/e2e/real_camera_chain.h).
     nlohmann::json d = nlohmann::json::parse(ReadBinaryFile(ds_ + "/dataset.json"));
@@ -128,9 +128,8 @@ TEST_F(ConsistencyCalibration, LegitimateChainPassesEveryCheck) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
   using Map = std::map<std::string, std::string>;
-  EXPECT_EQ(Outcomes("calibrate response"),
-            (Map{{"response.exposure_order", "passed"},
-                 {"response.fit_explains_frames", "passed"}}));
+  EXPECT_EQ(Outcomes("calibrate response"), (Map{{"response.exposure_order", "passed"},
+                                                 {"response.fit_explains_frames", "passed"}}));
   EXPECT_EQ(Outcomes("calibrate dark"), (Map{{"dark.is_dark", "passed"}}));
   EXPECT_EQ(Outcomes("calibrate flat"),
             (Map{{"flat.has_signal", "passed"}, {"flat.is_flat", "passed"}}));
@@ -208,8 +207,9 @@ TEST_F(ConsistencyCalibration, LightIsNotADarkFrameAndDarkIsNotAFlat) {
 // their noise.
 TEST_F(ConsistencyCalibration, ScaleAtAnUnlitPointIsRefused) {
   WriteTrueScreen();
-  const auto r = Calibrate("scale", " --position 1,1 --point-mm 500,-500 --reading-p 1 "
-                                    "--reading-n 0.5");
+  const auto r = Calibrate("scale",
+                           " --position 1,1 --point-mm 500,-500 --reading-p 1 "
+                           "--reading-n 0.5");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("command line: point_mm"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("[scale.point_lit]"), std::string::npos) << r.output;

@@ -3,9 +3,11 @@
 #include <filesystem>
 #include <sstream>
 
+#include "calibrate/radiometric/calibration_checks.h"
 #include "calibrate/radiometric/calibration_frames.h"
 #include "calibrate/radiometric/flat_calibrator.h"
 #include "core/atomic_file.h"
+#include "core/checks.h"
 #include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -92,10 +94,13 @@ int RunDark(const RadiometricCommand& c, const Dataset& dataset) {
   f.corrections = Corrections(dataset, {false, true, false}, "dark");
   const std::vector<CalibrationFrame> frames = DecodeCalibrationFrames(dataset, f);
   NoteSrgbCurve("dark", frames[0].photo);
+  CheckLog checks(dataset.dir, "calibrate dark");
+  CheckDarkFrames(frames, &checks);
   nlohmann::json report;
   const DarkMap map = CalibrateDark(frames, c.dark_options, &report);
   MakeCalib(dataset);
   SaveDarkMap(out, map, report);
+  checks.Save();
   LogInfo("dark: ", c.frames.size(), " frame(s), ", report["exposures"].size(), " exposure(s) -> ",
           map.current.empty() ? "constant level" : "offset + current", "; mean level ",
           report["mean_black_level"].get<double>(), ", ", map.hot_count,
@@ -110,6 +115,8 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
   if (frames.size() < 2)
     throw BadInput("--frames: expected at least 2 bracketed frames, got " +
                    std::to_string(frames.size()));
+  CheckLog checks(dataset.dir, "calibrate response");
+  CheckExposureOrder(frames, &checks);
   std::string out;
   if (!frames[0].photo.EightBitCodes()) {
     // Linear data: nothing to recover, only to verify.
@@ -119,6 +126,7 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
     report["kind"] = "linearity";
     MakeCalib(dataset);
     WriteJsonAtomically(out, report);
+    checks.Save();
     LogInfo("response: ", frames[0].photo.CodeBits(),
             "-bit frames are linear data: no curve recovered; value / exposure deviates from the "
             "middle exposure's by at most ",
@@ -128,8 +136,10 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
   if (!Prepare(dataset, "response.json", c.force, &out)) return 0;
   nlohmann::json report;
   const ResponseCurve curve = CalibrateResponse(frames, c.response_options, &report);
+  CheckResponseFit(report, &checks);
   MakeCalib(dataset);
   SaveResponseCurve(out, curve, report);
+  checks.Save();
   const nlohmann::json& dev = report["channel_deviation"];
   LogInfo("response: ", report["curves"].get<std::string>(), " from ",
           report["samples"][0].get<int>() + report["samples"][1].get<int>() +
@@ -153,9 +163,12 @@ int RunFlat(const RadiometricCommand& c, const Dataset& dataset) {
   const std::vector<CalibrationFrame> frames = DecodeCalibrationFrames(dataset, f);
   NoteSrgbCurve("flat", frames[0].photo);
   nlohmann::json report;
-  const FlatMap map = CalibrateFlat(frames, dataset, screen, &report, c.flat_smooth_px);
+  CheckLog checks(dataset.dir, "calibrate flat");
+  const FlatMap map = CalibrateFlat(frames, dataset, screen, &report, c.flat_smooth_px, &checks);
+  CheckFlat(report, &checks);
   MakeCalib(dataset);
   SaveFlatMap(out, map, report);
+  checks.Save();
   LogInfo("flat: ", c.frames.size(), " frame(s); gain ", report["min_gain"].get<double>(), " .. ",
           report["max_gain"].get<double>(), " over ", report["screen_pixels"].get<long long>(),
           " screen pixels -> ", out);
@@ -191,8 +204,11 @@ int RunScale(const RadiometricCommand& c, const Dataset& dataset) {
   nlohmann::json report;
   const RadiometricScale scale =
       CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report);
+  CheckLog checks(dataset.dir, "calibrate scale");
+  CheckScale(report, scale.scale, &checks);
   MakeCalib(dataset);
   SaveRadiometricScale(out, scale, report);
+  checks.Save();
   if (report.value("photos_through_srgb_curve", false))
     LogInfo(
         "scale: the photos' codes were linearised through the sRGB curve (no "

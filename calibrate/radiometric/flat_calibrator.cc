@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calibrate/radiometric/calibration_checks.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -19,7 +20,6 @@ namespace {
 // (sigma kSmoothFraction of the image width) by more than kStructureTolerance in some channel.
 // The frames' noise (about 1 % per pixel for 8-bit flats) stays far below the tolerance.
 constexpr double kStructureTolerance = 0.2;
-constexpr double kMaxStructuredFraction = 0.01;
 constexpr double kSmoothFraction = 0.01;
 constexpr int kBorderPx = 3;
 
@@ -54,7 +54,8 @@ double StructuredFraction(const ImageF& gain, const std::vector<uint8_t>& on_scr
 }  // namespace
 
 FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset& dataset,
-                      const ScreenCalibration& screen, nlohmann::json* report, double smooth_px) {
+                      const ScreenCalibration& screen, nlohmann::json* report, double smooth_px,
+                      CheckLog* checks) {
   const int w = frames[0].photo.pixels.cols, h = frames[0].photo.pixels.rows;
   const size_t n = size_t(w) * h;
   // Pixels that see the screen.
@@ -78,6 +79,10 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
   // frames are overexposed.
   constexpr double kMaxClippedFraction = 1e-3;
   std::vector<uint8_t> clipped_any(n, 0);
+  // The frames' mean level on the screen at their own exposures (fraction of full scale): a
+  // flat has light (calibration_checks.h, flat.has_signal).
+  double level_sum = 0;
+  long long level_n = 0;
   for (const auto& f : frames) {
     const LinearReader reader(f.photo);
     long long clipped_pixels = 0;
@@ -90,6 +95,8 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
         if (on_screen[p] && !(dark && dark->hot[p]) && (clipped[0] || clipped[1] || clipped[2]))
           ++clipped_pixels, clipped_any[p] = 1;
         for (int c = 0; c < 3; ++c) sum[p * 3 + c] += v[c], sum2[p * 3 + c] += double(v[c]) * v[c];
+        if (on_screen[p] && !(dark && dark->hot[p]))
+          level_sum += (v[0] + v[1] + v[2]) / 3 * f.exposure, ++level_n;
       }
     if (double(clipped_pixels) > kMaxClippedFraction * double(screen_pixels))
       throw InputError(
@@ -109,6 +116,8 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
     for (int c = 0; c < 3; ++c) mean[c] += sum[p * 3 + c] / frames_n;
     ++used;
   }
+  const double mean_level = level_n ? level_sum / double(level_n) : 0.0;
+  if (checks) CheckFlatSignal(frames[0].photo.path, mean_level, checks);
   for (double& m : mean) {
     m /= double(std::max<size_t>(used, 1));
     if (!(m > 0))
@@ -139,12 +148,21 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
     }
   }
   const double structured = StructuredFraction(map.gain, on_screen, dark, w, h);
-  if (structured > kMaxStructuredFraction)
-    LogWarning("flat: ", Num(100 * structured, 2), " % of the screen's pixels (",
-               frames[0].photo.path, ", ...) differ from the smooth gain around them by more than ",
-               Num(100 * kStructureTolerance, 2),
-               " %: vignetting and a screen's non-uniformity are smooth, so these frames may not "
-               "show the uniformly lit screen (a light pattern, a shadow, an object in view)");
+  // The spread of the gain over the screen (the channels' mean, 1st and 99th percentile): a
+  // lens's vignetting times a screen's non-uniformity stays within a few stops; a pattern of
+  // light leaves parts of the screen near zero (calibration_checks.h, flat.is_flat).
+  std::vector<float> gains;
+  for (size_t p = 0; p < n; ++p)
+    if (on_screen[p] && !(dark && dark->hot[p]))
+      gains.push_back((map.gain.data[p * 3] + map.gain.data[p * 3 + 1] + map.gain.data[p * 3 + 2]) /
+                      3);
+  const auto percentile = [&](double q) {
+    const size_t k = std::min(gains.size() - 1, size_t(q * double(gains.size())));
+    std::nth_element(gains.begin(), gains.begin() + long(k), gains.end());
+    return double(gains[k]);
+  };
+  const double gain_p01 = gains.empty() ? 1.0 : percentile(0.01);
+  const double gain_p99 = gains.empty() ? 1.0 : percentile(0.99);
   if (smooth_px > 0) {
     // Normalised convolution: blur(gain * mask) / blur(mask) over the pixels that count.
     cv::Mat gain(h, w, CV_32FC3, map.gain.data.data()), mask(h, w, CV_32FC1, 0.f);
@@ -179,6 +197,8 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
   r["clamped_values"] = clamped;
   r["clipped_pixels_at_gain_1"] = clipped_left;
   r["structured_fraction"] = structured;
+  r["mean_level"] = mean_level;
+  r["gain_percentiles_1_99"] = {gain_p01, gain_p99};
   r["noise_rms"] = noise_n ? nlohmann::json(std::sqrt(noise2 / noise_n)) : nlohmann::json();
   r["corrections_applied"] = {{"dark", dark != nullptr},
                               {"response", corrections && corrections->response != nullptr}};

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calibrate/radiometric/calibration_frames.h"
+#include "core/checks.h"
 #include "core/dataset.h"
 #include "core/screen_calibration.h"
 #include "lib/photo/radiometric_calibration.h"
@@ -23,8 +24,10 @@ namespace lumislab {
 // pull their neighbours): vignetting and a screen's non-uniformity vary over tens of pixels,
 // while the frames' noise and a JPEG's compression error vary from pixel to pixel and would be
 // divided into every photo.
+// `checks` (optional): flat.has_signal is checked there before the gain is formed
+// (calibration_checks.h); a frame without light fails it.
 FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset& dataset,
-                      const ScreenCalibration& screen, nlohmann::json* report,
-                      double smooth_px = 0);
+                      const ScreenCalibration& screen, nlohmann::json* report, double smooth_px = 0,
+                      CheckLog* checks = nullptr);
 
 }  // namespace lumislab

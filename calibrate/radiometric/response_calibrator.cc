@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "calibrate/radiometric/response_fit.h"
 #include "core/error.h"
@@ -86,13 +87,20 @@ std::vector<float> Observations(const std::vector<cv::Mat>& codes, int channel, 
 // RMS and mean of log((v_b / e_b) / (v_a / e_a)) over the channel values whose codes are in
 // [32, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent. (Below
 // code 32 a dark offset, which the curve absorbs (docs/formats.md §14), and noise dominate.)
+// `pairs` (optional) gets the same per consecutive pair, with the exposure ratio the linearised
+// frames imply, stated ratio x exp(mean): what the curve says of each bracket step.
 nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<double>& exposure,
-                           const std::array<std::array<float, 256>, 3>& curve_rgb) {
+                           const std::array<std::array<float, 256>, 3>& curve_rgb,
+                           const std::vector<std::string>& files = {},
+                           nlohmann::json* pairs = nullptr) {
   double sum = 0, sum2 = 0;
   long long n = 0;
+  if (pairs) *pairs = nlohmann::json::array();
   for (size_t a = 0; a + 1 < codes.size(); ++a) {
     const size_t b = a + 1;
     if (exposure[a] == exposure[b]) continue;
+    double pair_sum = 0, pair_sum2 = 0;
+    long long pair_n = 0;
     for (int y = 0; y < codes[a].rows; ++y)
       for (int x = 0; x < codes[a].cols; ++x) {
         const cv::Vec3b ca = codes[a].at<cv::Vec3b>(y, x), cb = codes[b].at<cv::Vec3b>(y, x);
@@ -101,9 +109,19 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
           const double va = curve_rgb[2 - c][ca[c]] / exposure[a];
           const double vb = curve_rgb[2 - c][cb[c]] / exposure[b];
           const double r = std::log(vb / va);
-          sum += r, sum2 += r * r, ++n;
+          pair_sum += r, pair_sum2 += r * r, ++pair_n;
         }
       }
+    sum += pair_sum, sum2 += pair_sum2, n += pair_n;
+    if (!pairs) continue;
+    const double mean = pair_n ? pair_sum / pair_n : 0.0;
+    pairs->push_back({{"darker", files[a]},
+                      {"brighter", files[b]},
+                      {"samples", pair_n},
+                      {"stated_ratio", exposure[b] / exposure[a]},
+                      {"implied_ratio", exposure[b] / exposure[a] * std::exp(mean)},
+                      {"mean_log_ratio", mean},
+                      {"rms_log_ratio", pair_n ? std::sqrt(pair_sum2 / pair_n) : 0.0}});
   }
   nlohmann::json j;
   j["samples"] = n;
@@ -203,7 +221,9 @@ ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
   r["frames"] = nlohmann::json::array();
   for (size_t k = 0; k < sorted.size(); ++k)
     r["frames"].push_back({{"file", sorted[k]->photo.path}, {"exposure", sorted_exposure[k]}});
-  r["consistency"] = Consistency(codes, sorted_exposure, curve.linear_of_code);
+  std::vector<std::string> files;
+  for (const auto* f : sorted) files.push_back(f->photo.path);
+  r["consistency"] = Consistency(codes, sorted_exposure, curve.linear_of_code, files, &r["pairs"]);
   r["consistency_srgb_curve"] = Consistency(codes, sorted_exposure, srgb);
   return curve;
 }

@@ -24,7 +24,8 @@ struct ResponseOptions {
 // neither clipped nor black; one curve for R, G, B unless `per_channel`. Frames must be 8-bit with
 // known exposures, at least two of them different (BadInput naming the frame and field). The curve
 // is normalised to 1 at code 255 and made strictly increasing; `report` gets how consistent the
-// frames become after linearisation (and with the sRGB curve, for comparison).
+// frames become after linearisation (and with the sRGB curve, for comparison), overall and per
+// consecutive pair ("pairs": the exposure ratio the linearised frames imply against the stated).
 ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
                                 const ResponseOptions& options, nlohmann::json* report);
 

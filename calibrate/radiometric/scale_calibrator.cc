@@ -2,7 +2,10 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include "core/error.h"
 #include "core/json.h"
@@ -53,6 +56,10 @@ ScaleReference LoadScaleReference(const std::string& path) {
 
 namespace {
 
+double Luminance(const double rgb[3]) {
+  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];  // Rec. 709, as LinearGray
+}
+
 struct SlideValue {
   double rgb[3] = {0, 0, 0};
   double exposure_sum = 0;
@@ -64,8 +71,10 @@ struct SlideValue {
 // fitted to the pixels within r of it, per channel, evaluated there (a). The fit keeps the
 // light's slope and curvature across the neighbourhood from biasing the value (a plain mean
 // over a peak reads low) while averaging the pixels' noise and a JPEG's compression error.
-// Nothing when a pixel in the neighbourhood is clipped.
-void AddPhoto(const Photo& photo, const Eigen::Vector2d& at, int r, SlideValue* out) {
+// Nothing when a pixel in the neighbourhood is clipped. Returns the photo's value (RGB, per unit
+// exposure), or nothing.
+std::optional<Eigen::Vector3d> AddPhoto(const Photo& photo, const Eigen::Vector2d& at, int r,
+                                        SlideValue* out) {
   const LinearReader reader(photo);
   Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 3> atb = Eigen::Matrix<double, 6, 3>::Zero();
@@ -78,7 +87,7 @@ void AddPhoto(const Photo& photo, const Eigen::Vector2d& at, int r, SlideValue* 
       float v[3];
       bool clipped[3];
       reader.Read(y, x, v, clipped);
-      if (clipped[0] || clipped[1] || clipped[2]) return;
+      if (clipped[0] || clipped[1] || clipped[2]) return std::nullopt;
       Eigen::Matrix<double, 6, 1> row;
       row << 1, dx, dy, dx * dx, dx * dy, dy * dy;
       ata += row * row.transpose();
@@ -89,10 +98,17 @@ void AddPhoto(const Photo& photo, const Eigen::Vector2d& at, int r, SlideValue* 
   for (int c = 0; c < 3; ++c) out->rgb[c] += coefficients(0, c) * e;
   out->exposure_sum += e;
   ++out->photos;
+  return Eigen::Vector3d(coefficients(0, 0), coefficients(0, 1), coefficients(0, 2));
 }
 
-double Luminance(const double rgb[3]) {
-  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];  // Rec. 709, as LinearGray
+// The brightest light in a photo (per unit exposure): the 99.9th percentile of its luminance, so
+// that a few hot or glinting pixels do not count.
+double PeakLuminance(const Photo& photo) {
+  const cv::Mat gray = LinearGray(photo);
+  std::vector<float> v(gray.begin<float>(), gray.end<float>());
+  const size_t k = std::min(v.size() - 1, size_t(0.999 * double(v.size())));
+  std::nth_element(v.begin(), v.begin() + long(k), v.end());
+  return v[k];
 }
 
 }  // namespace
@@ -111,6 +127,11 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
                          std::to_string(pixel.x()) + ", " + std::to_string(pixel.y()) + ")",
                      "a point outside the photo");
   SlideValue slides[2];
+  // Each photo's value at the point (luminance per unit exposure) and level (at its exposure,
+  // fraction of full scale); the T+ photos' peak (the least exposed photo's): the checks of
+  // calibration_checks.h, scale.*.
+  nlohmann::json bracket_values[2] = {nlohmann::json::array(), nlohmann::json::array()};
+  double peak_p = 0, peak_exposure = 0;
   bool srgb = false;  // codes linearised through the sRGB curve (report, and a note in the log)
   for (const PhotoEntry& e : dataset.PhotosOf(reference.i, reference.j)) {
     PhotoSpec spec = PhotoSpecOf(dataset, e);
@@ -122,7 +143,15 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
                        std::to_string(screen.image_width) + "x" +
                            std::to_string(screen.image_height) + " as calib/screen.json",
                        std::to_string(photo.pixels.cols) + "x" + std::to_string(photo.pixels.rows));
-    AddPhoto(photo, pixel, r, &slides[e.positive ? 0 : 1]);
+    const int s = e.positive ? 0 : 1;
+    if (const auto v = AddPhoto(photo, pixel, r, &slides[s])) {
+      const double y[3] = {v->x(), v->y(), v->z()};
+      bracket_values[s].push_back({{"file", photo.path},
+                                   {"value", Luminance(y)},
+                                   {"level", Luminance(y) * photo.spec.exposure}});
+    }
+    if (e.positive && (peak_exposure == 0 || photo.spec.exposure < peak_exposure))
+      peak_exposure = photo.spec.exposure, peak_p = PeakLuminance(photo);
   }
   double value[2];
   for (int s = 0; s < 2; ++s) {
@@ -159,6 +188,9 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
   j["value_p"] = value[0];
   j["value_n"] = value[1];
   j["photos_used"] = {slides[0].photos, slides[1].photos};
+  j["peak_value_p"] = peak_p;
+  j["bracket_values_p"] = bracket_values[0];
+  j["bracket_values_n"] = bracket_values[1];
   if (dataset.radiometric_scale) j["dataset_scale_w_m2"] = *dataset.radiometric_scale;
   j["corrections_applied"] = {{"dark", corrections && corrections->dark != nullptr},
                               {"response", corrections && corrections->response != nullptr},

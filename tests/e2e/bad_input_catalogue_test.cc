@@ -1733,8 +1733,11 @@ std::vector<Case> RadiometricCases() {
   v.push_back(F("frame_clipped")
                   .Do(WriteFrame("f0.png", 320, 240, 16, 1.0))
                   .Names({"f0.png", "pixel data"}));
-  v.push_back(
-      F("frame_black").Do(WriteFrame("f0.png", 320, 240, 16, 0.0)).Names({"f0.png", "pixel data"}));
+  // Refused by the check flat.has_signal, recorded in ds/checks.json (issue 28).
+  v.push_back(F("frame_black")
+                  .Do(WriteFrame("f0.png", 320, 240, 16, 0.0))
+                  .Names({"f0.png", "pixel data"})
+                  .MayChange("ds/checks.json"));
   v.push_back(F("frame_not_the_camera_size")
                   .Do(WriteFrame("f0.png", 8, 6, 16, 0.5))
                   .Names({"f0.png", "image size"}));
@@ -1801,6 +1804,47 @@ std::vector<Case> RadiometricCases() {
   v.push_back(
       Ref("unit_bogus").Do(SetJson("ref.json", "/unit", "cd/m2")).Names({"ref.json", "unit"}));
   v.push_back(Ref("missing").Do(RemovePath("ref.json")).Names({"ref.json"}));
+
+  // ---- Calibration consistency (issue 28, calibrate/radiometric/calibration_checks.h): frames
+  // that are well-formed but cannot be what the step reads. Each failure is recorded in
+  // ds/checks.json before the exit.
+  // An 8-bit 320x240 frame of a gradient scene at `gain` (a bracket of it).
+  const auto bracket = [](const std::string& file, double gain) -> Mutation {
+    return [=](const std::string& dir) {
+      cv::Mat image(240, 320, CV_8UC3);
+      for (int y = 0; y < 240; ++y)
+        for (int x = 0; x < 320; ++x)
+          for (int c = 0; c < 3; ++c)
+            image.at<cv::Vec3b>(y, x)[c] =
+                uchar(std::min(255.0, std::round(255 * gain * (0.05 + 0.6 * x / 320.0))));
+      WriteImage(dir + "/" + file, image);
+    };
+  };
+  // --exposures in another order than --frames: the brighter frame stated the shorter exposure.
+  v.push_back(C("consistency_response_exposures_swapped")
+                  .Radiometric("response --dataset ds --frames f0.png f1.png --exposures 1,4")
+                  .Do(bracket("f0.png", 1))
+                  .Do(bracket("f1.png", 0.25))
+                  .Names({"f1.png", "exposure: stated 4", "f0.png", "response.exposure_order"})
+                  .MayChange("ds/checks.json"));
+  // A slide photo given as a dark frame: light in a pattern.
+  v.push_back(C("consistency_dark_frame_is_a_slide_photo")
+                  .Radiometric("dark --dataset ds --frames ds/photos/pos_0_0_p.png")
+                  .Names({"ds/photos/pos_0_0_p.png", "dark.is_dark"})
+                  .MayChange("ds/checks.json"));
+  // An all-white frame given as a dark frame: even, but at full scale.
+  v.push_back(C("consistency_dark_frame_all_white")
+                  .Radiometric("dark --dataset ds --frames f0.png")
+                  .Do(WriteFrame("f0.png", 320, 240, 16, 0.9))
+                  .Names({"f0.png", "dark level", "dark.is_dark"})
+                  .MayChange("ds/checks.json"));
+  // A dark frame given as a flat: no light on the screen.
+  v.push_back(C("consistency_flat_frame_is_dark")
+                  .Radiometric("flat --dataset ds --frames f0.png")
+                  .Do(WriteFrame("f0.png", 320, 240, 16, 0.002))
+                  .Names({"f0.png", "pixel data", "flat.has_signal"})
+                  .MayChange("ds/checks.json"));
+  // ---- end of calibration consistency
 
   // The calib/ files as reconstruct reads them (every one is loaded before the first position).
   auto Cal = [&](const std::string& kind, const std::string& name) {

@@ -217,6 +217,21 @@ class RealCameraChain : public ::testing::Test {
     }
     return rows;
   }
+  // Every check the calibrate steps recorded in dataset folder `ds`'s checks.json passed
+  // (calibrate/radiometric/calibration_checks.h): a lab's legitimate chain trips none.
+  void ExpectCalibrationChecksPassed(const std::string& ds) {
+    const nlohmann::json j =
+        nlohmann::json::parse(ReadBinaryFile(root_ + "/" + ds + "/checks.json"));
+    int calibrate_records = 0;
+    for (const auto& [stage, record] : j["stages"].items()) {
+      if (stage.rfind("calibrate ", 0) != 0) continue;
+      for (const auto& c : record["checks"]) {
+        ++calibrate_records;
+        EXPECT_EQ(c["outcome"], "passed") << stage << ": " << c.dump();
+      }
+    }
+    EXPECT_GE(calibrate_records, 5) << j.dump();
+  }
   std::string root_;
   std::string cam_ = "cam";  // the capture the chains read
 };

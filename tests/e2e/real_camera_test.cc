@@ -37,6 +37,7 @@ TEST_F(RealCamera, JpegChainCloseToTruth) {
   Capture("cam_noisy", kJpegDark, kJpegCurve, kJpegSaturation, /*noisy=*/true);
   const SlabComparison noisy = RunChain("ds_noisy", kJpegCorrections, "", "");
   ASSERT_EQ(noisy.positions.size(), 9u);
+  ExpectCalibrationChecksPassed("ds_noisy");
   // The noise floor: the sensor's noise (its shot noise grown by the ambient light and the dark
   // current) and the curve's rounding, one JPEG code being (1/255) / C'(s) in sensor values.
   const ResponseEffect response("gamma", 2.2, 0.5, 95);
@@ -82,6 +83,7 @@ TEST_F(RealCamera, DngChainWithinOnePercentOfTruth) {
   Capture("cam", kDngDark, kDngRaw, 1.0, /*noisy=*/true);
   const SlabComparison all = RunChain("ds_0", kDngCorrections, "", "");
   ASSERT_EQ(all.positions.size(), 9u);
+  ExpectCalibrationChecksPassed("ds_0");
   // The noise floor: 14-bit codes between the DNG's black (512) and white (16383) levels; each
   // pixel samples one channel of the RGGB mosaic.
   testing::SensorNoiseModel sensor;

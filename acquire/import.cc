@@ -125,7 +125,7 @@ void CheckPositionsInTime(const ImportOptions& o, const SamplingGrid& grid,
   else
     checks.Warn("order.positions_and_times",
                 message + " (" + std::to_string(backward) + " of " + std::to_string(compared) +
-                    " consecutive positions backward)",
+                    " pairs of consecutive positions backward)",
                 values);
 }
 

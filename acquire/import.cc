@@ -117,7 +117,7 @@ void CheckPositionsInTime(const ImportOptions& o, const SamplingGrid& grid,
   if (backward == 0)
     checks.Pass("order.positions_and_times",
                 std::to_string(compared) +
-                    " consecutive positions (per slide) follow in EXIF "
+                    " pairs of consecutive positions (per slide) follow in EXIF "
                     "time the order " +
                     (!o.manifest.empty() ? "of the manifest's rows"
                                          : "of the scan (--scan " + o.scan + ")"),

@@ -1761,7 +1761,8 @@ std::vector<Case> RadiometricCases() {
   v.push_back(R("uniform_frames")
                   .Do(WriteFrame("f0.png", 8, 6, 8, 0.3))
                   .Do(WriteFrame("f1.png", 8, 6, 8, 0.3))
-                  .Names({"f0.png", "frames"}));
+                  .Names({"f0.png", "frames", "response.samples"})
+                  .MayChange("ds/checks.json"));
   v.push_back(R("frame_not_an_image").Do(WriteText("f1.png", Garbage())).Names({"f1.png"}));
   v.push_back(
       R("frames_mixed_sizes").Do(WriteFrame("f1.png", 8, 7, 8)).Names({"f1.png", "image size"}));
@@ -1776,7 +1777,8 @@ std::vector<Case> RadiometricCases() {
   };
   v.push_back(F("frame_clipped")
                   .Do(WriteFrame("f0.png", 320, 240, 16, 1.0))
-                  .Names({"f0.png", "pixel data"}));
+                  .Names({"f0.png", "pixel data", "flat.clipped"})
+                  .MayChange("ds/checks.json"));
   // Refused by the check flat.has_signal, recorded in ds/checks.json (issue 28).
   v.push_back(F("frame_black")
                   .Do(WriteFrame("f0.png", 320, 240, 16, 0.0))
@@ -1821,7 +1823,7 @@ std::vector<Case> RadiometricCases() {
   // Slide n's photo under slide p's name: Y+ = Y-, no scale can come of the readings.
   v.push_back(S("no_contrast", reading + " --reading-p 1 --reading-n 0.5")
                   .Do(CopyPath("ds/photos/pos_0_0_n.png", "ds/photos/pos_0_0_p.png"))
-                  .Names({"command line", "point_mm"})
+                  .Names({"command line", "point_mm", "scale.point_lit"})
                   .MayChange("ds/checks.json"));
   const std::string ref = "scale --dataset ds --reference ref.json";
   const json valid_ref = {{"position", {0, 0}},

@@ -16,6 +16,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/slab_compare.h"
+#include "core/slab_light.h"
 #include "core/stop_signal.h"
 #include "reconstruct/reconstructor.h"
 #include "reconstruct/slab_writer.h"
@@ -161,6 +162,15 @@ std::string CalibrationPath(const std::string& dir) { return dir + "/calib/scree
 
 void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_dir);
 
+// The complete slab's total light, recorded in the dataset's checks.json ("slab.total_light"):
+// exit 2 after writing a slab of negative light (its slides swapped) rather than exit 0.
+void CheckSlab(const std::string& dataset_dir, const std::string& slab_dir, int threads) {
+  const SlabInfo info = SlabInfo::Load(slab_dir);
+  CheckLog checks(dataset_dir, "reconstruct");
+  CheckSlabLight(info, ReadSlabPositions(slab_dir, info, threads), slab_dir, checks);
+  checks.Save();
+}
+
 // Reconstructs every position the slab in `dir` lacks; false when stopped by a signal.
 bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, const std::string& dir,
               const RunConfig& config) {
@@ -218,6 +228,7 @@ int RunBatch(RunConfig config) {
   LogInfo("slab: ", slab_dir, " (", info.present.size(), "/", dataset.grid.count(), " positions, ",
           config.options.resolution, "x", config.options.resolution, ", ", info.units, ")");
   ReportAgainstTruth(config.dataset_dir, slab_dir);
+  CheckSlab(config.dataset_dir, slab_dir, config.threads);
   return 0;
 }
 
@@ -295,6 +306,7 @@ int RunWatch(RunConfig config) {
   }
   LogInfo("slab: ", writer.dir(), " (complete, ", dataset.grid.count(), " positions)");
   ReportAgainstTruth(config.dataset_dir, writer.dir());
+  CheckSlab(config.dataset_dir, writer.dir(), config.threads);
   return 0;
 }
 

@@ -1,0 +1,100 @@
+#include "core/slab_light.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "core/log.h"
+
+namespace lumislab {
+
+namespace {
+
+// PLACEHOLDER thresholds, set from measurement below.
+constexpr double kMaxSlabNegativeShare = 0.25;
+
+}  // namespace
+
+nlohmann::json SlabLightValues(const SlabLight& light, double limit) {
+  return {{"total", light.total},
+          {"positive", light.positive},
+          {"negative", light.negative},
+          {"negative_share", light.NegativeShare()},
+          {"max_negative_share", limit},
+          {"positions", light.positions},
+          {"position_negative_share", light.PositionNegativeShare()},
+          {"negative_positions", light.negative_positions}};
+}
+
+SlabLight MeasureSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                           const Eigen::Vector3d& channel_weights) {
+  const SlabLayout& layout = info.layout;
+  const int texels = layout.res_x * layout.res_y;
+  const double area_m2 = layout.TexelW() * layout.TexelH() * 1e-6;
+  std::vector<double> texel_flux(size_t(texels), 0.0);
+  SlabLight light;
+  double lowest = 0;
+  for (size_t p = 0; p < positions.size(); ++p) {
+    const SlabPosition& pos = positions[p];
+    if (pos.irradiance.empty()) continue;
+    ++light.positions;
+    double sum = 0;
+    for (int t = 0; t < texels; ++t)
+      if (pos.mask.data[t] >= 0.5f) {
+        const double f = (channel_weights.x() * pos.irradiance.data[3 * t] +
+                          channel_weights.y() * pos.irradiance.data[3 * t + 1] +
+                          channel_weights.z() * pos.irradiance.data[3 * t + 2]) *
+                         area_m2;
+        texel_flux[t] += f;
+        sum += f;
+      }
+    (sum < 0 ? light.position_negative : light.position_positive) += std::abs(sum);
+    if (sum < 0) ++light.negative_positions;
+    if (sum < lowest) {
+      lowest = sum;
+      light.most_negative = {int(p) % info.grid.nu, int(p) / info.grid.nu};
+    }
+  }
+  for (const double f : texel_flux) {
+    light.total += f;
+    (f < 0 ? light.negative : light.positive) += std::abs(f);
+  }
+  return light;
+}
+
+SlabLight CheckSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                         const std::string& slab_dir, CheckLog& checks) {
+  const SlabLight light = MeasureSlabLight(info, positions);
+  const std::string file = slab_dir + "/slab.json";
+  const nlohmann::json values = SlabLightValues(light, kMaxSlabNegativeShare);
+  const std::string sums = "its " + std::to_string(light.positions) +
+                           " position(s) sum to " + Num(light.total, 6) + " (positive texels " +
+                           Num(light.positive, 6) + ", negative " + Num(light.negative, 6) + ")";
+  if (!(light.total > 0) || !std::isfinite(light.total))
+    checks.Fail("slab.total_light",
+                file + ": total light: expected a positive number, got " + Num(light.total, 6) +
+                    " (" + sums +
+                    "): the slides T+ and T- swapped (dataset.json photos), or a slab of no "
+                    "light; reconstruct it from photos in the right order",
+                values);
+  if (light.NegativeShare() > kMaxSlabNegativeShare)
+    checks.Fail("slab.total_light",
+                file + ": negative light: expected at most " +
+                    Num(100 * kMaxSlabNegativeShare, 3) + " % of |flux| in texels of negative " +
+                    "net light, got " + Num(100 * light.NegativeShare(), 3) + " % (" + sums +
+                    "): the slides T+ and T- swapped at some positions (dataset.json photos)",
+                values);
+  checks.Pass("slab.total_light",
+              sums + "; " + Num(100 * light.NegativeShare(), 3) + " % of |flux| negative",
+              values);
+  return light;
+}
+
+std::string DatasetOfSlab(const std::string& slab_dir) {
+  namespace fs = std::filesystem;
+  fs::path slab = fs::absolute(slab_dir).lexically_normal();
+  if (slab.filename().empty()) slab = slab.parent_path();
+  const fs::path dataset = slab.parent_path();
+  return fs::exists(dataset / "dataset.json") ? dataset.string() : std::string();
+}
+
+}  // namespace lumislab

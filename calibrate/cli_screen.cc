@@ -4,12 +4,33 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/checks.h"
 #include "core/error.h"
 #include "core/log.h"
 
 namespace lumislab {
 
 namespace {
+
+// "screen.board_mirrored": a board seen mirrored is legitimate (pinned mirrored, or photographed
+// through a translucent screen from behind) but turns the slab over: a warning, recorded.
+void CheckBoardHandedness(const Dataset& dataset, const ScreenCalibration& c,
+                          const ScreenCalibrationReport& report) {
+  CheckLog checks(dataset.dir, "calibrate screen");
+  const nlohmann::json values = {{"handedness", report.handedness},
+                                 {"unmirrored_handedness", kUnmirroredHandedness}};
+  if (MirroredBoard(report))
+    checks.Warn("screen.board_mirrored",
+                dataset.Path(c.photo) +
+                    ": the calibration board is seen mirrored (its corners run the other way "
+                    "round from a board pinned the right way round and photographed from the "
+                    "camera's side): the slab comes out mirrored, unless the lab meant it (the "
+                    "camera behind a translucent screen)",
+                values);
+  else
+    checks.Pass("screen.board_mirrored", "the board is seen the right way round", values);
+  checks.Save();
+}
 
 int RunScreen(const ScreenCommand& command, int threads) {
   std::ostringstream params;
@@ -56,6 +77,7 @@ int RunScreen(const ScreenCommand& command, int threads) {
   }
   LogInfo("rms: ", c.rms_px, " px, ", c.rms_mm, " mm on the screen (", c.method,
           "; OpenCV homography alone: ", report.initial_rms_px, " px) -> ", out);
+  CheckBoardHandedness(dataset, c, report);
   return 0;
 }
 

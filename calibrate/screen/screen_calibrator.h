@@ -51,6 +51,9 @@ struct ScreenCalibrationReport {
   double anisotropy = 0;   // worst over the corners
   double scale_ratio = 0;  // max / min local area scale
   double condition = 0;
+  // The sign of det(d screen / d image) over the board (the same at every corner, or the view is
+  // refused as folded): which way round the camera sees the board (MirroredBoard).
+  int handedness = 0;
   double initial_rms_px = 0;  // OpenCV homography, before refinement
   // With a known camera: the screen's pose (camera_from_screen: angle-axis rad, translation mm;
   // screen frame = lab x, y on the screen plane) and cv::solvePnP's RMS before Ceres.
@@ -58,6 +61,20 @@ struct ScreenCalibrationReport {
   Eigen::Matrix<double, 6, 1> pose = Eigen::Matrix<double, 6, 1>::Zero();
   double pnp_rms_px = 0;
 };
+
+// The handedness (ScreenCalibrationReport::handedness) of a board pinned the right way round on
+// the screen, its printed side towards the camera (docs/method.md: the camera looks at the
+// screen from the side away from the luminaire): image x right and y down, the board's x and y
+// (lab frame, mm) turn the other way round. Measured -1 in the synthetic lab (acquire synth)
+// and the real-camera fixtures; a board pinned mirrored, or seen through the screen, gives +1.
+inline constexpr int kUnmirroredHandedness = -1;
+
+// True when the board seen in the calibration photo is mirrored: pinned mirrored, or seen
+// through a translucent screen from behind. Legitimate, but the slab then comes out mirrored
+// unless the lab meant it (calibrate screen records a warning, "screen.board_mirrored").
+inline bool MirroredBoard(const ScreenCalibrationReport& report) {
+  return report.handedness == -kUnmirroredHandedness;
+}
 
 // `photo`: CV_32FC1 (lib/photo LinearGray), any value range. `photo_name` names the
 // photo in messages and in the result. `camera`: the calibrated camera (of the photo's size),

@@ -15,10 +15,10 @@
 #include "export/complete_slab.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/far_field.h"
+#include "lib/lightfield/far_field_light.h"
 #include "lib/lightfield/polar_plot.h"
 #include "lib/lightfield/reference_render.h"
 #include "lib/lightfield/scene_setup.h"
-#include "lib/lightfield/far_field_light.h"
 #include "lib/photo/photo_write.h"
 
 namespace lumislab {

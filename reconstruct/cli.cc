@@ -188,8 +188,8 @@ void CheckSaturationLevel(const Dataset& dataset, const std::vector<DecodedPhoto
                                  {"jpeg_saturation_level", kJpegSaturationLevel}};
   if (dataset.saturation_level > kJpegSaturationLevel)
     checks.Warn("radiometry.saturation_level",
-                dataset.Path("dataset.json") + ": radiometry.saturation_level: " +
-                    Num(dataset.saturation_level, 4) +
+                dataset.Path("dataset.json") +
+                    ": radiometry.saturation_level: " + Num(dataset.saturation_level, 4) +
                     " for JPEG photos, whose coding spreads clipped highlights below code 255: "
                     "they are merged as light (the slab a few % off); set it to " +
                     Num(kJpegSaturationLevel, 3) + " (setup.json radiometry, then import)",

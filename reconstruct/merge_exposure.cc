@@ -163,8 +163,8 @@ Exposure::Exposure(const DecodedPhoto& p, const NoiseModel& noise, double near_b
       code.spec.corrections = curve_only;
     }
     code.pixels.create(1, 1, photo.pixels.type());
-    code.pixels.setTo(cv::Scalar::all(photo.fractional_codes ? kTrustedCode * kFractionalCodeOne
-                                                              : kTrustedCode));
+    code.pixels.setTo(
+        cv::Scalar::all(photo.fractional_codes ? kTrustedCode * kFractionalCodeOne : kTrustedCode));
     float rgb[3];
     bool clipped[3];
     LinearReader(code).Read(0, 0, rgb, clipped);

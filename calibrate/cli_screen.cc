@@ -12,23 +12,26 @@ namespace lumislab {
 
 namespace {
 
-// "screen.board_mirrored": a board seen mirrored is legitimate (pinned mirrored, or photographed
-// through a translucent screen from behind) but turns the slab over: a warning, recorded.
+// "screen.board_mirrored": a board seen the other way round from the usual set-up (camera behind
+// the screen) is legitimate (a camera on the luminaire's side, a board pinned mirrored on
+// purpose) but turns the slab over if the lab did not mean it: a warning, recorded.
 void CheckBoardHandedness(const Dataset& dataset, const ScreenCalibration& c,
                           const ScreenCalibrationReport& report) {
   CheckLog checks(dataset.dir, "calibrate screen");
   const nlohmann::json values = {{"handedness", report.handedness},
-                                 {"unmirrored_handedness", kUnmirroredHandedness}};
+                                 {"usual_handedness", kUsualHandedness}};
   if (MirroredBoard(report))
     checks.Warn("screen.board_mirrored",
                 dataset.Path(c.photo) +
-                    ": the calibration board is seen mirrored (its corners run the other way "
-                    "round from a board pinned the right way round and photographed from the "
-                    "camera's side): the slab comes out mirrored, unless the lab meant it (the "
-                    "camera behind a translucent screen)",
+                    ": the calibration board is seen mirrored (its corners turn the other way "
+                    "round from the usual set-up, the board pinned the right way round and the "
+                    "camera behind the screen): the board is pinned mirrored, or the camera is on "
+                    "the luminaire's side of the screen; the slab comes out mirrored unless the "
+                    "lab meant that",
                 values);
   else
-    checks.Pass("screen.board_mirrored", "the board is seen the right way round", values);
+    checks.Pass("screen.board_mirrored",
+                "the board is seen as in the usual set-up (the camera behind the screen)", values);
   checks.Save();
 }
 

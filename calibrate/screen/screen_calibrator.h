@@ -62,18 +62,19 @@ struct ScreenCalibrationReport {
   double pnp_rms_px = 0;
 };
 
-// The handedness (ScreenCalibrationReport::handedness) of a board pinned the right way round on
-// the screen, its printed side towards the camera (docs/method.md: the camera looks at the
-// screen from the side away from the luminaire): image x right and y down, the board's x and y
-// (lab frame, mm) turn the other way round. Measured -1 in the synthetic lab (acquire synth)
-// and the real-camera fixtures; a board pinned mirrored, or seen through the screen, gives +1.
-inline constexpr int kUnmirroredHandedness = -1;
+// The handedness (ScreenCalibrationReport::handedness) of the usual set-up: the board pinned
+// the right way round on the screen, the camera behind the screen (away from the luminaire,
+// docs/formats.md "The board"), image x right and y down. Measured -1 in the synthetic lab
+// (acquire synth, the real-camera fixtures: camera at z = 2400 mm, screen at 750 mm). +1: the
+// board pinned mirrored, or the camera on the luminaire's side of the screen (a calibrate test
+// puts it at z = -520 mm).
+inline constexpr int kUsualHandedness = -1;
 
-// True when the board seen in the calibration photo is mirrored: pinned mirrored, or seen
-// through a translucent screen from behind. Legitimate, but the slab then comes out mirrored
-// unless the lab meant it (calibrate screen records a warning, "screen.board_mirrored").
+// True when the board is seen the other way round from the usual set-up. Legitimate (a camera
+// on the luminaire's side, a board pinned mirrored on purpose), but if the lab did not mean it
+// the slab comes out mirrored: calibrate screen records a warning, "screen.board_mirrored".
 inline bool MirroredBoard(const ScreenCalibrationReport& report) {
-  return report.handedness == -kUnmirroredHandedness;
+  return report.handedness == -kUsualHandedness;
 }
 
 // `photo`: CV_32FC1 (lib/photo LinearGray), any value range. `photo_name` names the

@@ -212,7 +212,8 @@ void Exercise(const Subject& s) {
   const Outcome again = run("reference_again", -1);
   if (s.vary) s.vary(false);
   ASSERT_EQ(again.exit_code, 0) << again.output;
-  const auto nondeterministic = testing::DiffSnapshots(expected, SnapshotTree(out_dir));
+  const auto nondeterministic =
+      testing::DiffSnapshots(Final(expected), Final(SnapshotTree(out_dir)));
   EXPECT_TRUE(nondeterministic.empty())
       << s.name << ": two uninterrupted runs differ (not caused by a kill):\n"
       << Lines(nondeterministic);

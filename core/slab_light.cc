@@ -55,23 +55,38 @@ SlabLight MeasureSlabLight(const SlabInfo& info, const std::vector<SlabPosition>
   return light;
 }
 
+bool TotalLightHasASign(const SlabInfo& info) { return info.grid.nu >= 2 && info.grid.nv >= 2; }
+
+void JudgeTotalLight(const std::string& check, const std::string& what, const SlabLight& light,
+                     const SlabInfo& info, const std::string& slab_dir, const std::string& sums,
+                     const nlohmann::json& values, CheckLog& checks) {
+  const std::string file = slab_dir + "/slab.json";
+  if (std::isnan(light.total) || (light.total < 0 && TotalLightHasASign(info)))
+    checks.Fail(check,
+                file + ": " + what + ": expected a positive number, got " + Num(light.total, 6) +
+                    " (" + sums +
+                    "): the slides T+ and T- swapped (dataset.json photos); reconstruct it from "
+                    "photos in the right order",
+                values);
+  if (light.total == 0) {
+    checks.Warn(check, file + ": " + what + ": 0, the slab holds no light (" + sums + ")", values);
+    return;
+  }
+  checks.Pass(
+      check,
+      sums + "; " + Num(100 * light.NegativeShare(), 3) + " % of |flux| negative" +
+          (TotalLightHasASign(info) ? "" : " (a grid of one row or column: its sign not held)"),
+      values);
+}
+
 SlabLight CheckSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                          const std::string& slab_dir, CheckLog& checks) {
   const SlabLight light = MeasureSlabLight(info, positions);
-  const std::string file = slab_dir + "/slab.json";
-  const nlohmann::json values = SlabLightValues(light);
   const std::string sums = "its " + std::to_string(light.positions) + " position(s) sum to " +
                            Num(light.total, 6) + " (positive texels " + Num(light.positive, 6) +
                            ", negative " + Num(light.negative, 6) + ")";
-  if (!(light.total > 0) || !std::isfinite(light.total))
-    checks.Fail("slab.total_light",
-                file + ": total light: expected a positive number, got " + Num(light.total, 6) +
-                    " (" + sums +
-                    "): the slides T+ and T- swapped (dataset.json photos), or a slab of no "
-                    "light; reconstruct it from photos in the right order",
-                values);
-  checks.Pass("slab.total_light",
-              sums + "; " + Num(100 * light.NegativeShare(), 3) + " % of |flux| negative", values);
+  JudgeTotalLight("slab.total_light", "total light", light, info, slab_dir, sums,
+                  SlabLightValues(light), checks);
   return light;
 }
 

@@ -222,7 +222,7 @@ IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& sla
   options.samples = c.samples;
   options.threads = threads;
   const FarField ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
-  CheckFarFieldLight(ff, slab.dir, checks);
+  CheckFarFieldLight(ff, slab.info, slab.dir, checks);
   d.values = ff.values;
   for (double& v : d.values) v = std::max(v, 0.0);  // ringing of the fit: no negative intensity
   d.photometric = Photometric(slab.info);

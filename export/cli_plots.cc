@@ -110,7 +110,7 @@ PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
   options.threads = threads;
   const std::vector<double> planes = {0, 90, 180, 270};
   const FarField far = ComputeFarField(info, positions, planes, gamma, options);
-  CheckFarFieldLight(far, o.slab_dir, checks);
+  CheckFarFieldLight(far, info, o.slab_dir, checks);
   checks.Save();
   size_t seen = 0;  // gamma[0 .. seen) seen in all four planes
   while (seen < gamma.size() && far.seen[seen] && far.seen[gamma.size() + seen] &&

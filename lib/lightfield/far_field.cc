@@ -308,8 +308,11 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
   }
   double signed_total = 0;
   for (const double f : texel_flux) signed_total += f;
-  // The caller checked the slab's light (slab_light.h CheckSlabLight: exit 2 naming the slab).
-  LUMISLAB_CHECK(signed_total > 0, "SampleSlabRays: a slab of positive total light");
+  // (CheckSlabLight refuses a negative total on grids where its sign means something; rays need
+  // a positive one on every grid.)
+  if (!(signed_total > 0))
+    throw BadInput("the slab holds no light (its seen texels sum to " +
+                   std::to_string(signed_total) + " W): no rays to draw");
   SlabRays out;
   out.total_flux = signed_total;
   out.flux_per_ray = signed_total / double(count);

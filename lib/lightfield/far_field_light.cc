@@ -47,7 +47,8 @@ SlabLight MeasureFarFieldLight(const FarField& far) {
   return light;
 }
 
-SlabLight CheckFarFieldLight(const FarField& far, const std::string& slab_dir, CheckLog& checks) {
+SlabLight CheckFarFieldLight(const FarField& far, const SlabInfo& info, const std::string& slab_dir,
+                             CheckLog& checks) {
   const SlabLight light = MeasureFarFieldLight(far);
   const std::string file = slab_dir + "/slab.json";
   nlohmann::json values = SlabLightValues(light);
@@ -57,10 +58,8 @@ SlabLight CheckFarFieldLight(const FarField& far, const std::string& slab_dir, C
   const std::string sums = "I dOmega over the seen directions " + Num(light.total, 6) +
                            " (positive " + Num(light.positive, 6) + ", negative " +
                            Num(light.negative, 6) + ")";
-  if (!(light.total > 0) || !std::isfinite(light.total))
-    checks.Fail("farfield.total_light",
-                file + ": far field: expected a positive total light, got " + sums, values);
-  checks.Pass("farfield.total_light", sums, values);
+  JudgeTotalLight("farfield.total_light", "far field's total light", light, info, slab_dir, sums,
+                  values, checks);
   if (light.NegativeShare() > kMaxFarFieldNegativeShare) {
     checks.Warn("farfield.negative_share",
                 file + ": far field: " + Num(100 * light.NegativeShare(), 3) +

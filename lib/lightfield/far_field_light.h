@@ -17,7 +17,8 @@ namespace lumislab {
 SlabLight MeasureFarFieldLight(const FarField& far);
 
 // Checks "farfield.negative_share" (a warning above kMaxFarFieldNegativeShare: the file written
-// clips those directions to 0) and "farfield.total_light" (a failure when not a positive number).
-SlabLight CheckFarFieldLight(const FarField& far, const std::string& slab_dir, CheckLog& checks);
+// clips those directions to 0) and "farfield.total_light" (JudgeTotalLight).
+SlabLight CheckFarFieldLight(const FarField& far, const SlabInfo& info, const std::string& slab_dir,
+                             CheckLog& checks);
 
 }  // namespace lumislab

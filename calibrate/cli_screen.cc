@@ -4,12 +4,36 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/checks.h"
 #include "core/error.h"
 #include "core/log.h"
 
 namespace lumislab {
 
 namespace {
+
+// "screen.board_mirrored": a board seen the other way round from the usual set-up (camera behind
+// the screen) is legitimate (a camera on the luminaire's side, a board pinned mirrored on
+// purpose) but turns the slab over if the lab did not mean it: a warning, recorded.
+void CheckBoardHandedness(const Dataset& dataset, const ScreenCalibration& c,
+                          const ScreenCalibrationReport& report) {
+  CheckLog checks(dataset.dir, "calibrate screen");
+  const nlohmann::json values = {{"handedness", report.handedness},
+                                 {"usual_handedness", kUsualHandedness}};
+  if (MirroredBoard(report))
+    checks.Warn("screen.board_mirrored",
+                dataset.Path(c.photo) +
+                    ": the calibration board is seen mirrored (its corners turn the other way "
+                    "round from the usual set-up, the board pinned the right way round and the "
+                    "camera behind the screen): the board is pinned mirrored, or the camera is on "
+                    "the luminaire's side of the screen; the slab comes out mirrored unless the "
+                    "lab meant that",
+                values);
+  else
+    checks.Pass("screen.board_mirrored",
+                "the board is seen as in the usual set-up (the camera behind the screen)", values);
+  checks.Save();
+}
 
 int RunScreen(const ScreenCommand& command, int threads) {
   std::ostringstream params;
@@ -56,6 +80,7 @@ int RunScreen(const ScreenCommand& command, int threads) {
   }
   LogInfo("rms: ", c.rms_px, " px, ", c.rms_mm, " mm on the screen (", c.method,
           "; OpenCV homography alone: ", report.initial_rms_px, " px) -> ", out);
+  CheckBoardHandedness(dataset, c, report);
   return 0;
 }
 

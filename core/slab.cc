@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/exr_io.h"
 #include "core/json.h"
+#include "core/parallel.h"
 
 namespace lumislab {
 
@@ -142,6 +143,18 @@ std::vector<std::pair<int, int>> ScanSlabPositions(const std::string& slab_dir,
         found.emplace_back(i, j);
   std::sort(found.begin(), found.end());
   return found;
+}
+
+std::vector<SlabPosition> ReadSlabPositions(const std::string& slab_dir, const SlabInfo& info,
+                                            int threads) {
+  if (info.present.empty())
+    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
+  std::vector<SlabPosition> out(size_t(info.grid.count()));
+  ParallelFor(int(info.present.size()), threads, [&](int k) {
+    const auto [i, j] = info.present[k];
+    out[size_t(info.grid.Index(i, j))] = ReadSlabPosition(slab_dir, info, i, j);
+  });
+  return out;
 }
 
 }  // namespace lumislab

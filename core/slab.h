@@ -52,4 +52,9 @@ SlabPosition ReadSlabPosition(const std::string& slab_dir, const SlabInfo& info,
 std::vector<std::pair<int, int>> ScanSlabPositions(const std::string& slab_dir,
                                                    const SlabInfo& info);
 
+// Every position the slab lists, E_ij and mask, by linear index j * nu + i (empty for the
+// others), read on `threads` threads (ReadSlabPosition: a damaged file is exit 2).
+std::vector<SlabPosition> ReadSlabPositions(const std::string& slab_dir, const SlabInfo& info,
+                                            int threads);
+
 }  // namespace lumislab

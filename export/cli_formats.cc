@@ -15,6 +15,7 @@
 #include "core/slab.h"
 #include "export/complete_slab.h"
 #include "lib/lightfield/far_field.h"
+#include "lib/lightfield/far_field_light.h"
 #include "lib/photometry/eulumdat.h"
 #include "lib/photometry/file_info.h"
 #include "lib/photometry/ies.h"
@@ -44,8 +45,9 @@ struct Slab {
   std::vector<SlabPosition> positions;
 };
 
-// The whole slab: a partial one would leave out the light of its missing positions.
-Slab LoadCompleteSlab(const std::string& path, int threads) {
+// The whole slab: a partial one would leave out the light of its missing positions. Its total
+// light is checked into `checks` (a log of the dataset holding the slab, SlabChecks).
+Slab LoadCompleteSlab(const std::string& path, int threads, CheckLog& checks) {
   Slab slab;
   slab.dir = ResolveSlabDir(path);
   slab.info = SlabInfo::Load(slab.dir);
@@ -55,7 +57,14 @@ Slab LoadCompleteSlab(const std::string& path, int threads) {
           slab.info.grid.spacing_mm, " mm, d ", slab.info.distance_mm, " mm, ",
           slab.info.layout.res_x, " x ", slab.info.layout.res_y, " texels, units ",
           slab.info.units);
+  CheckSlabLight(slab.info, slab.positions, slab.dir, checks);
   return slab;
+}
+
+// The checks of `stage` on the slab at `path` (a dataset folder or its slab/), recorded in the
+// dataset's checks.json when the slab is in one.
+CheckLog SlabChecks(const std::string& path, const std::string& stage) {
+  return CheckLog(DatasetOfSlab(ResolveSlabDir(path)), stage);
 }
 
 // cd / lm for a slab scaled with a lux meter, W/sr / W otherwise (relative: a warning).
@@ -206,12 +215,14 @@ IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
   return d;
 }
 
-IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& slab, int threads) {
+IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& slab, int threads,
+                                       CheckLog& checks) {
   IntensityDistribution d = DirectionGrid(c);
   FarFieldOptions options;
   options.samples = c.samples;
   options.threads = threads;
   const FarField ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
+  CheckFarFieldLight(ff, slab.info, slab.dir, checks);
   d.values = ff.values;
   for (double& v : d.values) v = std::max(v, 0.0);  // ringing of the fit: no negative intensity
   d.photometric = Photometric(slab.info);
@@ -248,8 +259,10 @@ int RunFarField(const FarFieldCommand& c, int threads) {
     return 0;
   }
   DirectionGrid(c);  // refuses a bad grid before the slab is read
-  const Slab slab = LoadCompleteSlab(c.slab, threads);
-  const IntensityDistribution d = SlabDistribution(c, slab, threads);
+  CheckLog checks = SlabChecks(c.slab, "export " + c.format);
+  const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
+  const IntensityDistribution d = SlabDistribution(c, slab, threads, checks);
+  checks.Save();
   if (c.format == "ies")
     WriteIes(d, c.out);
   else
@@ -306,7 +319,9 @@ int RunRays(const RayCommand& c, int threads) {
     std::printf("tm25: %s\n", c.out.c_str());
     return 0;
   }
-  const Slab slab = LoadCompleteSlab(c.slab, threads);
+  CheckLog checks = SlabChecks(c.slab, "export tm25");
+  const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
+  checks.Save();
   const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed, threads);
   Tm25RaySet set;
   set.photometric = Photometric(slab.info);

@@ -15,6 +15,7 @@
 #include "export/complete_slab.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/far_field.h"
+#include "lib/lightfield/far_field_light.h"
 #include "lib/lightfield/polar_plot.h"
 #include "lib/lightfield/reference_render.h"
 #include "lib/lightfield/scene_setup.h"
@@ -61,7 +62,14 @@ int RunIrradiance(const IrradianceOptions& o, int threads) {
   ParseFalseColourRange(o.range, "--range", &request);
   const SlabInfo info = SlabInfo::Load(o.slab_dir);
   RequireCompleteSlab(info, o.slab_dir);
-  const std::vector<ImageF> irradiance = ReadSlabIrradiance(o.slab_dir, info, threads);
+  std::vector<ImageF> irradiance;
+  {
+    std::vector<SlabPosition> positions = ReadSlabPositions(o.slab_dir, info, threads);
+    CheckLog checks(DatasetOfSlab(o.slab_dir), "export irradiance");
+    CheckSlabLight(info, positions, o.slab_dir, checks);
+    checks.Save();
+    for (SlabPosition& p : positions) irradiance.push_back(std::move(p.irradiance));
+  }
   SceneRequest scene;
   scene.name = "plane";
   scene.receiver_plane_mm = o.distance_mm;
@@ -93,6 +101,8 @@ PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
   const SlabInfo info = SlabInfo::Load(o.slab_dir);
   RequireCompleteSlab(info, o.slab_dir);
   const std::vector<SlabPosition> positions = ReadSlabPositions(o.slab_dir, info, threads);
+  CheckLog checks(DatasetOfSlab(o.slab_dir), "export polar");
+  CheckSlabLight(info, positions, o.slab_dir, checks);
   std::vector<double> gamma;
   for (int k = 0; k * o.gamma_step_deg <= 90 + 1e-9; ++k) gamma.push_back(k * o.gamma_step_deg);
   FarFieldOptions options;
@@ -100,6 +110,8 @@ PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
   options.threads = threads;
   const std::vector<double> planes = {0, 90, 180, 270};
   const FarField far = ComputeFarField(info, positions, planes, gamma, options);
+  CheckFarFieldLight(far, info, o.slab_dir, checks);
+  checks.Save();
   size_t seen = 0;  // gamma[0 .. seen) seen in all four planes
   while (seen < gamma.size() && far.seen[seen] && far.seen[gamma.size() + seen] &&
          far.seen[2 * gamma.size() + seen] && far.seen[3 * gamma.size() + seen])

@@ -16,6 +16,7 @@
 #include "core/dataset.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/slab_light.h"
 #include "core/stop_signal.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/synthetic/scene.h"
@@ -282,6 +283,18 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
     throw InputError("--bench-frames", "", "1 .. 100000", std::to_string(config.bench_frames));
 }
 
+// The light of the slab's positions there now, before anything is rendered of it
+// ("slab.total_light", recorded in the dataset's checks.json under "preview"): a slab of negative
+// light renders as a plausible dark scene. A --watch run checks the slab when it starts complete
+// (positions that arrive later are the reconstruct's, which checks the complete slab).
+void CheckSlabBeforeRendering(const PreviewConfig& config, const SlabInfo& info) {
+  if (info.present.empty() || (config.watch && !info.Complete())) return;
+  CheckLog checks(DatasetOfSlab(config.slab_dir), "preview");
+  CheckSlabLight(info, ReadSlabPositions(config.slab_dir, info, config.threads), config.slab_dir,
+                 checks);
+  checks.Save();
+}
+
 // Runs the configured preview inside a stop-signal scope (Ctrl-C ends --watch cleanly).
 int Run(const PreviewConfig& config, bool write_test_slab) {
   if (write_test_slab && !std::filesystem::exists(config.slab_dir + "/slab.json")) {
@@ -300,6 +313,7 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     return 0;
   }
   CheckReceiverPlane(config, *info);
+  if (config.analytic.empty()) CheckSlabBeforeRendering(config, *info);
   if (config.reference || !config.analytic.empty()) return RunReferenceMode(config, *info);
   return config.backend == Backend::kWindow ? RunWindow(config, *info) : RunHeadless(config, *info);
 }

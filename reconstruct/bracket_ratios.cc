@@ -67,8 +67,10 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
             // near-black floor: the ratio of two values a few codes above black is dominated by
             // their quantisation.
             const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
-            if (!(a >= 4 * exposures[order[k]].floor_u && a > 0)) continue;
-            if (!(b >= 4 * exposures[order[k + 1]].floor_u && b > 0)) continue;
+            // And at codes where the curve is trusted (kTrustedCode).
+            const Exposure &ea = exposures[order[k]], &eb = exposures[order[k + 1]];
+            if (!(a >= 4 * ea.floor_u && a >= ea.trusted_u[ch] && a > 0)) continue;
+            if (!(b >= 4 * eb.floor_u && b >= eb.trusted_u[ch] && b > 0)) continue;
             sample_ratios[k][samples[k]++] = b / a;
           }
       }

@@ -71,8 +71,8 @@ PositionLight MeasureLight(const SlabPosition& p, const SlabLayout& layout) {
   return out;
 }
 
-CaptureChecks::CaptureChecks(const Dataset& dataset)
-    : dataset_(dataset), log_(dataset.dir, "reconstruct") {}
+CaptureChecks::CaptureChecks(const Dataset& dataset, CheckLog* log)
+    : dataset_(dataset), log_(*log) {}
 
 std::string CaptureChecks::SlidePhotos(int i, int j) const {
   std::string p, n;

@@ -45,7 +45,8 @@ PositionLight MeasureLight(const SlabPosition& position, const SlabLayout& layou
 
 class CaptureChecks {
  public:
-  explicit CaptureChecks(const Dataset& dataset);
+  // Records into `log` (the run's, shared with reconstruct's other checks), which outlives this.
+  CaptureChecks(const Dataset& dataset, CheckLog* log);
   // One position reconstructed (from any thread): its brackets' order checked at once (exit 2
   // naming the photos), its light kept for Finish.
   void AddPosition(const SlabPosition& position, const SlabLayout& layout,
@@ -61,7 +62,7 @@ class CaptureChecks {
   std::string SlidePhotos(int i, int j) const;  // "<p photo> and <n photo>"
 
   const Dataset& dataset_;
-  CheckLog log_;
+  CheckLog& log_;
   std::mutex mutex_;
   std::map<std::pair<int, int>, PositionLight> light_;  // (j, i): grid order
   // brackets.exposure_order: the smallest log(estimated) / log(recorded) ratio met, where.

@@ -10,12 +10,14 @@
 #include <thread>
 
 #include "core/atomic_file.h"
+#include "core/checks.h"
 #include "core/command_line.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/slab_compare.h"
+#include "core/slab_light.h"
 #include "core/stop_signal.h"
 #include "reconstruct/capture_checks.h"
 #include "reconstruct/reconstructor.h"
@@ -164,9 +166,45 @@ std::string CalibrationPath(const std::string& dir) { return dir + "/calib/scree
 
 void ReportAgainstTruth(const std::string& dataset_dir, const std::string& slab_dir);
 
+// The complete slab's total light, recorded in the dataset's checks.json ("slab.total_light"):
+// exit 2 after writing a slab of negative light (its slides swapped) rather than exit 0.
+void CheckSlab(const std::string& slab_dir, int threads, CheckLog& checks) {
+  const SlabInfo info = SlabInfo::Load(slab_dir);
+  CheckSlabLight(info, ReadSlabPositions(slab_dir, info, threads), slab_dir, checks);
+  checks.Save();
+}
+
+// "radiometry.saturation_level": JPEG's coding error spreads clipped highlights over the codes
+// just below 255, so a saturation level of 1 (what an empty setup.json radiometry gives) merges
+// them as light. Measured on a synthetic JPEG camera (gamma curve with a shoulder, quality 95,
+// three brackets, dark offset 0.005): worst position 4.1 % from truth at 1.0, 1.7 % at 0.95
+// (tests/e2e/consistency_slab_test.cc). A lab may mean 1 (a camera whose JPEG never clips):
+// a warning, recorded, with the value to set.
+constexpr double kJpegSaturationLevel = 0.95;
+void CheckSaturationLevel(const Dataset& dataset, const std::vector<DecodedPhoto>& photos,
+                          CheckLog& checks) {
+  bool jpeg = false;
+  for (const DecodedPhoto& p : photos) jpeg = jpeg || p.photo.format == PhotoFormat::kJpeg;
+  if (!jpeg) return;
+  const nlohmann::json values = {{"saturation_level", dataset.saturation_level},
+                                 {"jpeg_saturation_level", kJpegSaturationLevel}};
+  if (dataset.saturation_level > kJpegSaturationLevel)
+    checks.Warn("radiometry.saturation_level",
+                dataset.Path("dataset.json") +
+                    ": radiometry.saturation_level: " + Num(dataset.saturation_level, 4) +
+                    " for JPEG photos, whose coding spreads clipped highlights below code 255: "
+                    "they are merged as light (the slab a few % off); set it to " +
+                    Num(kJpegSaturationLevel, 3) + " (setup.json radiometry, then import)",
+                values);
+  else
+    checks.Pass("radiometry.saturation_level",
+                "JPEG photos clipped at " + Num(dataset.saturation_level, 4) + " of full scale",
+                values);
+}
+
 // Reconstructs every position the slab in `dir` lacks; false when stopped by a signal.
 bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, const std::string& dir,
-              const RunConfig& config) {
+              const RunConfig& config, CheckLog& log) {
   SlabWriter writer(dataset, config.options.resolution, config.force, dir,
                     config.options.radiometry->units);
   const std::vector<Position> todo = Missing(dataset, writer);
@@ -174,7 +212,7 @@ bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, cons
   if (skipped > 0)
     LogInfo(skipped, " position(s) already in ", writer.dir(), " (use --force to redo them)");
   Progress progress("reconstruct", int(todo.size()));
-  CaptureChecks checks(dataset);
+  CaptureChecks checks(dataset, &log);
   ProcessPositions(dataset, calibration, writer, todo, config, checks, &progress);
   progress.Finish();
   // The photos checked against each other over the whole slab (exit 2 before a staged slab
@@ -198,9 +236,13 @@ int RunBatch(RunConfig config) {
   for (int j = 0; j < dataset.grid.nv; ++j)
     for (int i = 0; i < dataset.grid.nu; ++i) all.push_back({i, j});
   CheckPhotosExist(dataset, all);
+  // The run's consistency record (checks.json's stage "reconstruct", docs/verifies.md).
+  CheckLog checks(dataset.dir, "reconstruct");
   // Photos that do not fit the calibration (size, format) are refused before anything is
   // written: decode the first position's photos now.
-  DecodePosition(dataset, calibration, 0, 0, config.options.radiometry->corrections);
+  CheckSaturationLevel(
+      dataset, DecodePosition(dataset, calibration, 0, 0, config.options.radiometry->corrections),
+      checks);
   const std::string slab_dir = dataset.Path("slab");
   // --force over an existing slab builds the new one beside it and swaps it in when complete:
   // a failure or a stop leaves the previous slab as it was (and then nothing is resumable).
@@ -208,7 +250,7 @@ int RunBatch(RunConfig config) {
   if (staged) RemoveOrphanedTemporaries(dataset.dir);
   const std::string dir = staged ? TemporaryPathFor(slab_dir) : slab_dir;
   try {
-    if (!FillSlab(dataset, calibration, dir, config)) {
+    if (!FillSlab(dataset, calibration, dir, config, checks)) {
       if (staged) {
         fs::remove_all(dir);
         LogWarning("interrupted: the previous slab is unchanged (--force starts over)");
@@ -225,6 +267,7 @@ int RunBatch(RunConfig config) {
   LogInfo("slab: ", slab_dir, " (", info.present.size(), "/", dataset.grid.count(), " positions, ",
           config.options.resolution, "x", config.options.resolution, ", ", info.units, ")");
   ReportAgainstTruth(config.dataset_dir, slab_dir);
+  CheckSlab(slab_dir, config.threads, checks);
   return 0;
 }
 
@@ -268,7 +311,8 @@ int RunWatch(RunConfig config) {
   SlabWriter writer(dataset, config.options.resolution, config.force, "",
                     config.options.radiometry->units);
   Progress progress("reconstruct --watch", dataset.grid.count());
-  CaptureChecks checks(dataset);
+  CheckLog log(dataset.dir, "reconstruct");  // checks.json's stage (docs/verifies.md)
+  CaptureChecks checks(dataset, &log);
   progress.Advance(writer.PresentCount());
   auto last_new = std::chrono::steady_clock::now();
   while (!writer.Complete() && !StopRequested()) {
@@ -304,6 +348,7 @@ int RunWatch(RunConfig config) {
   checks.Finish(writer.dir(), writer.info());
   LogInfo("slab: ", writer.dir(), " (complete, ", dataset.grid.count(), " positions)");
   ReportAgainstTruth(config.dataset_dir, writer.dir());
+  CheckSlab(writer.dir(), config.threads, log);
   return 0;
 }
 

@@ -155,6 +155,21 @@ Exposure::Exposure(const DecodedPhoto& p, const NoiseModel& noise, double near_b
     return response ? ResponseSlope(*response, l) : TransferSlope(transfer, l);
   };
   floor_u = std::max(float(near_black_codes) * code_step * slope(black), 3.f * std::sqrt(read_var));
+  if (photo.EightBitCodes()) {  // code kTrustedCode through the curve, without per-pixel maps
+    Photo code = photo;
+    if (photo.spec.corrections) {
+      auto curve_only = std::make_shared<PhotoCorrections>();
+      curve_only->response = photo.spec.corrections->response;
+      code.spec.corrections = curve_only;
+    }
+    code.pixels.create(1, 1, photo.pixels.type());
+    code.pixels.setTo(
+        cv::Scalar::all(photo.fractional_codes ? kTrustedCode * kFractionalCodeOne : kTrustedCode));
+    float rgb[3];
+    bool clipped[3];
+    LinearReader(code).Read(0, 0, rgb, clipped);
+    for (int c = 0; c < 3; ++c) trusted_u[c] = rgb[c] * recorded;
+  }
   curved = transfer == Transfer::kSrgb || response != nullptr;
   for (int k = 0; k < kQuantTable; ++k) {
     const float q = code_step * slope(float(k) / (kQuantTable - 1));

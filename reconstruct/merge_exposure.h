@@ -30,6 +30,10 @@ bool CodesAreLinear(const Photo& photo);
 // One photo in the merge, with what the noise model and the near-black test need. u is the
 // recorded value above black in units of the white level (the reader's value times the
 // recorded exposure), the same whatever exposure the merge assumes.
+// The lowest 8-bit code whose value a fitted response curve gives to within noise
+// (calibrate response's consistency report starts there too, calibrate/radiometric).
+constexpr int kTrustedCode = 32;
+
 struct Exposure {
   LinearReader reader;
   // CodesAreLinear: u = code * u_gain - u_offset, clipped at code >= saturation_code (or NaN),
@@ -51,6 +55,10 @@ struct Exposure {
   float effective = 1;  // the exposure the merge divides by (recorded, or from the ratios)
   // Well exposed: not clipped, u >= floor_u and u > 0; unclipped below that: near-black.
   float floor_u = 0;
+  // u of 8-bit code kTrustedCode per channel (0 for other photos): below it a response curve
+  // fitted to the photos absorbs the camera's dark offset (docs/formats.md §14) and reads a few
+  // % low, too little for the merge's weights, too much for the bracket ratios' estimate.
+  float trusted_u[3] = {0, 0, 0};
   float read_var = 0;   // (read noise / full well)^2, u^2
   float code_step = 0;  // one code in u units at curve slope 1 (0: float photo)
   Transfer transfer = Transfer::kLinear;

@@ -58,6 +58,7 @@ void CheckView(const BoardCorners& corners, const Eigen::Matrix3d& h, const cv::
     min_det = std::min(min_det, std::abs(det));
     max_det = std::max(max_det, std::abs(det));
   }
+  report->handedness = sign;
   report->anisotropy = anisotropy;
   report->scale_ratio = max_det / min_det;
   if (anisotropy > options.max_anisotropy || report->scale_ratio > options.max_scale_ratio)

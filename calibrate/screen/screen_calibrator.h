@@ -51,6 +51,9 @@ struct ScreenCalibrationReport {
   double anisotropy = 0;   // worst over the corners
   double scale_ratio = 0;  // max / min local area scale
   double condition = 0;
+  // The sign of det(d screen / d image) over the board (the same at every corner, or the view is
+  // refused as folded): which way round the camera sees the board (MirroredBoard).
+  int handedness = 0;
   double initial_rms_px = 0;  // OpenCV homography, before refinement
   // With a known camera: the screen's pose (camera_from_screen: angle-axis rad, translation mm;
   // screen frame = lab x, y on the screen plane) and cv::solvePnP's RMS before Ceres.
@@ -58,6 +61,21 @@ struct ScreenCalibrationReport {
   Eigen::Matrix<double, 6, 1> pose = Eigen::Matrix<double, 6, 1>::Zero();
   double pnp_rms_px = 0;
 };
+
+// The handedness (ScreenCalibrationReport::handedness) of the usual set-up: the board pinned
+// the right way round on the screen, the camera behind the screen (away from the luminaire,
+// docs/formats.md "The board"), image x right and y down. Measured -1 in the synthetic lab
+// (acquire synth, the real-camera fixtures: camera at z = 2400 mm, screen at 750 mm). +1: the
+// board pinned mirrored, or the camera on the luminaire's side of the screen (a calibrate test
+// puts it at z = -520 mm).
+inline constexpr int kUsualHandedness = -1;
+
+// True when the board is seen the other way round from the usual set-up. Legitimate (a camera
+// on the luminaire's side, a board pinned mirrored on purpose), but if the lab did not mean it
+// the slab comes out mirrored: calibrate screen records a warning, "screen.board_mirrored".
+inline bool MirroredBoard(const ScreenCalibrationReport& report) {
+  return report.handedness == -kUsualHandedness;
+}
 
 // `photo`: CV_32FC1 (lib/photo LinearGray), any value range. `photo_name` names the
 // photo in messages and in the result. `camera`: the calibrated camera (of the photo's size),

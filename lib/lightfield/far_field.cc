@@ -231,18 +231,6 @@ void CancelNegativeRayCells(const RayCellAxis& ax, const RayCellAxis& ay,
 
 }  // namespace
 
-std::vector<SlabPosition> ReadSlabPositions(const std::string& slab_dir, const SlabInfo& info,
-                                            int threads) {
-  if (info.present.empty())
-    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
-  std::vector<SlabPosition> out(size_t(info.grid.count()));
-  ParallelFor(int(info.present.size()), threads, [&](int k) {
-    const auto [i, j] = info.present[k];
-    out[size_t(info.grid.Index(i, j))] = ReadSlabPosition(slab_dir, info, i, j);
-  });
-  return out;
-}
-
 FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                          const std::vector<double>& c_deg, const std::vector<double>& gamma_deg,
                          const FarFieldOptions& options) {
@@ -320,6 +308,8 @@ SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& p
   }
   double signed_total = 0;
   for (const double f : texel_flux) signed_total += f;
+  // (CheckSlabLight refuses a negative total on grids where its sign means something; rays need
+  // a positive one on every grid.)
   if (!(signed_total > 0))
     throw BadInput("the slab holds no light (its seen texels sum to " +
                    std::to_string(signed_total) + " W): no rays to draw");

@@ -10,18 +10,9 @@
 #include <vector>
 
 #include "core/slab.h"
+#include "core/slab_light.h"  // LuminanceWeights, ReadSlabPositions
 
 namespace lumislab {
-
-// Rec. 709 luminance: the one channel far-field and ray files carry (lux slabs give cd and lm,
-// W/m^2 slabs W/sr and W, as calib/scale.json's radiometer reading weighs RGB, docs/formats.md
-// §16).
-inline Eigen::Vector3d LuminanceWeights() { return {0.2126, 0.7152, 0.0722}; }
-
-// Every position the slab lists, E_ij and mask, by linear index j * nu + i (empty for the
-// others), read on `threads` threads (ReadSlabPosition: a damaged file is exit 2).
-std::vector<SlabPosition> ReadSlabPositions(const std::string& slab_dir, const SlabInfo& info,
-                                            int threads);
 
 struct FarFieldOptions {
   int samples = 4;                                       // N x N bell quadrature per position

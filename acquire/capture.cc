@@ -614,7 +614,7 @@ class Capture {
     if (!list_) {
       ds_ = ImportSkeleton(import_);
       ds_.calibration.photo = journal_.board()->file;
-      list_ = std::make_unique<CaptureList>(import_, ds_.grid);
+      list_ = std::make_unique<CaptureList>(import_, ds_.grid, "acquire capture");
       for (const auto& [key, photos] : journal_.done())
         for (const auto& p : photos)
           AddToList({std::get<0>(key), std::get<1>(key), std::get<2>(key)}, p);

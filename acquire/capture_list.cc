@@ -1,6 +1,7 @@
 #include "acquire/capture_list.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <sstream>
 
 #include "core/error.h"
@@ -16,7 +17,63 @@ std::string Number(double v) {
   return os.str();
 }
 
+// EXIF Orientation as a person reads it (decoders turn the pixels by it).
+std::string OrientationText(int orientation) {
+  const char* what = orientation == 1   ? "upright"
+                     : orientation == 3 ? "turned 180 degrees"
+                     : orientation == 6 ? "turned 90 degrees clockwise"
+                     : orientation == 8 ? "turned 90 degrees counter-clockwise"
+                                        : "mirrored";
+  return std::to_string(orientation) + " (" + what + ")";
+}
+
 }  // namespace
+
+void NameTimeOrder::Next(const std::string& name, const PhotoExif& exif) {
+  if (!exif.date_time) return;
+  ++timed_;
+  if (!previous_.empty()) {
+    equal_times_ += *exif.date_time == previous_time_;
+    if (*exif.date_time < previous_time_ && Agree()) {
+      earlier_ = previous_, later_ = name;
+      earlier_time_ = previous_time_, later_time_ = *exif.date_time;
+    }
+  }
+  previous_ = name;
+  previous_time_ = *exif.date_time;
+}
+
+nlohmann::json NameTimeOrder::Values() const {
+  nlohmann::json values = {{"photos_with_time", timed_}, {"equal_consecutive_times", equal_times_}};
+  if (!Agree()) values["earlier"] = earlier_, values["later"] = later_;
+  return values;
+}
+
+void NameTimeOrder::Fail(CheckLog& checks, const std::string& photos_dir) const {
+  checks.Fail("order.names_and_times",
+              photos_dir + "/" + later_ + ": EXIF DateTimeOriginal: expected " + earlier_time_ +
+                  " or later (--order name: taken after " + earlier_ + "), got " + later_time_ +
+                  ": the name order is not the capture order (--order capture follows the "
+                  "EXIF time)",
+              Values());
+}
+
+void NameTimeOrder::Record(CheckLog& checks, const std::string& photos_dir) const {
+  if (timed_ < 2) return;  // no record where nothing was compared
+  if (Agree())
+    checks.Pass("order.names_and_times",
+                std::to_string(timed_) + " photos: name order and EXIF time order agree (" +
+                    std::to_string(equal_times_) +
+                    " consecutive pairs with the same time, to the second)",
+                Values());
+  else
+    checks.Warn("order.names_and_times",
+                photos_dir + "/" + later_ + ": EXIF time " + later_time_ + " is before that of " +
+                    earlier_ + " (" + earlier_time_ +
+                    "), which comes before it by name: the photos were ordered by their time "
+                    "(--order capture)",
+                Values());
+}
 
 const PhotoExif& PhotoHeaders::Of(const std::string& path) {
   auto it = exif_.find(path);
@@ -28,8 +85,66 @@ const PhotoExif& PhotoHeaders::Of(const std::string& path) {
   return it->second;
 }
 
-CaptureList::CaptureList(const ImportOptions& options, const SamplingGrid& grid)
-    : options_(options), grid_(grid) {}
+CaptureList::CaptureList(const ImportOptions& options, const SamplingGrid& grid, std::string stage)
+    : options_(options), grid_(grid), stage_(std::move(stage)) {}
+
+// camera.same_geometry: the screen calibration maps the screen into the photo once, from the
+// board photo; a zoom touched (focal length) or a photo the decoder turns (orientation) puts the
+// screen elsewhere in the photo. Any difference from the first photo that states the field is
+// refused: no capture means it.
+void CaptureList::SameGeometry(const std::string& path, const PhotoExif& exif) {
+  const std::optional<std::string> focal =
+      exif.focal_length ? std::optional<std::string>(Number(*exif.focal_length) + " mm")
+                        : std::nullopt;
+  const std::optional<std::string> orientation =
+      exif.orientation ? std::optional<std::string>(OrientationText(*exif.orientation))
+                       : std::nullopt;
+  geometry_photos_ += focal || orientation;
+  for (const auto& [field, value, why] :
+       {std::make_tuple("EXIF focal length", focal, "the zoom was touched"),
+        std::make_tuple("EXIF orientation", orientation,
+                        "the camera was turned, or its orientation sensor tagged the photo "
+                        "turned and the decoder turns its pixels (turn auto-rotate off)")}) {
+    if (!value) continue;
+    const auto [it, first] = camera_.emplace(field, std::make_pair(*value, path));
+    if (first || it->second.first == *value) continue;
+    const std::string dir = std::filesystem::is_directory(options_.out_dir) ? options_.out_dir : "";
+    CheckLog(dir, stage_)
+        .Fail("camera.same_geometry",
+              path + ": " + field + ": expected " + it->second.first + " as in " +
+                  it->second.second +
+                  " (the screen calibration assumes one geometry in every photo, the board photo's "
+                  "too), got " +
+                  *value + ": " + why,
+              {{"photo", path},
+               {"field", field},
+               {"expected", it->second.first},
+               {"got", *value},
+               {"as_in", it->second.second}});
+  }
+}
+
+void CaptureList::CheckBoardGeometry(const std::string& path) {
+  SameGeometry(path, headers_.Of(path));
+  board_checked_ = true;
+}
+
+void CaptureList::RecordGeometry(CheckLog& checks) const {
+  if (geometry_photos_ == 0) return;
+  nlohmann::json values = {{"photos", geometry_photos_}, {"board_photo", board_checked_}};
+  std::string found;
+  for (const char* field : {"EXIF focal length", "EXIF orientation"}) {
+    const auto it = camera_.find(field);
+    if (it == camera_.end()) continue;
+    values[field] = it->second.first;
+    found += std::string(found.empty() ? "" : ", ") + field + " " + it->second.first;
+  }
+  checks.Pass("camera.same_geometry",
+              std::to_string(geometry_photos_) + " photos" +
+                  (board_checked_ ? " (the board photo too)" : "") +
+                  " state one geometry: " + found,
+              values);
+}
 
 // One camera, one lens, one ISO for the whole capture, as far as the photos tell: the first
 // photo that states a field sets it, and a photo that states another value is refused.
@@ -57,6 +172,7 @@ void CaptureList::Add(const NamedPhoto& n) {
   SameCamera(path, "EXIF lens model", exif.lens_model);
   SameCamera(path, "EXIF ISO",
              exif.iso ? std::optional<std::string>(Number(*exif.iso)) : std::nullopt);
+  SameGeometry(path, exif);
   PhotoEntry e;
   e.i = n.i;
   e.j = n.j;

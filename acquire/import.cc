@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "acquire/capture_list.h"
 #include "acquire/photo_naming.h"
@@ -42,37 +44,89 @@ std::vector<std::string> ByCaptureTime(const std::string& dir,
   return out;
 }
 
-// How the photos' name order and their EXIF time order agree (order.names_and_times): the
-// photos with a time, compared in name order; the first pair whose times run backwards.
-struct OrderAgreement {
-  int timed = 0;        // photos with an EXIF time
-  int equal_times = 0;  // consecutive (in name order) photos with the same time, to the second
-  std::string earlier, later, earlier_time, later_time;  // the first backward pair, by name
-  bool Agree() const { return earlier.empty(); }
-};
-
-// `files` in name order (FolderFiles, NameOrderLess: capt2 before capt10).
-OrderAgreement CompareNameAndTimeOrder(const std::string& dir,
-                                       const std::vector<std::string>& files,
-                                       PhotoHeaders& headers) {
-  OrderAgreement out;
-  const std::string* previous = nullptr;
-  std::string previous_time;
-  for (const std::string& f : files) {
-    const PhotoExif& exif = headers.Of(dir + "/" + f);
+// order.positions_and_times: with --manifest or --pattern the file names give the positions; where
+// the photos have EXIF times, each slide's positions must follow in time the order the capture
+// implies: the manifest's own rows (the first row naming each position and slide), or for a
+// pattern the setup's scan (--scan). Per slide, because a lab may shoot every position through
+// T+ and then every one through T- (one slide change) as well as both slides at each position;
+// a position's photos (its bracket) may come in any order among themselves. A warning only: a
+// manifest may list its rows in grid order rather than capture order, and a pattern capture
+// may have been scanned another way than --scan says; but where the rows were written as the
+// photos were taken, a backward pair is two files given each other's places.
+void CheckPositionsInTime(const ImportOptions& o, const SamplingGrid& grid,
+                          const std::vector<NamedPhoto>& named, PhotoHeaders& headers,
+                          CheckLog& checks) {
+  std::map<std::pair<int, int>, int> scan_rank;
+  for (int k = 0; k < grid.count(); ++k) scan_rank[ScanPosition(grid, o.scan, k)] = k;
+  struct Span {
+    int rank = 0;
+    std::string first, last, first_file, last_file;  // earliest and latest EXIF time, and files
+    int i = 0, j = 0;
+  };
+  std::map<std::tuple<bool, int, int>, Span> spans;  // (slide, i, j)
+  for (size_t row = 0; row < named.size(); ++row) {
+    const NamedPhoto& n = named[row];
+    const PhotoExif& exif = headers.Of(o.photos_dir + "/" + n.file);
     if (!exif.date_time) continue;
-    ++out.timed;
-    if (previous) {
-      out.equal_times += *exif.date_time == previous_time;
-      if (*exif.date_time < previous_time && out.Agree()) {
-        out.earlier = *previous, out.later = f;
-        out.earlier_time = previous_time, out.later_time = *exif.date_time;
-      }
+    const auto [it, first] = spans.try_emplace({n.positive, n.i, n.j});
+    Span& s = it->second;
+    if (first) {
+      s.rank = !o.manifest.empty() ? int(row) : scan_rank[{n.i, n.j}];
+      s.i = n.i, s.j = n.j;
+      s.first = s.last = *exif.date_time;
+      s.first_file = s.last_file = n.file;
     }
-    previous = &f;
-    previous_time = *exif.date_time;
+    if (*exif.date_time < s.first) s.first = *exif.date_time, s.first_file = n.file;
+    if (*exif.date_time > s.last) s.last = *exif.date_time, s.last_file = n.file;
   }
-  return out;
+  int compared = 0, backward = 0;
+  std::string message;
+  for (const bool positive : {true, false}) {
+    std::vector<const Span*> order;
+    for (const auto& [key, span] : spans)
+      if (std::get<0>(key) == positive) order.push_back(&span);
+    std::sort(order.begin(), order.end(),
+              [](const Span* a, const Span* b) { return a->rank < b->rank; });
+    for (size_t k = 1; k < order.size(); ++k) {
+      ++compared;
+      const Span& a = *order[k - 1];
+      const Span& b = *order[k];
+      if (!(b.first < a.last)) continue;  // equal times (to the second) agree
+      if (backward++ > 0) continue;
+      const auto at = [](const Span& s) {
+        return "(" + std::to_string(s.i) + ", " + std::to_string(s.j) + ")";
+      };
+      message = o.photos_dir + "/" + b.first_file + ": EXIF time " + b.first + " (slide " +
+                (positive ? "p" : "n") + " at position " + at(b) + ") is before " + a.last +
+                " of " + a.last_file + " at position " + at(a) + ", which " +
+                (!o.manifest.empty()
+                     ? o.manifest +
+                           " lists before it: the rows are not in capture order, or "
+                           "(if they were written as the photos were taken) they give "
+                           "these files each other's places"
+                     : "the scan (--scan " + o.scan +
+                           ") takes before it: the grid was scanned another way, or the names "
+                           "carry the wrong positions");
+    }
+  }
+  if (compared == 0) return;  // no record where nothing was compared
+  const nlohmann::json values = {
+      {"position_pairs_compared", compared},
+      {"backward_pairs", backward},
+      {"order", !o.manifest.empty() ? "manifest rows" : "scan " + o.scan}};
+  if (backward == 0)
+    checks.Pass("order.positions_and_times",
+                std::to_string(compared) +
+                    " pairs of consecutive positions (per slide) follow in EXIF "
+                    "time the order " +
+                    (!o.manifest.empty() ? "of the manifest's rows"
+                                         : "of the scan (--scan " + o.scan + ")"),
+                values);
+  else
+    checks.Warn("order.positions_and_times",
+                message + " (" + std::to_string(backward) + " of " + std::to_string(compared) +
+                    " pairs of consecutive positions backward)",
+                values);
 }
 
 // A photo count one more than the capture's: name the candidates (a stray test shot is the
@@ -220,23 +274,19 @@ ImportReport RunImport(const ImportOptions& o) {
   for (const std::string& f : FolderFiles(o.photos_dir))
     if (f != ds.calibration.photo && !IsDatasetFile(o, f)) files.push_back(f);
 
-  CaptureList list(o, ds.grid);
+  CaptureList list(o, ds.grid, "acquire import");
   // Every order the folder states, cross-checked where there are two: with --order, the names'
   // and the EXIF times'. --order name against times that run backwards is refused (a photo in
   // the wrong place shifts every later one); --order capture against names that do is a warning
   // (a camera's counter wraps at 9999, two cards).
-  OrderAgreement agreement;
+  NameTimeOrder names_and_times;
   if (!o.order.empty()) {
-    agreement = CompareNameAndTimeOrder(o.photos_dir, files, list.headers());
-    if (o.order == "name" && !agreement.Agree())
-      CheckLog(fs::is_directory(o.out_dir) ? o.out_dir : "", "acquire import")
-          .Fail("order.names_and_times",
-                o.photos_dir + "/" + agreement.later + ": EXIF DateTimeOriginal: expected " +
-                    agreement.earlier_time + " or later (--order name: taken after " +
-                    agreement.earlier + "), got " + agreement.later_time +
-                    ": the name order is not the capture order (--order capture follows the "
-                    "EXIF time)",
-                {{"earlier", agreement.earlier}, {"later", agreement.later}});
+    for (const std::string& f : files)
+      names_and_times.Next(f, list.headers().Of(o.photos_dir + "/" + f));
+    if (o.order == "name" && !names_and_times.Agree()) {
+      CheckLog checks(fs::is_directory(o.out_dir) ? o.out_dir : "", "acquire import");
+      names_and_times.Fail(checks, o.photos_dir);
+    }
   }
   if (o.order == "capture") files = ByCaptureTime(o.photos_dir, files, list.headers());
   const std::vector<NamedPhoto> named = !o.manifest.empty()  ? ManifestPhotos(o.manifest)
@@ -246,32 +296,18 @@ ImportReport RunImport(const ImportOptions& o) {
   // Watch makes the same check before any photo arrives (the message names the manifest).
   if (!o.manifest.empty() && !o.partial) CheckManifestCompletes(o.manifest, named, ds.grid);
   ds.photos = CompleteEntries(list, o, ds.grid, &ds.missing_positions);
+  list.CheckBoardGeometry(calibration);
   std::set<std::string> used;
   for (const auto& e : ds.photos) used.insert(e.file);
   for (const std::string& f : files)
     if (!used.count(f)) report.unused.push_back(f);
 
   WriteImportedDataset(ds, o.out_dir);
-  if (agreement.timed > 1) {  // (no record where nothing was compared)
-    CheckLog checks(o.out_dir, "acquire import");
-    const nlohmann::json values = {{"photos_with_time", agreement.timed},
-                                   {"equal_consecutive_times", agreement.equal_times}};
-    if (agreement.Agree())
-      checks.Pass("order.names_and_times",
-                  std::to_string(agreement.timed) +
-                      " photos: name order and EXIF time order agree (" +
-                      std::to_string(agreement.equal_times) +
-                      " consecutive pairs with the same time, to the second)",
-                  values);
-    else
-      checks.Warn("order.names_and_times",
-                  o.photos_dir + "/" + agreement.later + ": EXIF time " + agreement.later_time +
-                      " is before that of " + agreement.earlier + " (" + agreement.earlier_time +
-                      "), which comes before it by name: the photos were ordered by their time "
-                      "(--order capture)",
-                  values);
-    checks.Save();
-  }
+  CheckLog checks(o.out_dir, "acquire import");
+  names_and_times.Record(checks, o.photos_dir);
+  list.RecordGeometry(checks);
+  if (o.order.empty()) CheckPositionsInTime(o, ds.grid, named, list.headers(), checks);
+  if (!checks.records().empty()) checks.Save();  // (no record where nothing was compared)
   report.photos = int(ds.photos.size());
   report.brackets = ds.photos.empty() ? 0 : list.MostPerSlide();
   report.missing = ds.missing_positions;

@@ -15,6 +15,7 @@
 #include "acquire/capture_list.h"
 #include "acquire/photo_naming.h"
 #include "acquire/settle_tracker.h"
+#include "core/checks.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/log.h"
@@ -47,7 +48,10 @@ void KeepPhotoBuffersOutOfTheHeap() {
 class Watcher {
  public:
   explicit Watcher(const WatchOptions& w)
-      : o_(w.import), ds_(ImportSkeleton(o_)), list_(o_, ds_.grid), tracker_(w.settle_s) {
+      : o_(w.import),
+        ds_(ImportSkeleton(o_)),
+        list_(o_, ds_.grid, "acquire watch"),
+        tracker_(w.settle_s) {
     if (!o_.manifest.empty()) {
       // Rows that can never complete the grid are refused now, as import refuses them, rather
       // than waited for.
@@ -128,6 +132,15 @@ class Watcher {
     }
   }
   bool Complete() const { return ds_.missing_positions.empty() && board_; }
+  // The complete capture's checks: the board photo's geometry against the slides', and the
+  // record of what was compared (checks.json, stage "acquire watch").
+  void RecordChecks() {
+    list_.CheckBoardGeometry(Path(ds_.calibration.photo));
+    CheckLog checks(o_.out_dir, "acquire watch");
+    names_and_times_.Record(checks, o_.photos_dir);
+    list_.RecordGeometry(checks);
+    if (!checks.records().empty()) checks.Save();
+  }
   const Dataset& dataset() const { return ds_; }
   const std::vector<std::string>& unused() const { return unused_; }
 
@@ -194,6 +207,15 @@ class Watcher {
         throw InputError(Path(key.second), "capture order",
                          "at most " + std::to_string(expected) + " photos (the grid is complete)",
                          "one more");
+      // In name order, the EXIF times must not run backwards, as import checks them: a photo in
+      // the wrong place shifts every later one.
+      if (o_.order == "name") {
+        names_and_times_.Next(key.second, list_.headers().Of(Path(key.second)));
+        if (!names_and_times_.Agree()) {
+          CheckLog checks(o_.out_dir, "acquire watch");
+          names_and_times_.Fail(checks, o_.photos_dir);
+        }
+      }
       Add(OrderedPhoto(o_, ds_.grid, placed_++, key.second));
       last_ = key;
     }
@@ -219,6 +241,7 @@ class Watcher {
   std::optional<std::pair<std::string, std::string>> last_;  // --order: the last file placed
   size_t placed_ = 0;
   bool board_ = false;
+  NameTimeOrder names_and_times_;  // --order name
 };
 
 }  // namespace
@@ -264,6 +287,7 @@ WatchReport RunWatch(const WatchOptions& w) {
     }
     if (watcher.Complete()) {
       watcher.CheckKeptPhotos();
+      watcher.RecordChecks();
       break;
     }
     if (StopRequested()) {

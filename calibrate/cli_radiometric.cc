@@ -135,7 +135,7 @@ int RunResponse(const RadiometricCommand& c, const Dataset& dataset) {
   }
   if (!Prepare(dataset, "response.json", c.force, &out)) return 0;
   nlohmann::json report;
-  const ResponseCurve curve = CalibrateResponse(frames, c.response_options, &report);
+  const ResponseCurve curve = CalibrateResponse(frames, c.response_options, &report, &checks);
   CheckResponseFit(report, &checks);
   MakeCalib(dataset);
   SaveResponseCurve(out, curve, report);
@@ -202,9 +202,9 @@ int RunScale(const RadiometricCommand& c, const Dataset& dataset) {
   if (!Prepare(dataset, "scale.json", c.force, &out)) return 0;
   const auto corrections = Corrections(dataset, {}, "scale");
   nlohmann::json report;
-  const RadiometricScale scale =
-      CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report);
   CheckLog checks(dataset.dir, "calibrate scale");
+  const RadiometricScale scale =
+      CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report, &checks);
   CheckScale(report, scale.scale, &checks);
   MakeCalib(dataset);
   SaveRadiometricScale(out, scale, report);

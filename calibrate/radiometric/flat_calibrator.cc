@@ -98,12 +98,20 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
         if (on_screen[p] && !(dark && dark->hot[p]))
           level_sum += (v[0] + v[1] + v[2]) / 3 * f.exposure, ++level_n;
       }
-    if (double(clipped_pixels) > kMaxClippedFraction * double(screen_pixels))
-      throw InputError(
+    if (double(clipped_pixels) > kMaxClippedFraction * double(screen_pixels)) {
+      const Error error = InputError(
           f.photo.path, "pixel data",
           "a flat frame with at most 0.1 % of the screen's pixels clipped (lower "
           "the exposure)",
           std::to_string(clipped_pixels) + " clipped pixel(s) of " + std::to_string(screen_pixels));
+      if (checks)
+        checks->Fail("flat.clipped", error.what(),
+                     {{"frame", f.photo.path},
+                      {"clipped_pixels", clipped_pixels},
+                      {"screen_pixels", screen_pixels},
+                      {"max_clipped_fraction", kMaxClippedFraction}});
+      throw error;
+    }
   }
   long long clipped_left = 0;
   for (size_t p = 0; p < n; ++p)

@@ -133,7 +133,8 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
 }  // namespace
 
 ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
-                                const ResponseOptions& options, nlohmann::json* report) {
+                                const ResponseOptions& options, nlohmann::json* report,
+                                CheckLog* checks) {
   std::vector<double> exposure;
   for (const auto& f : frames) {
     if (!f.exposure_known)
@@ -173,11 +174,17 @@ ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
     size_t used = 0;
     std::array<double, 256> g{};
     if (count >= 20) g = FitLogInverseResponse(o, n_frames, log_exposure, options.lambda, &used);
-    if (used < 20)
-      throw InputError(frames[0].photo.path, "frames",
-                       "at least 20 pixels unclipped in two frames or more and changing over the "
-                       "series (use exposures closer together, or a scene with more mid-tones)",
-                       std::to_string(used));
+    if (used < 20) {
+      const Error error =
+          InputError(frames[0].photo.path, "frames",
+                     "at least 20 pixels unclipped in two frames or more and changing over the "
+                     "series (use exposures closer together, or a scene with more mid-tones)",
+                     std::to_string(used));
+      if (checks)
+        checks->Fail("response.samples", error.what(),
+                     {{"samples", used}, {"min_samples", 20}, {"frames", n_frames}});
+      throw error;
+    }
     return g;
   };
   std::array<std::array<double, 256>, 3> g;

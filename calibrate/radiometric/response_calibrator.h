@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calibrate/radiometric/calibration_frames.h"
+#include "core/checks.h"
 #include "lib/photo/radiometric_calibration.h"
 
 namespace lumislab {
@@ -26,8 +27,10 @@ struct ResponseOptions {
 // is normalised to 1 at code 255 and made strictly increasing; `report` gets how consistent the
 // frames become after linearisation (and with the sRGB curve, for comparison), overall and per
 // consecutive pair ("pairs": the exposure ratio the linearised frames imply against the stated).
+// Too few sample pixels to fit is recorded in `checks` (response.samples) when given.
 ResponseCurve CalibrateResponse(const std::vector<CalibrationFrame>& frames,
-                                const ResponseOptions& options, nlohmann::json* report);
+                                const ResponseOptions& options, nlohmann::json* report,
+                                CheckLog* checks = nullptr);
 
 // Linear frames (16-bit, float, RAW): value / exposure of each frame against the frame of the
 // middle exposure over pixels unclipped and above 2 % of full scale in both; the report lists

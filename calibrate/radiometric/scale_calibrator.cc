@@ -116,7 +116,8 @@ double PeakLuminance(const Photo& photo) {
 RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration& screen,
                                 const ScaleReference& reference,
                                 const std::shared_ptr<const PhotoCorrections>& corrections,
-                                const ScaleOptions& options, nlohmann::json* report) {
+                                const ScaleOptions& options, nlohmann::json* report,
+                                CheckLog* checks) {
   reference.Check(dataset);
   const Eigen::Vector2d pixel = screen.ImageFromScreen(reference.point_mm);
   const int r = options.radius_px;
@@ -166,10 +167,19 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
     value[s] = Luminance(slides[s].rgb);
   }
   const double difference = value[0] - value[1];
-  if (!(difference > 1e-6 * std::max(std::abs(value[0]), 1e-12)) || !std::isfinite(difference))
-    throw InputError(reference.source, "point_mm",
-                     "a point where the photos through T+ are brighter than through T-",
-                     "Y+ " + std::to_string(value[0]) + ", Y- " + std::to_string(value[1]));
+  // The reference reads more light through T+ (ScaleReference::Check); photos that do not are
+  // of other slides, or the point is where the filter passes none (recorded as scale.point_lit,
+  // the same question as its threshold on the signal's size).
+  if (!(difference > 1e-6 * std::max(std::abs(value[0]), 1e-12)) || !std::isfinite(difference)) {
+    const Error error =
+        InputError(reference.source, "point_mm",
+                   "a point where the photos through T+ are brighter than through T-",
+                   "Y+ " + std::to_string(value[0]) + ", Y- " + std::to_string(value[1]));
+    if (checks)
+      checks->Fail("scale.point_lit", error.what(),
+                   {{"y_plus", value[0]}, {"y_minus", value[1]}, {"signal", difference}});
+    throw error;
+  }
   RadiometricScale scale;
   scale.scale = (reference.reading_p - reference.reading_n) / difference;
   scale.units = reference.unit;

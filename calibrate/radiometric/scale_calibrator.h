@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/checks.h"
 #include "core/dataset.h"
 #include "core/screen_calibration.h"
 #include "lib/photo/radiometric_calibration.h"
@@ -44,6 +45,7 @@ struct ScaleOptions {
 RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration& screen,
                                 const ScaleReference& reference,
                                 const std::shared_ptr<const PhotoCorrections>& corrections,
-                                const ScaleOptions& options, nlohmann::json* report);
+                                const ScaleOptions& options, nlohmann::json* report,
+                                CheckLog* checks = nullptr);
 
 }  // namespace lumislab

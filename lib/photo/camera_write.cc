@@ -48,7 +48,7 @@ void Set(TIFF* tif, uint32_t tag, A... values) {
 }
 
 bool HasExifDirectory(const PhotoExif& e) {
-  return e.exposure_time || e.f_number || e.iso || e.lens_model || e.date_time;
+  return e.exposure_time || e.f_number || e.iso || e.lens_model || e.date_time || e.focal_length;
 }
 
 // The EXIF directory, written before IFD0 (libtiff appends it, unlinked; IFD0 then points to
@@ -61,6 +61,7 @@ uint64_t WriteExifDirectory(TIFF* tif, const PhotoExif& e) {
   if (e.f_number) Set(tif, EXIFTAG_FNUMBER, *e.f_number);
   if (e.iso) SetArray(tif, EXIFTAG_ISOSPEEDRATINGS, std::vector<uint16_t>{uint16_t(*e.iso)});
   if (e.lens_model) Set(tif, EXIFTAG_LENSMODEL, e.lens_model->c_str());
+  if (e.focal_length) Set(tif, EXIFTAG_FOCALLENGTH, *e.focal_length);
   if (e.date_time) Set(tif, EXIFTAG_DATETIMEORIGINAL, e.date_time->c_str());
   uint64_t offset = 0;
   if (!TIFFWriteCustomDirectory(tif, &offset)) throw Failure("TIFF writer: cannot write EXIF");
@@ -76,8 +77,10 @@ TiffFile CreateTiff(const std::string& tmp, std::string& error) {
   return file;
 }
 
-// Make, model and date-time in IFD0, and the pointer to the EXIF directory.
+// Make, model, date-time and orientation (top-left unless `e` states another) in IFD0, and the
+// pointer to the EXIF directory.
 void SetCameraTags(TIFF* tif, const PhotoExif& e, uint64_t exif_offset) {
+  Set(tif, TIFFTAG_ORIENTATION, uint16_t(e.orientation.value_or(ORIENTATION_TOPLEFT)));
   Set(tif, TIFFTAG_SOFTWARE, "lumislab");
   if (e.make) Set(tif, TIFFTAG_MAKE, e.make->c_str());
   if (e.model) Set(tif, TIFFTAG_MODEL, e.model->c_str());
@@ -100,7 +103,6 @@ void WriteDngFile(const std::string& tmp, const cv::Mat& mosaic, const DngInfo& 
   Set(tif, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
   Set(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_CFA);
   Set(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
-  Set(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
   Set(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
   SetCameraTags(tif, e, exif_offset);
   SetArray(tif, TIFFTAG_CFAREPEATPATTERNDIM, std::vector<uint16_t>{2, 2});
@@ -145,7 +147,6 @@ void WriteTiffFile(const std::string& tmp, const cv::Mat& image, const PhotoExif
     Set(tif, TIFFTAG_EXTRASAMPLES, uint16_t(1), alpha);
   }
   Set(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
-  Set(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
   Set(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
   SetCameraTags(tif, exif, exif_offset);
   cv::Mat rgb;  // TIFF stores R, G, B (a new buffer: the caller's image stays as it is)
@@ -209,9 +210,13 @@ std::vector<unsigned char> BuildExifPayload(const PhotoExif& exif) {
   text(EXIF_IFD_0, EXIF_TAG_MAKE, exif.make);
   text(EXIF_IFD_0, EXIF_TAG_MODEL, exif.model);
   text(EXIF_IFD_0, EXIF_TAG_DATE_TIME, exif.date_time);
+  if (exif.orientation)
+    exif_set_short(add(EXIF_IFD_0, EXIF_TAG_ORIENTATION, EXIF_FORMAT_SHORT, 1)->data, order,
+                   ExifShort(*exif.orientation));
   std::memcpy(add(EXIF_IFD_EXIF, EXIF_TAG_EXIF_VERSION, EXIF_FORMAT_UNDEFINED, 4)->data, "0230", 4);
   rational(EXIF_TAG_EXPOSURE_TIME, exif.exposure_time);
   rational(EXIF_TAG_FNUMBER, exif.f_number);
+  rational(EXIF_TAG_FOCAL_LENGTH, exif.focal_length);
   if (exif.iso)
     exif_set_short(add(EXIF_IFD_EXIF, EXIF_TAG_ISO_SPEED_RATINGS, EXIF_FORMAT_SHORT, 1)->data,
                    order, ExifShort(std::clamp(std::round(*exif.iso), 0.0, 65535.0)));
@@ -262,7 +267,7 @@ void WriteJpeg(const std::string& path, const cv::Mat& bgr8, int quality, const 
   // A camera writes SOI, then APP1 EXIF; libjpeg's JFIF APP0 segment is dropped. Without a field
   // to write, the JPEG is written as libjpeg encoded it (an empty EXIF block reads as corrupt).
   const bool any = exif.exposure_time || exif.f_number || exif.iso || exif.make || exif.model ||
-                   exif.lens_model || exif.date_time;
+                   exif.lens_model || exif.date_time || exif.focal_length || exif.orientation;
   if (!any) {
     WriteAtomically(path, [&](const std::string& tmp) {
       std::ofstream file(tmp, std::ios::binary);

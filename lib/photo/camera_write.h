@@ -33,9 +33,9 @@ void WriteDng(const std::string& path, const cv::Mat& mosaic, const DngInfo& inf
 void WriteTiff(const std::string& path, const cv::Mat& image, const PhotoExif& exif);
 
 // Writes an 8-bit BGR image (CV_8UC3) as a JPEG at `quality` (1 .. 100) through libjpeg, with an
-// EXIF APP1 segment (exposure time, f-number, ISO, make, model, lens, date-time; the fields
-// present) built with libexif and placed right after SOI, where cameras put it; no EXIF block
-// when no field is present.
+// EXIF APP1 segment (exposure time, f-number, ISO, make, model, lens, focal length, orientation,
+// date-time; the fields present) built with libexif and placed right after SOI, where cameras put
+// it; no EXIF block when no field is present.
 void WriteJpeg(const std::string& path, const cv::Mat& bgr8, int quality, const PhotoExif& exif);
 
 }  // namespace lumislab

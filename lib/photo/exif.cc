@@ -28,6 +28,12 @@ std::optional<double> Positive(double v) {
   return v;
 }
 
+// EXIF Orientation is 1 .. 8; another value is no statement (decoders take it as 1).
+std::optional<int> ValidOrientation(std::optional<double> v) {
+  if (!v || *v < 1 || *v > 8 || *v != std::floor(*v)) return std::nullopt;
+  return int(*v);
+}
+
 // The payload of a JPEG's EXIF APP1 segment ("Exif\0\0" + TIFF structure); empty when there is
 // none. Walks the marker segments up to the start of the image data.
 std::vector<unsigned char> JpegExifSegment(const std::string& path) {
@@ -108,6 +114,8 @@ PhotoExif ReadJpegExif(const std::string& path) {
   exif.make = text(EXIF_IFD_0, EXIF_TAG_MAKE);
   exif.model = text(EXIF_IFD_0, EXIF_TAG_MODEL);
   exif.lens_model = text(EXIF_IFD_EXIF, EXIF_TAG_LENS_MODEL);
+  exif.focal_length = real(EXIF_IFD_EXIF, EXIF_TAG_FOCAL_LENGTH);
+  exif.orientation = ValidOrientation(real(EXIF_IFD_0, EXIF_TAG_ORIENTATION));
   exif.date_time = text(EXIF_IFD_EXIF, EXIF_TAG_DATE_TIME_ORIGINAL);
   if (!exif.date_time) exif.date_time = text(EXIF_IFD_0, EXIF_TAG_DATE_TIME);
   return exif;
@@ -133,6 +141,9 @@ PhotoExif ReadTiffExif(const std::string& path) {
   exif.make = text(TIFFTAG_MAKE);
   exif.model = text(TIFFTAG_MODEL);
   exif.date_time = text(TIFFTAG_DATETIME);
+  uint16_t orientation = 0;  // IFD0's, read before the EXIF directory replaces it
+  if (TIFFGetField(tif.get(), TIFFTAG_ORIENTATION, &orientation))
+    exif.orientation = ValidOrientation(double(orientation));
   uint64_t offset = 0;
   if (!TIFFGetField(tif.get(), TIFFTAG_EXIFIFD, &offset)) return exif;
   if (!TIFFReadEXIFDirectory(tif.get(), offset))
@@ -154,6 +165,7 @@ PhotoExif ReadTiffExif(const std::string& path) {
   if (TIFFGetField(tif.get(), EXIFTAG_ISOSPEEDRATINGS, &count, &iso) && count > 0 && iso)
     exif.iso = Positive(iso[0]);
   exif.lens_model = text(EXIFTAG_LENSMODEL);
+  exif.focal_length = real(EXIFTAG_FOCALLENGTH);
   if (auto original = text(EXIFTAG_DATETIMEORIGINAL)) exif.date_time = original;
   return exif;
 }

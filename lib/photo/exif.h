@@ -16,6 +16,11 @@ struct PhotoExif {
   std::optional<double> f_number;       // N
   std::optional<double> iso;            // ISO speed rating
   std::optional<std::string> make, model, lens_model;
+  // The camera's geometry, which the screen calibration assumes the same in every photo:
+  std::optional<double> focal_length;  // mm (FocalLength): a zoom lens touched changes it
+  // Orientation 1 .. 8 (1 as stored, 3 turned 180 degrees, 6 and 8 turned 90 degrees): the JPEG
+  // and TIFF decoders turn the pixels by it; LibRaw's flip for camera RAW.
+  std::optional<int> orientation;
   // "YYYY:MM:DD HH:MM:SS" as EXIF stores it (DateTimeOriginal, else DateTime): the camera's
   // clock, no time zone.
   std::optional<std::string> date_time;

@@ -192,6 +192,11 @@ PhotoExif ReadRawExif(const std::string& path) {
   exif.make = text(d.idata.make, sizeof d.idata.make);
   exif.model = text(d.idata.model, sizeof d.idata.model);
   exif.lens_model = text(d.lens.Lens, sizeof d.lens.Lens);
+  exif.focal_length = positive(d.other.focal_len);
+  // LibRaw's flip (0 none, 3 180 degrees, 5 and 6 90 degrees, 1 2 4 7 mirrored) back to the
+  // EXIF Orientation it was read from.
+  constexpr int kOrientationOfFlip[8] = {1, 2, 4, 3, 5, 8, 6, 7};
+  if (d.sizes.flip >= 0 && d.sizes.flip < 8) exif.orientation = kOrientationOfFlip[d.sizes.flip];
   if (d.other.timestamp > 0) {
     // LibRaw turned the EXIF text into a time_t with mktime (local time); localtime undoes it.
     std::tm t{};

@@ -1695,6 +1695,50 @@ std::vector<Case> MoreCases() {
   v.push_back(C("cli_preview_unknown_option").Preview(kPreview + " --bogus").Names({"--bogus"}));
   v.push_back(C("cli_preview_slab_missing").Preview("--scene plane --out r.exr").Names({"--slab"}));
   v.push_back(C("cli_preview_no_output").Preview("--slab ds/slab --scene plane").Names({"--out"}));
+
+  // ---- issue 28: the photos of a capture (reconstruct/capture_checks.h, acquire/import.cc):
+  // photos that are each well-formed but do not add up as one capture. (A bracket with its
+  // exposures exchanged has no case here: the masters have one photo per slide; it is
+  // consistency_capture_test's BracketWithItsExposuresExchangedIsRefused.)
+  // The slides swapped in dataset.json at every position: every position's light is negative.
+  v.push_back(C("consistency_slides_swapped_everywhere")
+                  .Reconstruct()
+                  .Do(EditJson(kDs,
+                               [](json& d) {
+                                 for (auto& e : d["photos"])
+                                   e["slide"] = e["slide"] == "p" ? "n" : "p";
+                               }))
+                  .Names({"ds/photos/pos_", "slides.sign"})
+                  .MayChange("ds/slab/")
+                  .MayChange("ds/checks.json"));
+  // One photo taken with the camera turned to portrait (240 x 320 among 320 x 240).
+  v.push_back(C("consistency_photo_turned_portrait")
+                  .Reconstruct()
+                  .Do(PngResize(e, 240, 320))
+                  .Names({e, "image size"})
+                  .MayChange("ds/slab/")
+                  .MayChange("ds/checks.json")
+                  .MustNotExist("ds/slab/pos_1_0.exr"));
+  // A camera folder (synth --camera-folder: TIFFs with EXIF times, one a second) whose third
+  // and fourth photos were given each other's names: import --order name is refused
+  // (order.names_and_times), nothing written.
+  v.push_back(
+      C("consistency_import_by_name_times_backwards")
+          .Synth()
+          .Args("import --photos cam/camera --setup cam/setup.json --out imp --order name")
+          .Do([](const std::string& dir) {
+            const CommandResult r = RunToolIn(
+                dir, "lumislab-acquire",
+                "synth --scene scene.json --out cam --camera-folder --truth-resolution 20", 120);
+            if (r.exit_code != 0) throw std::runtime_error(r.output);
+            const std::string c = dir + "/cam/camera/";
+            fs::rename(c + "IMG_0003.TIF", c + "swap.TIF");
+            fs::rename(c + "IMG_0004.TIF", c + "IMG_0003.TIF");
+            fs::rename(c + "swap.TIF", c + "IMG_0004.TIF");
+          })
+          .Names({"cam/camera/IMG_0004.TIF", "EXIF DateTimeOriginal", "order.names_and_times"})
+          .MustNotExist("imp/dataset.json"));
+  // ---- end of the photos of a capture
   return v;
 }
 
@@ -1752,7 +1796,8 @@ std::vector<Case> RadiometricCases() {
   v.push_back(R("uniform_frames")
                   .Do(WriteFrame("f0.png", 8, 6, 8, 0.3))
                   .Do(WriteFrame("f1.png", 8, 6, 8, 0.3))
-                  .Names({"f0.png", "frames"}));
+                  .Names({"f0.png", "frames", "response.samples"})
+                  .MayChange("ds/checks.json"));
   v.push_back(R("frame_not_an_image").Do(WriteText("f1.png", Garbage())).Names({"f1.png"}));
   v.push_back(
       R("frames_mixed_sizes").Do(WriteFrame("f1.png", 8, 7, 8)).Names({"f1.png", "image size"}));
@@ -1767,7 +1812,8 @@ std::vector<Case> RadiometricCases() {
   };
   v.push_back(F("frame_clipped")
                   .Do(WriteFrame("f0.png", 320, 240, 16, 1.0))
-                  .Names({"f0.png", "pixel data"}));
+                  .Names({"f0.png", "pixel data", "flat.clipped"})
+                  .MayChange("ds/checks.json"));
   // Refused by the check flat.has_signal, recorded in ds/checks.json (issue 28).
   v.push_back(F("frame_black")
                   .Do(WriteFrame("f0.png", 320, 240, 16, 0.0))
@@ -1812,7 +1858,8 @@ std::vector<Case> RadiometricCases() {
   // Slide n's photo under slide p's name: Y+ = Y-, no scale can come of the readings.
   v.push_back(S("no_contrast", reading + " --reading-p 1 --reading-n 0.5")
                   .Do(CopyPath("ds/photos/pos_0_0_n.png", "ds/photos/pos_0_0_p.png"))
-                  .Names({"command line", "point_mm"}));
+                  .Names({"command line", "point_mm", "scale.point_lit"})
+                  .MayChange("ds/checks.json"));
   const std::string ref = "scale --dataset ds --reference ref.json";
   const json valid_ref = {{"position", {0, 0}},
                           {"point_mm", {0, 0}},

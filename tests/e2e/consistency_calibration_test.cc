@@ -216,5 +216,48 @@ TEST_F(ConsistencyCalibration, ScaleAtAnUnlitPointIsRefused) {
   EXPECT_FALSE(fs::exists(ds_ + "/calib/scale.json"));
 }
 
+// The refusals inside the fits are recorded in checks.json as failed checks of their stage, as
+// the checks after them are: a response series with nothing that changes over it (one frame
+// given twice: response.samples), a flat frame with the screen clipped (the longest bracket of a
+// slide photo: flat.clipped), and a scale whose photos through T+ are darker than through T-
+// (the slides swapped in dataset.json at the reference position: scale.point_lit).
+TEST_F(ConsistencyCalibration, RefusalsInsideTheFitsAreRecorded) {
+  std::vector<std::string> files;
+  std::vector<double> exposures;
+  Frames("response", &files, &exposures);
+  auto r = Calibrate("response", " --frames " + files[2] + " " + files[2] + " --exposures 1,2");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(files[2] + ": frames: expected at least 20 pixels"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(Outcomes("calibrate response")["response.samples"], "failed");
+
+  WriteTrueScreen();
+  nlohmann::json d = nlohmann::json::parse(ReadBinaryFile(ds_ + "/dataset.json"));
+  std::string longest;
+  double longest_exposure = 0;
+  for (const auto& e : d["photos"])
+    if (e["i"] == 1 && e["j"] == 1 && e["slide"] == "p" &&
+        e["exposure"].get<double>() > longest_exposure)
+      longest_exposure = e["exposure"], longest = ds_ + "/" + e["file"].get<std::string>();
+  r = Calibrate("flat", " --frames " + longest + " --exposures 1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(longest + ": pixel data: expected a flat frame with at most 0.1 %"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(Outcomes("calibrate flat")["flat.clipped"], "failed");
+
+  for (auto& e : d["photos"])
+    if (e["i"] == 1 && e["j"] == 1) e["slide"] = e["slide"] == "p" ? "n" : "p";
+  WriteFile(ds_ + "/dataset.json", d.dump(2));
+  r = Calibrate("scale", " --position 1,1 --point-mm 0,0 --reading-p 1 --reading-n 0.5");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("command line: point_mm: expected a point where the photos through T+ "
+                          "are brighter"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(Outcomes("calibrate scale")["scale.point_lit"], "failed");
+  EXPECT_FALSE(fs::exists(ds_ + "/calib/scale.json"));
+}
+
 }  // namespace
 }  // namespace lumislab

@@ -109,6 +109,34 @@ TEST(Exif, Tiff16RoundTrip) {
   EXPECT_EQ(cv::norm(photo.pixels, bgr16, cv::NORM_INF), 0);  // lossless, same channel order
 }
 
+// The camera's geometry (focal length, orientation; acquire's camera.same_geometry) round-trips
+// through each writer and reader: libexif (JPEG), libtiff (TIFF), LibRaw's focal_len and flip
+// (DNG). Orientation 3 (turned 180 degrees) keeps the image size.
+TEST(Exif, FocalLengthAndOrientationRoundTrip) {
+  const std::string dir = ScratchDir();
+  PhotoExif exif = Shot();
+  exif.focal_length = 35;
+  exif.orientation = 3;
+  WriteJpeg(dir + "/shot.jpg", Gradient(), 90, exif);
+  cv::Mat bgr16;
+  Gradient().convertTo(bgr16, CV_16UC3, 257);
+  WriteTiff(dir + "/shot.tif", bgr16, exif);
+  DngInfo info;
+  info.exif = exif;
+  WriteDng(dir + "/shot.dng", cv::Mat(48, 64, CV_16UC1, cv::Scalar(4000)), info);
+  for (const char* name : {"shot.jpg", "shot.tif", "shot.dng"}) {
+    const PhotoExif read = ReadPhotoExif(dir + "/" + name);
+    EXPECT_NEAR(read.focal_length.value_or(0), 35, 1e-4) << name;
+    EXPECT_EQ(read.orientation.value_or(0), 3) << name;
+  }
+  // Not written: a JPEG states neither; a TIFF is upright (its Orientation tag is always there).
+  WriteJpeg(dir + "/plain.jpg", Gradient(), 90, Shot());
+  WriteTiff(dir + "/plain.tif", bgr16, Shot());
+  EXPECT_FALSE(ReadPhotoExif(dir + "/plain.jpg").focal_length);
+  EXPECT_FALSE(ReadPhotoExif(dir + "/plain.jpg").orientation);
+  EXPECT_EQ(ReadPhotoExif(dir + "/plain.tif").orientation.value_or(0), 1);
+}
+
 TEST(Exif, JpegWithoutExifHasNoFields) {
   const std::string dir = ScratchDir();
   const std::string path = dir + "/plain.jpg";

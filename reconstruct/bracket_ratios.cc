@@ -53,9 +53,11 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
     // as the log is monotonic, with one log instead of one per sample).
     // At most 3 per grid pixel; plain arrays with a count (push_back was not inlined: a call
     // per sample).
-    std::vector<std::unique_ptr<float[]>> sample_ratios(order.size() - 1);
+    std::vector<std::unique_ptr<float[]>> sample_ratios(order.size() - 1),
+        sample_values(order.size() - 1);  // and the shorter exposure's value
     std::vector<size_t> samples(order.size() - 1, 0);
     for (auto& v : sample_ratios) v.reset(new float[3 * grid]);
+    for (auto& v : sample_values) v.reset(new float[3 * grid]);
     std::vector<float> u(order.size() * 3);  // NaN where clipped
     for (int y = stride / 2; y < h; y += stride)
       for (int x = stride / 2; x < w; x += stride) {
@@ -67,10 +69,16 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
             // near-black floor: the ratio of two values a few codes above black is dominated by
             // their quantisation.
             const float a = u[k * 3 + ch], b = u[(k + 1) * 3 + ch];
-            // And at codes where the curve is trusted (kTrustedCode).
+            // And at codes where the curve is trusted (kTrustedCode), and at a signal of at
+            // least kMinRatioValue in both: the noise model's floor is the dataset's assumption,
+            // and where the camera's real noise or dark level lies above it, values near it are
+            // the same in both photos whatever their exposures (a ratio of 1 where 4 was
+            // recorded, on the unlit positions of the study's noisy bracket point).
             const Exposure &ea = exposures[order[k]], &eb = exposures[order[k + 1]];
-            if (!(a >= 4 * ea.floor_u && a >= ea.trusted_u[ch] && a > 0)) continue;
-            if (!(b >= 4 * eb.floor_u && b >= eb.trusted_u[ch] && b > 0)) continue;
+            const float lowest_a = std::max({4 * ea.floor_u, ea.trusted_u[ch], kMinRatioValue});
+            const float lowest_b = std::max({4 * eb.floor_u, eb.trusted_u[ch], kMinRatioValue});
+            if (!(a >= lowest_a) || !(b >= lowest_b)) continue;
+            sample_values[k][samples[k]] = a;
             sample_ratios[k][samples[k]++] = b / a;
           }
       }
@@ -86,6 +94,17 @@ std::vector<BracketRatio> EstimateRatios(std::vector<Exposure>& exposures, int w
         const float median = KthSmallestNonNegative(sample_ratios[k].get(), n, n / 2);
         r.estimated = std::exp(double(std::log(median)));
         r.samples = (long long)n;
+        // The halves by the shorter exposure's value.
+        const float split = KthSmallestNonNegative(sample_values[k].get(), n, n / 2);
+        std::vector<float> dim, bright;
+        for (size_t s = 0; s < n; ++s)
+          (sample_values[k][s] < split ? dim : bright).push_back(sample_ratios[k][s]);
+        r.estimated_dim = dim.empty()
+                              ? r.estimated
+                              : KthSmallestNonNegative(dim.data(), dim.size(), dim.size() / 2);
+        r.estimated_bright = bright.empty() ? r.estimated
+                                            : KthSmallestNonNegative(bright.data(), bright.size(),
+                                                                     bright.size() / 2);
       }
       ratios.push_back(r);
     }
@@ -110,6 +129,11 @@ void ApplyRatios(std::vector<Exposure>& exposures, const std::vector<BracketRati
 }
 
 }  // namespace merge
+
+bool BracketRatio::DeviationIsTheExposures() const {
+  const double spread = std::abs(std::log(estimated_bright / estimated_dim));
+  return spread <= std::max(0.01, std::abs(std::log(estimated / Recorded())) / 3);
+}
 
 std::vector<BracketRatio> EstimateBracketRatios(const std::vector<DecodedPhoto>& photos,
                                                 const MergeOptions& options) {

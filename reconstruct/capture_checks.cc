@@ -13,9 +13,11 @@ namespace lumislab {
 namespace {
 
 // brackets.exposure_order: log(estimated ratio) / log(recorded ratio) of consecutive exposures
-// (1: the pixels agree with the recorded order and step; -1: the two photos exchanged). Below 0
-// the pixels say the longer exposure is the darker one.
-constexpr double kMinOrderFraction = 0;
+// (1: the pixels agree with the recorded order and step; -1: the two photos exchanged; about 0:
+// the pixels carry no light that tells, e.g. noise above the noise model's floor at an unlit
+// position, where the study's noisy bracket point measured -0.002). Below -0.5 the pixels say
+// the longer exposure is the darker one by at least half the recorded step.
+constexpr double kMinOrderFraction = -0.5;
 
 // slides.sign: a position fails when its light is mostly negative (negative > 2 x positive:
 // noise-only positions have both about equal) and its negative flux exceeds this share of the

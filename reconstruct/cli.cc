@@ -70,7 +70,8 @@ void CheckPhotosExist(const Dataset& dataset, const std::vector<Position>& todo)
 
 // What the merge of a bracket found: the dynamic range, the pixels no exposure measured well,
 // and how far the exposure ratios in the pixels are from the recorded ones (info above 1 %, a
-// warning above 5 %: EXIF shutter times are nominal, 1/30 s may be 1/32 s).
+// warning above 5 %: EXIF shutter times are nominal, 1/30 s may be 1/32 s), with the advice to
+// use the estimate only where the deviation is the same at every brightness.
 void ReportBrackets(const Position& position, const PositionReport& r, const RunConfig& config) {
   LogInfo("position ", Name(position), ": ", r.exposures, " exposures per slide merged, dynamic ",
           "range ", r.dynamic_range_stops, " stops (", r.brightest, " / ", r.faintest, "), ",
@@ -88,10 +89,22 @@ void ReportBrackets(const Position& position, const PositionReport& r, const Run
       continue;
     }
     text << b.estimated << " in the pixels, " << b.Recorded() << " recorded ("
-         << 100 * b.Deviation() << " %, " << b.samples << " values); "
-         << (used ? "the estimate is used"
-                  : "the recorded one is used (--bracket-ratios estimated uses the estimate)");
+         << 100 * b.Deviation() << " %, " << b.samples << " values); ";
     const double deviation = std::abs(b.Deviation());
+    if (!b.DeviationIsTheExposures()) {
+      // No advice: an estimate that changes with the brightness measures the noise, a dark
+      // offset or the response curve, which --bracket-ratios estimated would not correct.
+      text << "the ratio changes with the brightness (" << b.estimated_dim << " in the dimmer, "
+           << b.estimated_bright << " in the brighter half of those values): not the "
+           << "exposures' own; " << (used ? "the estimate is used" : "the recorded one is used");
+      if (deviation > 0.01)
+        LogInfo(text.str());
+      else
+        LogDebug(text.str());
+      continue;
+    }
+    text << (used ? "the estimate is used"
+                  : "the recorded one is used (--bracket-ratios estimated uses the estimate)");
     if (deviation > 0.05)
       LogWarning(text.str());
     else if (deviation > 0.01)

@@ -53,11 +53,23 @@ struct BracketRatio {
   double recorded_short = 1, recorded_long = 1;  // recorded exposures
   double estimated = 1;   // longer / shorter from the pixels (the recorded ratio when samples = 0)
   long long samples = 0;  // pixel channels well exposed in both that the estimate used
+  // The same estimate over the dimmer and the brighter half of those samples (by the shorter
+  // exposure's value). An exposure that is off changes the ratio at every brightness alike;
+  // noise above the noise model's floor, a dark offset or a response curve that does not fit
+  // change it more in the dimmer half.
+  double estimated_dim = 1, estimated_bright = 1;
   double Recorded() const { return recorded_long / recorded_short; }
   double Deviation() const { return estimated / Recorded() - 1; }  // relative
+  // The deviation is the exposures' own: the two halves agree to within a third of it (or 1 %),
+  // so that following it (--bracket-ratios estimated) corrects the exposure, not the noise.
+  bool DeviationIsTheExposures() const;
 };
 // Too few pixels well exposed in both: the ratio is not estimated (the recorded one is used).
 constexpr long long kMinRatioSamples = 200;
+// The least value (above black, in units of the white level) a pixel needs in both photos to
+// count in a bracket ratio's estimate: 1 % of full scale: 2.6 8-bit codes in linear units, code 25
+// through the sRGB curve.
+constexpr float kMinRatioValue = 0.01f;
 
 struct MergedPosition {
   // R, G, B = gain * (E+ - E-) at the photo pixels box-averaged `downsample` x `downsample`

@@ -88,7 +88,8 @@ std::vector<float> Observations(const std::vector<cv::Mat>& codes, int channel, 
 // [32, 245] in consecutive frames a, b: 0 when the curve makes the frames consistent. (Below
 // code 32 a dark offset, which the curve absorbs (docs/formats.md §14), and noise dominate.)
 // `pairs` (optional) gets the same per consecutive pair, with the exposure ratio the linearised
-// frames imply, stated ratio x exp(mean): what the curve says of each bracket step.
+// frames imply, stated ratio x exp(mean): what the curve says of each bracket step; and the mean
+// over the values whose code in the darker frame is kResponseBrightCode or more.
 nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<double>& exposure,
                            const std::array<std::array<float, 256>, 3>& curve_rgb,
                            const std::vector<std::string>& files = {},
@@ -99,8 +100,8 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
   for (size_t a = 0; a + 1 < codes.size(); ++a) {
     const size_t b = a + 1;
     if (exposure[a] == exposure[b]) continue;
-    double pair_sum = 0, pair_sum2 = 0;
-    long long pair_n = 0;
+    double pair_sum = 0, pair_sum2 = 0, bright_sum = 0;
+    long long pair_n = 0, bright_n = 0;
     for (int y = 0; y < codes[a].rows; ++y)
       for (int x = 0; x < codes[a].cols; ++x) {
         const cv::Vec3b ca = codes[a].at<cv::Vec3b>(y, x), cb = codes[b].at<cv::Vec3b>(y, x);
@@ -110,6 +111,7 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
           const double vb = curve_rgb[2 - c][cb[c]] / exposure[b];
           const double r = std::log(vb / va);
           pair_sum += r, pair_sum2 += r * r, ++pair_n;
+          if (ca[c] >= kResponseBrightCode) bright_sum += r, ++bright_n;
         }
       }
     sum += pair_sum, sum2 += pair_sum2, n += pair_n;
@@ -121,7 +123,9 @@ nlohmann::json Consistency(const std::vector<cv::Mat>& codes, const std::vector<
                       {"stated_ratio", exposure[b] / exposure[a]},
                       {"implied_ratio", exposure[b] / exposure[a] * std::exp(mean)},
                       {"mean_log_ratio", mean},
-                      {"rms_log_ratio", pair_n ? std::sqrt(pair_sum2 / pair_n) : 0.0}});
+                      {"rms_log_ratio", pair_n ? std::sqrt(pair_sum2 / pair_n) : 0.0},
+                      {"bright_samples", bright_n},
+                      {"bright_mean_log_ratio", bright_n ? bright_sum / bright_n : 0.0}});
   }
   nlohmann::json j;
   j["samples"] = n;

@@ -20,6 +20,12 @@ struct ResponseOptions {
   void Check() const;        // BadInput naming the option
 };
 
+// The code from which a pair of the report's "pairs" also gives its "bright_mean_log_ratio":
+// values whose code in the darker frame is this or more, far above any dark offset (cameras
+// whose black sits at code 33 or 66 were measured), where only the exposures and the curve's
+// shape decide the ratio.
+constexpr int kResponseBrightCode = 128;
+
 // Debevec and Malik's least squares on continuous codes (response_fit.h) over sample
 // pixels chosen here: 3 x 3 means in smooth regions, in the frames where their neighbourhood is
 // neither clipped nor black; one curve for R, G, B unless `per_channel`. Frames must be 8-bit with

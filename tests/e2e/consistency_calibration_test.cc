@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -63,7 +64,7 @@ class ConsistencyCalibration : public ::testing::Test {
     WriteFile(ds_ + "/dataset.json", d.dump(2));
   }
   void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
+    if (!HasFailure() && !std::getenv("LUMISLAB_KEEP_CASES")) fs::remove_all(dir_);
   }
   // The frames of one kind in the capture manifest (darkest first for the response series) and
   // their exposures.

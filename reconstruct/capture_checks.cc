@@ -18,6 +18,8 @@ namespace {
 // position, where the study's noisy bracket point measured -0.002). Below -0.5 the pixels say
 // the longer exposure is the darker one by at least half the recorded step.
 constexpr double kMinOrderFraction = -0.5;
+// brackets.recorded_ratios: reconstruct's advice threshold (reconstruct/photo_merge.h).
+constexpr double kRatioWarn = kRatioAdviceAbove;
 
 // slides.sign: a position fails when its light is mostly negative (negative > 2 x positive:
 // noise-only positions have both about equal) and its negative flux exceeds this share of the
@@ -93,16 +95,34 @@ void CaptureChecks::AddPosition(const SlabPosition& position, const SlabLayout& 
   for (const BracketRatio& b : report.bracket_ratios) {
     if (b.samples == 0) continue;
     ++brackets_;
-    const double fraction = std::log(b.estimated) / std::log(b.Recorded());
-    if (fraction >= order_fraction_) continue;
     // The two photos: the slide's entries at the recorded exposures (stored as float by the
     // merge, hence the tolerance).
-    std::string shorter, longer;
-    for (const PhotoEntry& e : dataset_.PhotosOf(position.i, position.j)) {
-      if (e.positive != b.positive) continue;
-      if (std::abs(e.exposure / b.recorded_short - 1) < 1e-5) shorter = dataset_.PhotoPath(e.file);
-      if (std::abs(e.exposure / b.recorded_long - 1) < 1e-5) longer = dataset_.PhotoPath(e.file);
+    const auto photos = [&] {
+      std::pair<std::string, std::string> out;  // shorter, longer
+      for (const PhotoEntry& e : dataset_.PhotosOf(position.i, position.j)) {
+        if (e.positive != b.positive) continue;
+        if (std::abs(e.exposure / b.recorded_short - 1) < 1e-5)
+          out.first = dataset_.PhotoPath(e.file);
+        if (std::abs(e.exposure / b.recorded_long - 1) < 1e-5)
+          out.second = dataset_.PhotoPath(e.file);
+      }
+      return out;
+    };
+    // brackets.recorded_ratios: a step whose ratio in the pixels is off the recorded one alike
+    // at every brightness (reconstruct's advice, BracketRatio::DeviationIsTheExposures).
+    const double deviation = std::abs(b.Deviation());
+    if (deviation > kRatioWarn && b.DeviationIsTheExposures()) {
+      ++ratios_off_;
+      if (deviation > ratio_worst_) {
+        const auto [shorter, longer] = photos();
+        ratio_worst_ = deviation;
+        ratio_where_ = longer + " against " + shorter + ": " + Text(b.estimated) +
+                       " in the pixels, " + Text(b.Recorded()) + " recorded";
+      }
     }
+    const double fraction = std::log(b.estimated) / std::log(b.Recorded());
+    if (fraction >= order_fraction_) continue;
+    const auto [shorter, longer] = photos();
     order_fraction_ = fraction;
     order_where_ = longer + " (exposure " + Text(b.recorded_long) + ") and " + shorter +
                    " (exposure " + Text(b.recorded_short) + ")";
@@ -137,6 +157,28 @@ void CaptureChecks::Finish(const std::string& slab_dir, const SlabInfo& info) {
               {{"steps", brackets_},
                {"log_ratio_fraction", order_fraction_},
                {"min_log_ratio_fraction", kMinOrderFraction}});
+  if (brackets_ > 0) {
+    const nlohmann::json values = {{"steps", brackets_},
+                                   {"steps_off", ratios_off_},
+                                   {"worst_deviation", ratio_worst_},
+                                   {"warn_above", kRatioWarn}};
+    if (ratios_off_ > 0)
+      log_.Warn("brackets.recorded_ratios",
+                std::to_string(ratios_off_) + " of " + std::to_string(brackets_) +
+                    " bracket step(s) measure an exposure ratio more than " +
+                    Text(100 * kRatioWarn) + " % off the recorded one at every brightness (worst " +
+                    Text(100 * ratio_worst_) + " %, " + ratio_where_ +
+                    "): the recorded exposures are not the camera's (nominal EXIF times, a "
+                    "wrong --exposures); --bracket-ratios estimated uses the pixels' ratios",
+                values);
+    else
+      log_.Pass("brackets.recorded_ratios",
+                std::to_string(brackets_) +
+                    " bracket step(s): no exposure ratio off the "
+                    "recorded one by more than " +
+                    Text(100 * kRatioWarn) + " % at every brightness",
+                values);
+  }
   CheckSlideSigns();
   CheckNeighbours();
   log_.Save();

@@ -6,6 +6,9 @@
 //    larger values at the pixels well exposed in both (the ratio the merge estimates from the
 //    pixels, reconstruct/bracket_ratios.h); a bracket whose pixels say the other order is
 //    exit 2, naming the two photos.
+//  * brackets.recorded_ratios: the steps whose ratio in the pixels is off the recorded one by
+//    more than kRatioAdviceAbove alike at every brightness (the exposures are not the camera's):
+//    a warning naming the worst step's photos, the advice of --bracket-ratios estimated.
 //  * slides.sign: the two slides of a position are T+ and T- of the same light (docs/method.md
 //    §2.5), so E = peak (E+ - E-) summed over the screen is the light through Phi~_ij: positive
 //    at the positions that carry the luminaire's light, negative only under the filter's
@@ -69,6 +72,10 @@ class CaptureChecks {
   double order_fraction_ = 1e300;
   std::string order_where_;
   int brackets_ = 0;
+  // brackets.recorded_ratios: steps whose ratio is off the recorded one, the worst, where.
+  int ratios_off_ = 0;
+  double ratio_worst_ = 0;
+  std::string ratio_where_;
 };
 
 }  // namespace lumislab

@@ -105,7 +105,7 @@ void ReportBrackets(const Position& position, const PositionReport& r, const Run
     }
     text << (used ? "the estimate is used"
                   : "the recorded one is used (--bracket-ratios estimated uses the estimate)");
-    if (deviation > 0.05)
+    if (deviation > kRatioAdviceAbove)
       LogWarning(text.str());
     else if (deviation > 0.01)
       LogInfo(text.str());

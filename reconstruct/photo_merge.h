@@ -64,6 +64,10 @@ struct BracketRatio {
   // so that following it (--bracket-ratios estimated) corrects the exposure, not the noise.
   bool DeviationIsTheExposures() const;
 };
+// A bracket step whose estimate deviates more than this from the recorded ratio, alike at every
+// brightness, is warned with the advice to use the estimate: EXIF shutter times are nominal,
+// 1/30 s may be 1/32 s (6.7 %).
+constexpr double kRatioAdviceAbove = 0.05;
 // Too few pixels well exposed in both: the ratio is not estimated (the recorded one is used).
 constexpr long long kMinRatioSamples = 200;
 // The least value (above black, in units of the white level) a pixel needs in both photos to

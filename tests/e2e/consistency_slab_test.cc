@@ -183,12 +183,15 @@ TEST_F(JpegCamera, BracketAdviceOnlyWhenTheExposuresAreOff) {
   EXPECT_LT(exact.second, 0.7 * at_one.second);
   // Exact exposures: no advice (before the estimate kept to codes >= 32: 36 warnings of -50 %).
   EXPECT_EQ(exact.first, 0) << output;
+  EXPECT_EQ(Record(root_ + "/ds", "reconstruct", "brackets.recorded_ratios")["outcome"], "passed");
   // The long bracket labelled 2.2 where it was 2 (10 % off): advised, and the advice helps.
   SetDataset([](nlohmann::json& d) {
     for (auto& p : d["photos"])
       if (p["exposure"].get<double>() == 2.0) p["exposure"] = 2.2;
   });
   const auto off = Reconstruct("recorded");
+  // The advice is recorded too (the dataset's report, not only the log).
+  EXPECT_EQ(Record(root_ + "/ds", "reconstruct", "brackets.recorded_ratios")["outcome"], "warning");
   const auto followed = Reconstruct("estimated");
   std::printf("exposures 10 %% off: %d warnings, worst position %.4f recorded, %.4f estimated\n",
               off.first, off.second, followed.second);

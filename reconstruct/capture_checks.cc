@@ -41,7 +41,30 @@ constexpr double kNegativeDominance = 2;
 // -1.12 spacings (a hard-case sweep's point sources under the negative lobes), 2.6 (demo), 31 ...
 // 38 (the test scenes); two neighbours exchanged: -41.6 (demo), -31.9 (the test scene).
 constexpr double kLitShare = 0.1;
+
+// positions.distinct: a lit neighbour pair whose thumbnails differ (||a - b|| / (||a|| + ||b||))
+// by less than this share of the capture's median neighbour pair warns. Measured (the least pair
+// over the median): legitimate 0.56 (one emitter 300 mm behind S), 0.78 (the default scene),
+// 0.80 (the four-emitter wide scene), 0.83 (15 x 11 at 2 mm), 0.88 - 1 (the test scenes, a
+// narrow beam, an emitter off the grid); a position photographed twice with noise, or the same
+// photos listed for two positions, 0.034.
+constexpr double kDistinctShare = 0.1;
+constexpr int kDistinctMinPairs = 4;  // fewer pairs: no median to compare with
 constexpr double kMaxBackwardSpacings = 4;
+// ... and only where such a jump is isolated: at most this many pairs (or this share of them)
+// move against the grid at all. The light of several emitters moves its centroid back and forth
+// as one emitter or another dominates the window: a legitimate four-emitter scene (the wide
+// study scene, 400 x 300 photos) has 11 of 108 pairs backward, 5 by more than 4 spacings (down
+// to -13.4); the default luminaire on a 15 x 11 grid at 2 mm 12 of 216, down to -30.7 spacings.
+// Single-emitter and the default scene at 5 mm: none backward. Two neighbours of the default
+// scene exchanged: 1 pair, -41.5 spacings.
+constexpr int kMaxIsolatedBackward = 2;
+// A row whose lit pairs along s (at least this many) all move backward while another row's all
+// move forward warns too (every other row reversed: the scan order mistold). The red team's rows
+// capture imported as serpentine: rows 1 of 3 reversed; none of the legitimate captures above
+// has a whole row backward.
+constexpr int kMinRowPairs = 3;
+constexpr double kIsolatedShare = 0.02;
 
 std::string Text(double v) {
   std::ostringstream os;
@@ -69,6 +92,8 @@ PositionLight MeasureLight(const SlabPosition& p, const SlabLayout& layout) {
       (e > 0 ? out.positive : out.negative) += std::abs(e);
       const Eigen::Vector2d c = layout.TexelCentre(col, row);
       ws += std::abs(e) * c.x(), wt += std::abs(e) * c.y();
+      const int side = PositionLight::kThumbnailSide;
+      out.thumbnail[size_t(row * side / layout.res_y) * side + col * side / layout.res_x] += e;
     }
   const double w = out.Magnitude();
   if (w > 0) out.centre_s = ws / w, out.centre_t = wt / w;
@@ -181,6 +206,7 @@ void CaptureChecks::Finish(const std::string& slab_dir, const SlabInfo& info) {
   }
   CheckSlideSigns();
   CheckNeighbours();
+  CheckDistinct();
   log_.Save();
 }
 
@@ -249,6 +275,8 @@ void CaptureChecks::CheckNeighbours() {
   double least = HUGE_VAL;  // the smallest centroid step, in spacings
   std::string least_where;
   std::vector<std::string> backward;
+  int any_backward = 0;                     // pairs whose centroid moves against the grid at all
+  std::map<int, std::pair<int, int>> rows;  // per row j: lit pairs along s, those backward
   for (const auto& [key, a] : light_)
     for (const bool along_i : {true, false}) {
       const auto it =
@@ -258,6 +286,14 @@ void CaptureChecks::CheckNeighbours() {
       if (a.Magnitude() < kLitShare * lit || b.Magnitude() < kLitShare * lit) continue;
       ++pairs;
       const double step = (along_i ? b.centre_s - a.centre_s : b.centre_t - a.centre_t) / h;
+      LogDebug("positions.shift: ", PositionName(a.i, a.j), " -> ", PositionName(b.i, b.j), " ",
+               step, " spacings");
+      if (step < 0) ++any_backward;
+      if (along_i) {
+        auto& row = rows[a.j];
+        ++row.first;
+        if (step < 0) ++row.second;
+      }
       const std::string where = PositionName(a.i, a.j) + " -> " + PositionName(b.i, b.j);
       if (step < least) least = step, least_where = where;
       if (step < -kMaxBackwardSpacings)
@@ -265,10 +301,35 @@ void CaptureChecks::CheckNeighbours() {
                            ")");
     }
   if (pairs == 0) return;
+  const int isolated = std::max(kMaxIsolatedBackward, int(kIsolatedShare * pairs));
   const nlohmann::json values = {{"pairs", pairs},
                                  {"smallest_step_spacings", least},
-                                 {"min_step_spacings", -kMaxBackwardSpacings}};
-  if (!backward.empty()) {
+                                 {"min_step_spacings", -kMaxBackwardSpacings},
+                                 {"pairs_backward", any_backward},
+                                 {"max_pairs_backward", isolated}};
+  // Whole rows backward while others run forward: the rows were scanned the other way than the
+  // import was told (rows against serpentine), every other row's photos reversed.
+  std::vector<int> reversed;
+  int forward_rows = 0;
+  for (const auto& [j, row] : rows) {
+    if (row.first < kMinRowPairs) continue;
+    if (row.second == row.first) reversed.push_back(j);
+    if (row.second == 0) ++forward_rows;
+  }
+  if (!reversed.empty() && forward_rows > 0) {
+    std::string list;
+    for (size_t k = 0; k < reversed.size(); ++k)
+      list += (k ? ", " : "") + std::to_string(reversed[k]);
+    log_.Warn("positions.shift",
+              dataset_.Path("dataset.json") + ": photos: in row(s) j = " + list +
+                  " the light moves against the grid at every lit pair, in " +
+                  std::to_string(forward_rows) +
+                  " other row(s) with it: the rows were scanned the other way than the import "
+                  "was told (--scan rows against serpentine)?",
+              values);
+    return;
+  }
+  if (!backward.empty() && any_backward <= isolated) {
     std::string list;
     for (size_t k = 0; k < backward.size() && k < 4; ++k) list += (k ? ", " : "") + backward[k];
     if (backward.size() > 4) list += " and " + std::to_string(backward.size() - 4) + " more";
@@ -282,10 +343,69 @@ void CaptureChecks::CheckNeighbours() {
               values);
     return;
   }
-  log_.Pass("positions.shift",
-            std::to_string(pairs) +
-                " lit neighbour pairs: the light moves with the grid (smallest step " +
-                Text(least) + " spacings, " + least_where + ")",
+  log_.Pass(
+      "positions.shift",
+      std::to_string(pairs) + " lit neighbour pairs: " +
+          (backward.empty() ? std::string("the light moves with the grid")
+                            : std::to_string(any_backward) +
+                                  " move against the grid, as the light of several emitters does") +
+          " (smallest step " + Text(least) + " spacings, " + least_where + ")",
+      values);
+}
+
+void CaptureChecks::CheckDistinct() {
+  double lit = 0;
+  for (const auto& [key, l] : light_) lit = std::max(lit, l.Magnitude());
+  struct Pair {
+    const PositionLight *a, *b;
+    double difference;
+  };
+  std::vector<Pair> pairs;
+  for (const auto& [key, a] : light_)
+    for (const bool along_i : {true, false}) {
+      const auto it =
+          light_.find(along_i ? std::make_pair(a.j, a.i + 1) : std::make_pair(a.j + 1, a.i));
+      if (it == light_.end()) continue;
+      const PositionLight& b = it->second;
+      if (a.Magnitude() < kLitShare * lit || b.Magnitude() < kLitShare * lit) continue;
+      double diff = 0, norm_a = 0, norm_b = 0;
+      for (size_t k = 0; k < a.thumbnail.size(); ++k) {
+        diff += (a.thumbnail[k] - b.thumbnail[k]) * (a.thumbnail[k] - b.thumbnail[k]);
+        norm_a += a.thumbnail[k] * a.thumbnail[k], norm_b += b.thumbnail[k] * b.thumbnail[k];
+      }
+      pairs.push_back({&a, &b, std::sqrt(diff) / (std::sqrt(norm_a) + std::sqrt(norm_b))});
+    }
+  if (int(pairs.size()) < kDistinctMinPairs) return;
+  std::vector<double> d;
+  for (const Pair& p : pairs) d.push_back(p.difference);
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  const double median = d[d.size() / 2];
+  const Pair* least =
+      &*std::min_element(pairs.begin(), pairs.end(),
+                         [](const Pair& x, const Pair& y) { return x.difference < y.difference; });
+  const double share = median > 0 ? least->difference / median : 1;
+  const nlohmann::json values = {{"pairs", pairs.size()},
+                                 {"median_difference", median},
+                                 {"least_difference", least->difference},
+                                 {"least_share_of_median", share},
+                                 {"warn_below_share", kDistinctShare}};
+  const std::string where = "positions " + PositionName(least->a->i, least->a->j) + " (" +
+                            SlidePhotos(least->a->i, least->a->j) + ") and " +
+                            PositionName(least->b->i, least->b->j) + " (" +
+                            SlidePhotos(least->b->i, least->b->j) + ")";
+  if (share < kDistinctShare) {
+    log_.Warn("positions.distinct",
+              dataset_.Path("dataset.json") + ": photos: " + where + " differ by " +
+                  Text(100 * share) +
+                  " % of the capture's median neighbour pair: the same "
+                  "position photographed twice (and the next one missed)?",
+              values);
+    return;
+  }
+  log_.Pass("positions.distinct",
+            std::to_string(pairs.size()) + " lit neighbour pairs differ (the least " +
+                Text(100 * share) + " % of the median, " + PositionName(least->a->i, least->a->j) +
+                " and " + PositionName(least->b->i, least->b->j) + ")",
             values);
 }
 

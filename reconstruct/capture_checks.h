@@ -16,14 +16,23 @@
 //    is mostly negative and more than 0.5 of that is exit 2, naming its two photos: the slides
 //    look swapped (in dataset.json, or every photo shifted by one in the import). A grid one
 //    position wide cannot tell (light beyond it is negative everywhere): a warning there.
+//  * positions.distinct: neighbouring positions see the light through different filter
+//    centres, so their slab images differ; a lit neighbour pair whose images differ by far less
+//    than the capture's typical neighbour pair (a tenth of the median) is a warning: the same
+//    position photographed twice (and the next one missed), or its photos listed twice. (Not
+//    an error even for the same photo files twice: each position's slab image is in the
+//    luminaire's frame, so the same photos give images shifted by a spacing, not equal ones.)
 //  * positions.shift: neighbouring positions see shifted copies of one light field, to first
 //    order: the light through a filter centre c lands around c + d tan(its direction), so its
 //    centroid on the screen (luminaire frame) moves with the grid index. A neighbour pair whose
-//    centroid moves against the grid by more than 4 spacings is a warning (photos of another
-//    position?); a converging luminaire could mean it. (A list shifted by a whole position
-//    shows only where the scan wraps, and only where those positions are lit.)
+//    centroid moves against the grid by more than 4 spacings, in a capture where such pairs are
+//    isolated (at most 2, or 2 % of the pairs, move backward at all: the light of several
+//    emitters moves back and forth legitimately), is a warning (photos of another position?). (A
+//    list shifted by a whole position shows only where the scan wraps, and only where those
+//    positions are lit.)
 #pragma once
 
+#include <array>
 #include <map>
 #include <mutex>
 #include <string>
@@ -41,6 +50,10 @@ struct PositionLight {
   int i = 0, j = 0;
   double positive = 0, negative = 0;  // sums of E above 0 and of -E below 0 (E x texels)
   double centre_s = 0, centre_t = 0;  // mm, luminaire frame: the |E|-weighted centroid
+  // E (channels summed, seen texels) summed over kThumbnailSide x kThumbnailSide cells of the
+  // slab image: what positions.distinct compares between neighbours.
+  static constexpr int kThumbnailSide = 16;
+  std::array<double, kThumbnailSide * kThumbnailSide> thumbnail{};
   double Flux() const { return positive - negative; }
   double Magnitude() const { return positive + negative; }
 };
@@ -62,6 +75,7 @@ class CaptureChecks {
  private:
   void CheckSlideSigns();
   void CheckNeighbours();
+  void CheckDistinct();
   std::string SlidePhotos(int i, int j) const;  // "<p photo> and <n photo>"
 
   const Dataset& dataset_;

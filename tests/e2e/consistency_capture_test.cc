@@ -5,6 +5,7 @@
 // laid out as a camera leaves it (IMG_0001.PNG ... in capture order, rows, p then n).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -89,6 +90,14 @@ class ConsistencyCapture : public ::testing::Test {
       if (c["check"] == check) return c["outcome"];
     return "";
   }
+  // The values of `check` in <ds>/checks.json's stage "reconstruct", as JSON text.
+  std::string Values(const std::string& ds, const std::string& check) {
+    const nlohmann::json j =
+        nlohmann::json::parse(ReadBinaryFile(root_ + "/" + ds + "/checks.json"));
+    for (const auto& c : j["stages"]["reconstruct"]["checks"])
+      if (c["check"] == check) return c["values"].dump();
+    return "";
+  }
   std::string root_, board_;
   std::vector<std::string> taken_;  // the photos in the order they were taken
 };
@@ -109,6 +118,8 @@ TEST_F(ConsistencyCapture, LegitimateCapturePassesAndUnpaddedNamesGiveTheSameSla
   for (const char* ds : {"a", "b"}) {
     EXPECT_EQ(Outcome(ds, "reconstruct", "slides.sign"), "passed") << ds;
     EXPECT_EQ(Outcome(ds, "reconstruct", "positions.shift"), "passed") << ds;
+    EXPECT_EQ(Outcome(ds, "reconstruct", "positions.distinct"), "passed") << ds;
+    std::printf("legitimate: %s\n", Values(ds, "positions.distinct").c_str());
   }
 }
 
@@ -166,6 +177,40 @@ TEST_F(ConsistencyCapture, NeighboursExchangedWarn) {
   EXPECT_NE(r.output.find("moves against the grid"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(0, 0) -> (1, 0)"), std::string::npos) << r.output;
   EXPECT_EQ(Outcome("ds", "reconstruct", "positions.shift"), "warning");
+}
+
+// Position (1, 0) photographed twice and (2, 0) never: the count is right, so --order name
+// gives (2, 0) the second shots of (1, 0). Shot again, with the sensor's noise, or the same files
+// listed twice, the two slab images differ far less than neighbours do: warned
+// (positions.distinct), naming both positions' photos.
+TEST_F(ConsistencyCapture, APositionShotTwiceIsNoticed) {
+  std::vector<std::string> photos = taken_;
+  fs::create_directories(root_ + "/again");
+  for (int k = 0; k < 2; ++k) {  // (1, 0)'s p and n photographed again: 0.2 % brighter, noisy
+    cv::Mat again = cv::imread(taken_[2 + k], cv::IMREAD_UNCHANGED), noise(again.size(), CV_32FC3);
+    ASSERT_FALSE(again.empty());
+    again.convertTo(again, CV_32FC3, 1.002);
+    cv::randn(noise, 0, 30);  // codes of 65535
+    again += noise;
+    again.convertTo(again, CV_16UC3);
+    photos[4 + k] = root_ + "/again/" + std::to_string(k) + ".png";
+    ASSERT_TRUE(cv::imwrite(photos[4 + k], again));
+  }
+  CameraFolder("twice", photos, "IMG_%04d.PNG");
+  Chain("twice", "ds");
+  const auto r = RunToolIn(root_, "lumislab-reconstruct", "--dataset ds --resolution 40");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("positions (1, 0) ("), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("photographed twice"), std::string::npos) << r.output;
+  EXPECT_EQ(Outcome("ds", "reconstruct", "positions.distinct"), "warning");
+  std::printf("shot twice: %s\n", Values("ds", "positions.distinct").c_str());
+
+  photos[4] = taken_[2], photos[5] = taken_[3];
+  CameraFolder("copies", photos, "IMG_%04d.PNG");
+  Chain("copies", "ds2");
+  Ok("lumislab-reconstruct", "--dataset ds2 --resolution 40");
+  EXPECT_EQ(Outcome("ds2", "reconstruct", "positions.distinct"), "warning");
+  std::printf("listed twice: %s\n", Values("ds2", "positions.distinct").c_str());
 }
 
 // A bracket of two exposures per slide made from the capture (the photo and a copy at a quarter

@@ -19,40 +19,44 @@ nlohmann::json SlabLightValues(const SlabLight& light) {
           {"negative_positions", light.negative_positions}};
 }
 
-SlabLight MeasureSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                           const Eigen::Vector3d& channel_weights) {
-  const SlabLayout& layout = info.layout;
-  const int texels = layout.res_x * layout.res_y;
-  const double area_m2 = layout.TexelW() * layout.TexelH() * 1e-6;
-  std::vector<double> texel_flux(size_t(texels), 0.0);
-  SlabLight light;
-  double lowest = 0;
-  for (size_t p = 0; p < positions.size(); ++p) {
-    const SlabPosition& pos = positions[p];
-    if (pos.irradiance.empty()) continue;
-    ++light.positions;
-    double sum = 0;
-    for (int t = 0; t < texels; ++t)
-      if (pos.mask.data[t] >= 0.5f) {
-        const double f = (channel_weights.x() * pos.irradiance.data[3 * t] +
-                          channel_weights.y() * pos.irradiance.data[3 * t + 1] +
-                          channel_weights.z() * pos.irradiance.data[3 * t + 2]) *
-                         area_m2;
-        texel_flux[t] += f;
-        sum += f;
-      }
-    (sum < 0 ? light.position_negative : light.position_positive) += std::abs(sum);
-    if (sum < 0) ++light.negative_positions;
-    if (sum < lowest) {
-      lowest = sum;
-      light.most_negative = {int(p) % info.grid.nu, int(p) / info.grid.nu};
+SlabLightSum::SlabLightSum(const SlabInfo& info, const Eigen::Vector3d& channel_weights)
+    : info_(info),
+      weights_(channel_weights),
+      area_m2_(info.layout.TexelW() * info.layout.TexelH() * 1e-6),
+      texel_flux_(size_t(info.layout.res_x) * info.layout.res_y, 0.0) {}
+
+void SlabLightSum::Add(const SlabPosition& pos) {
+  if (pos.irradiance.empty()) return;
+  ++light_.positions;
+  double sum = 0;
+  for (size_t t = 0; t < texel_flux_.size(); ++t)
+    if (pos.mask.data[t] >= 0.5f) {
+      const double f = (weights_.x() * pos.irradiance.data[3 * t] +
+                        weights_.y() * pos.irradiance.data[3 * t + 1] +
+                        weights_.z() * pos.irradiance.data[3 * t + 2]) *
+                       area_m2_;
+      texel_flux_[t] += f;
+      sum += f;
     }
-  }
-  for (const double f : texel_flux) {
+  (sum < 0 ? light_.position_negative : light_.position_positive) += std::abs(sum);
+  if (sum < 0) ++light_.negative_positions;
+  if (sum < lowest_) lowest_ = sum, light_.most_negative = {pos.i, pos.j};
+}
+
+SlabLight SlabLightSum::Result() const {
+  SlabLight light = light_;
+  for (const double f : texel_flux_) {
     light.total += f;
     (f < 0 ? light.negative : light.positive) += std::abs(f);
   }
   return light;
+}
+
+SlabLight MeasureSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                           const Eigen::Vector3d& channel_weights) {
+  SlabLightSum sum(info, channel_weights);
+  for (const SlabPosition& pos : positions) sum.Add(pos);
+  return sum.Result();
 }
 
 bool TotalLightHasASign(const SlabInfo& info) { return info.grid.nu >= 2 && info.grid.nv >= 2; }
@@ -82,12 +86,17 @@ void JudgeTotalLight(const std::string& check, const std::string& what, const Sl
 SlabLight CheckSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                          const std::string& slab_dir, CheckLog& checks) {
   const SlabLight light = MeasureSlabLight(info, positions);
+  CheckSlabLight(info, light, slab_dir, checks);
+  return light;
+}
+
+void CheckSlabLight(const SlabInfo& info, const SlabLight& light, const std::string& slab_dir,
+                    CheckLog& checks) {
   const std::string sums = "its " + std::to_string(light.positions) + " position(s) sum to " +
                            Num(light.total, 6) + " (positive texels " + Num(light.positive, 6) +
                            ", negative " + Num(light.negative, 6) + ")";
   JudgeTotalLight("slab.total_light", "total light", light, info, slab_dir, sums,
                   SlabLightValues(light), checks);
-  return light;
 }
 
 std::string DatasetOfSlab(const std::string& slab_dir) {

@@ -40,7 +40,25 @@ struct SlabLight {
   double NegativeShare() const { return negative / (positive + negative); }
 };
 
-// The one channel (channel_weights . RGB) of every seen texel of the positions with an image.
+// The one channel (channel_weights . RGB) of every seen texel of the positions with an image,
+// summed one position at a time (a stage that does not hold the slab reads it position by
+// position: one image in memory, not the whole slab).
+class SlabLightSum {
+ public:
+  explicit SlabLightSum(const SlabInfo& info,
+                        const Eigen::Vector3d& channel_weights = LuminanceWeights());
+  void Add(const SlabPosition& position);  // one with an image; its i, j name it
+  SlabLight Result() const;
+
+ private:
+  const SlabInfo& info_;
+  Eigen::Vector3d weights_;
+  double area_m2_;
+  std::vector<double> texel_flux_;
+  SlabLight light_;
+  double lowest_ = 0;
+};
+// The same over a whole slab (positions without an image are skipped).
 SlabLight MeasureSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                            const Eigen::Vector3d& channel_weights = LuminanceWeights());
 
@@ -68,6 +86,9 @@ void JudgeTotalLight(const std::string& check, const std::string& what, const Sl
 // demo's -1.23 against +1.23, a half swapped -0.20).
 SlabLight CheckSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                          const std::string& slab_dir, CheckLog& checks);
+// The same of a slab measured already (SlabLightSum).
+void CheckSlabLight(const SlabInfo& info, const SlabLight& light, const std::string& slab_dir,
+                    CheckLog& checks);
 
 // The numbers a check records: the sums and the shares.
 nlohmann::json SlabLightValues(const SlabLight& light);

@@ -290,8 +290,9 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
 void CheckSlabBeforeRendering(const PreviewConfig& config, const SlabInfo& info) {
   if (info.present.empty() || (config.watch && !info.Complete())) return;
   CheckLog checks(DatasetOfSlab(config.slab_dir), "preview");
-  CheckSlabLight(info, ReadSlabPositions(config.slab_dir, info, config.threads), config.slab_dir,
-                 checks);
+  SlabLightSum sum(info);  // position by position: one image in memory
+  for (const auto& [i, j] : info.present) sum.Add(ReadSlabPosition(config.slab_dir, info, i, j));
+  CheckSlabLight(info, sum.Result(), config.slab_dir, checks);
   checks.Save();
 }
 

@@ -228,7 +228,10 @@ TEST_F(Gphoto2CameraTest, SilentCameraAtThePortIsBadInputWithinTheSocketTimeout)
   const Clock::time_point start = Clock::now();
   ExpectBadInput([&] { CameraAt(emulator)->Connect(Quick(), nullptr); },
                  {"gphoto2@" + emulator.ptpip_path(), "connecting", "no camera answers"});
-  EXPECT_LT(SecondsSince(start), 5);  // libgphoto2's PTP/IP read timeout is 2.5 s
+  // libgphoto2's PTP/IP read timeout is 2.5 s; its connect read the header once or three times
+  // before it gave up (2.55 s in most runs, 7.54 s in one CI run on a loaded machine), so the
+  // bound is three reads and a margin: what matters is that it ends, with this error.
+  EXPECT_LT(SecondsSince(start), 10);
 }
 
 void ExpectDeviceError(const std::function<void()>& f, const std::vector<std::string>& parts) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include "core/log.h"
@@ -267,9 +268,24 @@ void CaptureChecks::CheckSlideSigns() {
             values);
 }
 
-void CaptureChecks::CheckNeighbours() {
+void CaptureChecks::ForEachLitNeighbourPair(
+    const std::function<void(const PositionLight&, const PositionLight&, bool)>& visit) const {
   double lit = 0;
-  for (const auto& [key, l] : light_) lit = std::max(lit, l.Magnitude());
+  for (const auto& entry : light_) lit = std::max(lit, entry.second.Magnitude());
+  for (const auto& entry : light_) {
+    const PositionLight& a = entry.second;
+    for (const bool along_i : {true, false}) {
+      const auto it =
+          light_.find(along_i ? std::make_pair(a.j, a.i + 1) : std::make_pair(a.j + 1, a.i));
+      if (it == light_.end()) continue;
+      const PositionLight& b = it->second;
+      if (a.Magnitude() < kLitShare * lit || b.Magnitude() < kLitShare * lit) continue;
+      visit(a, b, along_i);
+    }
+  }
+}
+
+void CaptureChecks::CheckNeighbours() {
   const double h = dataset_.grid.spacing_mm;
   int pairs = 0;
   double least = HUGE_VAL;  // the smallest centroid step, in spacings
@@ -277,29 +293,23 @@ void CaptureChecks::CheckNeighbours() {
   std::vector<std::string> backward;
   int any_backward = 0;                     // pairs whose centroid moves against the grid at all
   std::map<int, std::pair<int, int>> rows;  // per row j: lit pairs along s, those backward
-  for (const auto& [key, a] : light_)
-    for (const bool along_i : {true, false}) {
-      const auto it =
-          light_.find(along_i ? std::make_pair(a.j, a.i + 1) : std::make_pair(a.j + 1, a.i));
-      if (it == light_.end()) continue;
-      const PositionLight& b = it->second;
-      if (a.Magnitude() < kLitShare * lit || b.Magnitude() < kLitShare * lit) continue;
-      ++pairs;
-      const double step = (along_i ? b.centre_s - a.centre_s : b.centre_t - a.centre_t) / h;
-      LogDebug("positions.shift: ", PositionName(a.i, a.j), " -> ", PositionName(b.i, b.j), " ",
-               step, " spacings");
-      if (step < 0) ++any_backward;
-      if (along_i) {
-        auto& row = rows[a.j];
-        ++row.first;
-        if (step < 0) ++row.second;
-      }
-      const std::string where = PositionName(a.i, a.j) + " -> " + PositionName(b.i, b.j);
-      if (step < least) least = step, least_where = where;
-      if (step < -kMaxBackwardSpacings)
-        backward.push_back(where + " (" + Text(step) + " spacings along " + (along_i ? "s" : "t") +
-                           ")");
+  ForEachLitNeighbourPair([&](const PositionLight& a, const PositionLight& b, bool along_i) {
+    ++pairs;
+    const double step = (along_i ? b.centre_s - a.centre_s : b.centre_t - a.centre_t) / h;
+    LogDebug("positions.shift: ", PositionName(a.i, a.j), " -> ", PositionName(b.i, b.j), " ", step,
+             " spacings");
+    if (step < 0) ++any_backward;
+    if (along_i) {
+      auto& row = rows[a.j];
+      ++row.first;
+      if (step < 0) ++row.second;
     }
+    const std::string where = PositionName(a.i, a.j) + " -> " + PositionName(b.i, b.j);
+    if (step < least) least = step, least_where = where;
+    if (step < -kMaxBackwardSpacings)
+      backward.push_back(where + " (" + Text(step) + " spacings along " + (along_i ? "s" : "t") +
+                         ")");
+  });
   if (pairs == 0) return;
   const int isolated = std::max(kMaxIsolatedBackward, int(kIsolatedShare * pairs));
   const nlohmann::json values = {{"pairs", pairs},
@@ -354,27 +364,19 @@ void CaptureChecks::CheckNeighbours() {
 }
 
 void CaptureChecks::CheckDistinct() {
-  double lit = 0;
-  for (const auto& [key, l] : light_) lit = std::max(lit, l.Magnitude());
   struct Pair {
     const PositionLight *a, *b;
     double difference;
   };
   std::vector<Pair> pairs;
-  for (const auto& [key, a] : light_)
-    for (const bool along_i : {true, false}) {
-      const auto it =
-          light_.find(along_i ? std::make_pair(a.j, a.i + 1) : std::make_pair(a.j + 1, a.i));
-      if (it == light_.end()) continue;
-      const PositionLight& b = it->second;
-      if (a.Magnitude() < kLitShare * lit || b.Magnitude() < kLitShare * lit) continue;
-      double diff = 0, norm_a = 0, norm_b = 0;
-      for (size_t k = 0; k < a.thumbnail.size(); ++k) {
-        diff += (a.thumbnail[k] - b.thumbnail[k]) * (a.thumbnail[k] - b.thumbnail[k]);
-        norm_a += a.thumbnail[k] * a.thumbnail[k], norm_b += b.thumbnail[k] * b.thumbnail[k];
-      }
-      pairs.push_back({&a, &b, std::sqrt(diff) / (std::sqrt(norm_a) + std::sqrt(norm_b))});
+  ForEachLitNeighbourPair([&](const PositionLight& a, const PositionLight& b, bool) {
+    double diff = 0, norm_a = 0, norm_b = 0;
+    for (size_t k = 0; k < a.thumbnail.size(); ++k) {
+      diff += (a.thumbnail[k] - b.thumbnail[k]) * (a.thumbnail[k] - b.thumbnail[k]);
+      norm_a += a.thumbnail[k] * a.thumbnail[k], norm_b += b.thumbnail[k] * b.thumbnail[k];
     }
+    pairs.push_back({&a, &b, std::sqrt(diff) / (std::sqrt(norm_a) + std::sqrt(norm_b))});
+  });
   if (int(pairs.size()) < kDistinctMinPairs) return;
   std::vector<double> d;
   for (const Pair& p : pairs) d.push_back(p.difference);

@@ -33,6 +33,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -76,6 +77,10 @@ class CaptureChecks {
   void CheckSlideSigns();
   void CheckNeighbours();
   void CheckDistinct();
+  // Calls visit(a, b, along_i) for every neighbour pair (b one step along i or along j from a)
+  // whose two positions are lit (magnitude >= kLitShare of the brightest).
+  void ForEachLitNeighbourPair(
+      const std::function<void(const PositionLight&, const PositionLight&, bool)>& visit) const;
   std::string SlidePhotos(int i, int j) const;  // "<p photo> and <n photo>"
 
   const Dataset& dataset_;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
-#include <sstream>
 
 #include "core/log.h"
 
@@ -66,13 +65,6 @@ constexpr int kMaxIsolatedBackward = 2;
 // has a whole row backward.
 constexpr int kMinRowPairs = 3;
 constexpr double kIsolatedShare = 0.02;
-
-std::string Text(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
-}
 
 std::string PositionName(int i, int j) {
   return "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
@@ -142,21 +134,21 @@ void CaptureChecks::AddPosition(const SlabPosition& position, const SlabLayout& 
       if (deviation > ratio_worst_) {
         const auto [shorter, longer] = photos();
         ratio_worst_ = deviation;
-        ratio_where_ = longer + " against " + shorter + ": " + Text(b.estimated) +
-                       " in the pixels, " + Text(b.Recorded()) + " recorded";
+        ratio_where_ = longer + " against " + shorter + ": " + Num(b.estimated, 3) +
+                       " in the pixels, " + Num(b.Recorded(), 3) + " recorded";
       }
     }
     const double fraction = std::log(b.estimated) / std::log(b.Recorded());
     if (fraction >= order_fraction_) continue;
     const auto [shorter, longer] = photos();
     order_fraction_ = fraction;
-    order_where_ = longer + " (exposure " + Text(b.recorded_long) + ") and " + shorter +
-                   " (exposure " + Text(b.recorded_short) + ")";
+    order_where_ = longer + " (exposure " + Num(b.recorded_long, 3) + ") and " + shorter +
+                   " (exposure " + Num(b.recorded_short, 3) + ")";
     if (fraction < kMinOrderFraction)
       log_.Fail("brackets.exposure_order",
-                longer + ": exposure: expected values " + Text(b.Recorded()) + "x those of " +
-                    shorter + " (recorded " + Text(b.recorded_long) + " against " +
-                    Text(b.recorded_short) + "), got " + Text(b.estimated) +
+                longer + ": exposure: expected values " + Num(b.Recorded(), 3) + "x those of " +
+                    shorter + " (recorded " + Num(b.recorded_long, 3) + " against " +
+                    Num(b.recorded_short, 3) + "), got " + Num(b.estimated, 3) +
                     "x in the pixels well exposed in both: the longer exposure is the darker "
                     "photo (exposures exchanged in dataset.json, or --exposures in another "
                     "order than the camera took them)",
@@ -179,7 +171,7 @@ void CaptureChecks::Finish(const std::string& slab_dir, const SlabInfo& info) {
               std::to_string(brackets_) +
                   " bracket step(s): every longer exposure the brighter photo (smallest log "
                   "ratio estimated / recorded " +
-                  Text(order_fraction_) + ", " + order_where_ + ")",
+                  Num(order_fraction_, 3) + ", " + order_where_ + ")",
               {{"steps", brackets_},
                {"log_ratio_fraction", order_fraction_},
                {"min_log_ratio_fraction", kMinOrderFraction}});
@@ -192,8 +184,9 @@ void CaptureChecks::Finish(const std::string& slab_dir, const SlabInfo& info) {
       log_.Warn("brackets.recorded_ratios",
                 std::to_string(ratios_off_) + " of " + std::to_string(brackets_) +
                     " bracket step(s) measure an exposure ratio more than " +
-                    Text(100 * kRatioWarn) + " % off the recorded one at every brightness (worst " +
-                    Text(100 * ratio_worst_) + " %, " + ratio_where_ +
+                    Num(100 * kRatioWarn, 3) +
+                    " % off the recorded one at every brightness (worst " +
+                    Num(100 * ratio_worst_, 3) + " %, " + ratio_where_ +
                     "): the recorded exposures are not the camera's (nominal EXIF times, a "
                     "wrong --exposures); --bracket-ratios estimated uses the pixels' ratios",
                 values);
@@ -202,7 +195,7 @@ void CaptureChecks::Finish(const std::string& slab_dir, const SlabInfo& info) {
                 std::to_string(brackets_) +
                     " bracket step(s): no exposure ratio off the "
                     "recorded one by more than " +
-                    Text(100 * kRatioWarn) + " % at every brightness",
+                    Num(100 * kRatioWarn, 3) + " % at every brightness",
                 values);
   }
   CheckSlideSigns();
@@ -241,10 +234,10 @@ void CaptureChecks::CheckSlideSigns() {
     const bool all = brightest <= 0;
     const std::string message =
         SlidePhotos(worst->i, worst->j) + ": slides: expected T+ and T- of one light (the " +
-        "light through p minus n negative at most " + Text(kMaxNegativeShare) +
+        "light through p minus n negative at most " + Num(kMaxNegativeShare, 3) +
         " of the brightest position's), got " +
         (all ? std::string("a negative total at every position")
-             : Text(worst_share) + " of it negative at position " +
+             : Num(worst_share, 3) + " of it negative at position " +
                    PositionName(worst->i, worst->j)) +
         ": the two slides look swapped" +
         (swapped > 1 ? " (at " + std::to_string(swapped) +
@@ -263,7 +256,7 @@ void CaptureChecks::CheckSlideSigns() {
   }
   log_.Pass("slides.sign",
             std::to_string(light_.size()) + " position(s): light through p minus n positive (" +
-                std::to_string(dominated) + " mostly negative, at most " + Text(worst_share) +
+                std::to_string(dominated) + " mostly negative, at most " + Num(worst_share, 3) +
                 " of the brightest position's: the filter's negative lobes)",
             values);
 }
@@ -307,7 +300,7 @@ void CaptureChecks::CheckNeighbours() {
     const std::string where = PositionName(a.i, a.j) + " -> " + PositionName(b.i, b.j);
     if (step < least) least = step, least_where = where;
     if (step < -kMaxBackwardSpacings)
-      backward.push_back(where + " (" + Text(step) + " spacings along " + (along_i ? "s" : "t") +
+      backward.push_back(where + " (" + Num(step, 3) + " spacings along " + (along_i ? "s" : "t") +
                          ")");
   });
   if (pairs == 0) return;
@@ -359,7 +352,7 @@ void CaptureChecks::CheckNeighbours() {
           (backward.empty() ? std::string("the light moves with the grid")
                             : std::to_string(any_backward) +
                                   " move against the grid, as the light of several emitters does") +
-          " (smallest step " + Text(least) + " spacings, " + least_where + ")",
+          " (smallest step " + Num(least, 3) + " spacings, " + least_where + ")",
       values);
 }
 
@@ -398,7 +391,7 @@ void CaptureChecks::CheckDistinct() {
   if (share < kDistinctShare) {
     log_.Warn("positions.distinct",
               dataset_.Path("dataset.json") + ": photos: " + where + " differ by " +
-                  Text(100 * share) +
+                  Num(100 * share, 3) +
                   " % of the capture's median neighbour pair: the same "
                   "position photographed twice (and the next one missed)?",
               values);
@@ -406,8 +399,9 @@ void CaptureChecks::CheckDistinct() {
   }
   log_.Pass("positions.distinct",
             std::to_string(pairs.size()) + " lit neighbour pairs differ (the least " +
-                Text(100 * share) + " % of the median, " + PositionName(least->a->i, least->a->j) +
-                " and " + PositionName(least->b->i, least->b->j) + ")",
+                Num(100 * share, 3) + " % of the median, " +
+                PositionName(least->a->i, least->a->j) + " and " +
+                PositionName(least->b->i, least->b->j) + ")",
             values);
 }
 

@@ -112,13 +112,6 @@ constexpr double kDarkLevelWarn = 0.05, kDarkLevelFail = 0.2;
 constexpr double kDarkStructureFail = 0.01;
 constexpr int kDarkBlockPx = 16;
 
-double Percentile(std::vector<float> v, double q) {
-  if (v.empty()) return 0;
-  const size_t k = std::min(v.size() - 1, size_t(q * double(v.size())));
-  std::nth_element(v.begin(), v.begin() + long(k), v.end());
-  return v[k];
-}
-
 // ---- flat ---------------------------------------------------------------------------------
 
 // Mean level of the flat frames on the screen (fraction of full scale at each frame's own
@@ -458,6 +451,13 @@ void CheckScale(const nlohmann::json& report, double scale, CheckLog* checks) {
       checks->Pass("scale.matches_dataset",
                    "scale " + Num(ratio) + " times dataset.json's radiometry.scale_w_m2", v);
   }
+}
+
+double Percentile(std::vector<float> v, double q) {
+  if (v.empty()) return 0;
+  const size_t k = std::min(v.size() - 1, size_t(q * double(v.size())));
+  std::nth_element(v.begin(), v.begin() + long(k), v.end());
+  return v[k];
 }
 
 }  // namespace lumislab

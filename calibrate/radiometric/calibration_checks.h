@@ -41,4 +41,7 @@ void CheckFlat(const nlohmann::json& report, CheckLog* checks);
 // against dataset.json's radiometry.scale_w_m2 when it has one (report of scale_calibrator.h).
 void CheckScale(const nlohmann::json& report, double scale, CheckLog* checks);
 
+// The value below which a share q of `v` lies (nth_element's, at index q * size): 0 when empty.
+double Percentile(std::vector<float> v, double q);
+
 }  // namespace lumislab

@@ -164,13 +164,8 @@ FlatMap CalibrateFlat(const std::vector<CalibrationFrame>& frames, const Dataset
     if (on_screen[p] && !(dark && dark->hot[p]))
       gains.push_back((map.gain.data[p * 3] + map.gain.data[p * 3 + 1] + map.gain.data[p * 3 + 2]) /
                       3);
-  const auto percentile = [&](double q) {
-    const size_t k = std::min(gains.size() - 1, size_t(q * double(gains.size())));
-    std::nth_element(gains.begin(), gains.begin() + long(k), gains.end());
-    return double(gains[k]);
-  };
-  const double gain_p01 = gains.empty() ? 1.0 : percentile(0.01);
-  const double gain_p99 = gains.empty() ? 1.0 : percentile(0.99);
+  const double gain_p01 = gains.empty() ? 1.0 : Percentile(gains, 0.01);
+  const double gain_p99 = gains.empty() ? 1.0 : Percentile(gains, 0.99);
   if (smooth_px > 0) {
     // Normalised convolution: blur(gain * mask) / blur(mask) over the pixels that count.
     cv::Mat gain(h, w, CV_32FC3, map.gain.data.data()), mask(h, w, CV_32FC1, 0.f);

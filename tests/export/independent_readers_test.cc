@@ -102,12 +102,15 @@ std::string Joined(const std::vector<std::string>& files) {
 
 bool HavePython() { return RunShell("python3 -c 'import json, struct' 2>&1").exit_code == 0; }
 
-// build/npm with three installed from tests/export/readers/package.json (scripts/setup.sh
-// installs it; here too when it is missing). Empty, with `why` set, when npm cannot install it.
+// A folder with three installed from tests/export/readers/package.json: build/npm (scripts/
+// setup.sh installs it; this test installs it into its own build folder when it is missing). Empty,
+// with `why` set, when npm cannot install it.
 std::string ThreeFolder(std::string* why) {
   const std::string dir = std::string(LUMISLAB_BIN_DIR) + "/../npm";
-  const std::string loader = dir + "/node_modules/three/examples/jsm/loaders/IESLoader.js";
-  if (std::filesystem::exists(loader)) return dir;
+  const std::string loader = "/node_modules/three/examples/jsm/loaders/IESLoader.js";
+  // This build's folder, else build/'s (the sanitizer build shares what setup.sh installed).
+  for (const std::string& d : {dir, std::string(LUMISLAB_SOURCE_DIR) + "/build/npm"})
+    if (std::filesystem::exists(d + loader)) return d;
   if (RunShell("node --version && npm --version").exit_code != 0) {
     *why = "node or npm is not installed (scripts/setup.sh installs Debian's nodejs and npm)";
     return "";
@@ -117,7 +120,7 @@ std::string ThreeFolder(std::string* why) {
                              std::filesystem::copy_options::overwrite_existing);
   const auto r =
       RunShell("cd " + ShellQuote(dir) + " && timeout 180 npm install --no-audit --no-fund 2>&1");
-  if (r.exit_code != 0 || !std::filesystem::exists(loader)) {
+  if (r.exit_code != 0 || !std::filesystem::exists(dir + loader)) {
     *why = "npm could not install three (tests/export/readers/package.json) into " + dir +
            ": the npm registry is not reachable from here? npm said: " +
            r.output.substr(r.output.size() > 600 ? r.output.size() - 600 : 0);

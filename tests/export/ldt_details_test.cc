@@ -74,8 +74,12 @@ TEST(LdtDetails, ItypIsOneForAxialAndThreeOtherwise) {
   for (const auto& [c, ityp] : cases) {
     const IntensityDistribution d =
         Analytic(c, [](double cv, double g) { return Cosine(cv, g) * (1 + 0.001 * cv); });
-    const std::vector<std::string> lines = Lines(FormatEulumdat(d, "x.ldt"));
-    EXPECT_EQ(Line(lines, 2), std::to_string(ityp)) << "C planes " << c.size();
+    const std::string text = FormatEulumdat(d, "x.ldt");
+    EXPECT_EQ(Line(Lines(text), 2), std::to_string(ityp)) << "C planes " << c.size();
+    // Files of other writers with Ityp 0 (as lumislab wrote them) are still read.
+    std::string old = text;
+    old.replace(old.find("\r\n") + 2, 1, "0");
+    EXPECT_EQ(ParseEulumdat(old, "old.ldt").values, ParseEulumdat(text, "x.ldt").values);
   }
 }
 

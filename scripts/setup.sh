@@ -32,11 +32,17 @@ packages=(
   # the linker of every build here (scripts/test.sh's too): several times faster than ld.bfd,
   # and each build links about 70 executables
   lld
+  # tests/export/independent_readers_test.cc: three.js's IESLoader runs under node; the
+  # EULUMDAT and TM-25 layout readers (tests/export/readers/*.py) under python3
+  nodejs python3
 )
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm: Debian's package, unless an npm is there already (a nodejs package from elsewhere that
+# bundles its own npm conflicts with Debian's)
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if ((${#missing[@]})); then
   echo "setup: installing ${missing[*]}"
   sudo=""
@@ -53,3 +59,15 @@ jobs=$(nproc)
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON \
   -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld "$@" >/dev/null
 cmake --build build -j "$jobs"
+
+# three.js (tests/export/readers/package.json, a pinned version) into build/npm for the
+# independent IES reader test; without the npm registry the test installs it itself or skips,
+# saying why.
+mkdir -p build/npm
+if ! cmp -s tests/export/readers/package.json build/npm/package.json ||
+  [ ! -f build/npm/node_modules/three/examples/jsm/loaders/IESLoader.js ]; then
+  cp tests/export/readers/package.json build/npm/package.json
+  (cd build/npm && timeout 300 npm install --no-audit --no-fund >/dev/null 2>&1) ||
+    echo "setup: npm could not install three into build/npm (registry not reachable?);" \
+      "export.IndependentReaders.ThreeJsIesLoaderReadsEveryIesFile will try again or skip"
+fi

@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/input_file.h"
 #include "core/log.h"
 
@@ -18,6 +19,8 @@ namespace {
 
 constexpr int kMaxLdtAngles = 100000;
 constexpr char kRadiometricLamp[] = "radiometric: W/sr per 1000 W";
+constexpr char kAbsoluteLamp[] = "luminaire (absolute photometry)";
+constexpr char kUnknown[] = "-";  // a lamp text field that is not known
 
 std::string TrimField(const std::string& s) {
   size_t a = 0, b = s.size();
@@ -161,18 +164,20 @@ IntensityDistribution ParseEulumdat(const std::string& text, const std::string& 
   in.Number("line 25 (tilt during measurement)");
   const int sets = in.Int("line 26 (number of standard sets of lamps)", 1, 100);
   double lamp_flux = 0;
-  std::string lamp_type;
+  std::string lamp_type, colour_temperature, colour_rendering;
   for (int s = 0; s < sets; ++s) {
     const std::string set = " of lamp set " + std::to_string(s + 1);
     in.Number("line 26a (number of lamps" + set + ")");
     const std::string type = in.Text("line 26b (type of lamps" + set + ")");
     const double flux = in.Number("line 26c (total flux of lamps" + set + ")");
-    in.Text("line 26d (colour temperature" + set + ")");
-    in.Text("line 26e (colour rendering" + set + ")");
+    const std::string cct = in.Text("line 26d (colour temperature" + set + ")");
+    const std::string cri = in.Text("line 26e (colour rendering" + set + ")");
     const double watts = in.Number("line 26f (wattage" + set + ")");
     if (s == 0) {
       lamp_flux = flux;
       lamp_type = type;
+      colour_temperature = cct;
+      colour_rendering = cri;
       d.input_watts = watts;
     }
   }
@@ -180,6 +185,10 @@ IntensityDistribution ParseEulumdat(const std::string& text, const std::string& 
     throw BadInput(name + ": line 26c (total flux of lamp set 1): expected a number > 0 (the " +
                    "intensities are per 1000 lm of it), got " + Num(lamp_flux, 8));
   d.keywords.push_back({"LAMP", lamp_type});
+  if (!colour_temperature.empty() && colour_temperature != kUnknown)
+    d.keywords.push_back({"COLORTEMP", colour_temperature});
+  if (!colour_rendering.empty() && colour_rendering != kUnknown)
+    d.keywords.push_back({"CRI", colour_rendering});
   d.keywords.push_back({"_LDT_LORL", Num(lorl, 6) + " %"});
   d.keywords.push_back({"_LDT_CONVERSION_FACTOR", Num(conversion, 6)});
   d.keywords.push_back({"_LDT_ITYP", std::to_string(ityp)});
@@ -253,18 +262,61 @@ IntensityDistribution ReadEulumdat(const std::string& path) {
   return ParseEulumdat(ReadTextFile(path), path);
 }
 
-std::string FormatEulumdat(const IntensityDistribution& d, const std::string& name) {
+std::array<double, 10> LdtDirectRatios(const IntensityDistribution& d) {
+  // Luminaires spread evenly over the ceiling of a square room of side a (heights in units of h,
+  // the luminaires' height above the work plane: a = 2k): a luminaire at p sends I(C, gamma)
+  // sin(gamma) dgamma dC towards the work plane point p + tan(gamma) (cos C, sin C), and the
+  // fraction of ceiling points p for which that point lies in the room is the overlap of two
+  // squares shifted by (x, y): (1 - |x|/a)(1 - |y|/a). So the direct flux is the downward flux
+  // weighed by that overlap. The definition (the part of the luminaires' downward flux falling
+  // directly on the work plane, DIN 5040 / CIE 52's direct ratio) with no zonal
+  // approximation: the zonal coefficients of holg/eulumdat-rs (calculations.rs
+  // calculate_direct_ratios) give 0.50-0.53 at k = 0.6 for three files that publish 0.22-0.27,
+  // this gives 0.21-0.26 (docs/formats.md §17). Midpoint sums, 1 degree in C, 0.25 in gamma.
+  constexpr int kC = 360, kGamma = 360;
+  constexpr double kDeg = kPi / 180;
+  std::array<double, 10> direct{};
+  // Intensities over the peak: a ratio, and sums of values near the largest double overflow.
+  const double peak = *std::max_element(d.values.begin(), d.values.end());
+  if (!(peak > 0)) return direct;
+  double down = 0;
+  for (int ig = 0; ig < kGamma; ++ig) {
+    const double gamma = (ig + 0.5) * 90.0 / kGamma;
+    const double t = std::tan(gamma * kDeg), s = std::sin(gamma * kDeg);
+    for (int ic = 0; ic < kC; ++ic) {
+      const double c = (ic + 0.5) * 360.0 / kC;
+      const double flux = d.Intensity(c, gamma) / peak * s;
+      if (flux == 0) continue;
+      down += flux;
+      const double x = std::abs(t * std::cos(c * kDeg)), y = std::abs(t * std::sin(c * kDeg));
+      for (size_t k = 0; k < kLdtRoomIndices.size(); ++k) {
+        const double a = 2 * kLdtRoomIndices[k];
+        if (x < a && y < a) direct[k] += flux * (1 - x / a) * (1 - y / a);
+      }
+    }
+  }
+  if (down > 0)
+    for (double& r : direct) r /= down;
+  return direct;
+}
+
+std::string FormatEulumdat(const IntensityDistribution& d, const std::string& name,
+                           const EulumdatWriteOptions& options) {
   d.Check(name);
   const double flux = d.TotalFlux();
   if (!(flux > 0))
     throw BadInput(name + ": the distribution has no flux (EULUMDAT stores intensities per " +
                    "1000 lm of it)");
   const CSymmetry symmetry = d.Symmetry();
-  int isym = 0, ityp = 3;
+  // Ityp: 1 a point source symmetric about the vertical axis, 2 linear, 3 a point source with
+  // any other symmetry (holg/eulumdat-rs: eulumdat.rs TypeIndicator, whose parser refuses
+  // anything but 1-3, and writer.rs, which writes 1 for Isym 1 and 3 otherwise). A slab does
+  // not tell whether the luminaire is linear, so never 2.
+  const int ityp = symmetry == CSymmetry::kAxial ? 1 : 3;
+  int isym = 0;
   switch (symmetry) {
     case CSymmetry::kAxial:
       isym = 1;
-      ityp = 1;
       break;
     case CSymmetry::kC0C180:
       isym = 2;
@@ -277,7 +329,6 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
       break;
     case CSymmetry::kNone:
       isym = 0;
-      ityp = 0;
       break;
   }
   // The ends of the C range within the angle tolerance of a symmetry plane (a multiple of 90
@@ -293,12 +344,34 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
   std::vector<double> full = symmetry == CSymmetry::kAxial ? planes : FullCircle(planes, symmetry);
   std::vector<double> stored = planes;
   if (symmetry == CSymmetry::kNone && std::abs(stored.back() - 360) < 1e-6) stored.pop_back();
-  auto field = [](const std::string& s) { return s.substr(0, 78); };
-  auto keyword_or = [&](const char* key, const std::string& fallback) {
-    const std::string v = d.Keyword(key);
-    std::string one_line = v.substr(0, v.find('\n'));
-    return field(one_line.empty() ? fallback : one_line);
+  // A text field: its first line, at most 78 characters (the format's field width).
+  auto field = [](const std::string& s) {
+    return s.substr(0, std::min(s.find_first_of("\r\n"), size_t(78)));
   };
+  auto keyword_or = [&](const char* key, const std::string& fallback) {
+    const std::string v = field(d.Keyword(key));
+    return v.empty() ? fallback : v;
+  };
+  std::vector<LdtLampSet> sets = options.lamp_sets;
+  if (sets.empty())
+    sets.push_back({-1, d.photometric ? keyword_or("LAMP", kAbsoluteLamp) : kRadiometricLamp, flux,
+                    keyword_or("COLORTEMP", kUnknown), keyword_or("CRI", kUnknown), d.input_watts});
+  if (sets.size() > 100)
+    throw BadInput(name + ": lamp sets: expected at most 100 (EULUMDAT line 26), got " +
+                   std::to_string(sets.size()));
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const std::string set = name + ": lamp set " + std::to_string(s + 1) + ": ";
+    if (sets[s].count == 0)
+      throw BadInput(set + "number of lamps: expected a count other than 0 (negative: absolute " +
+                     "photometry), got 0");
+    if (!(sets[s].flux_lm > 0) || !std::isfinite(sets[s].flux_lm))
+      throw BadInput(set + "flux: expected a finite number > 0 (lm), got " +
+                     Num(sets[s].flux_lm, 8));
+    if (!(sets[s].watts >= 0) || !std::isfinite(sets[s].watts))
+      throw BadInput(set + "wattage: expected a finite number >= 0 (W), got " +
+                     Num(sets[s].watts, 8));
+  }
+  const double lamp_flux = sets[0].flux_lm;  // the intensities are per 1000 lm of it
   const bool round = d.opening.width_mm < 0 || d.opening.length_mm < 0;
   const double length = std::abs(d.opening.length_mm);
   const double width = round ? 0.0 : std::abs(d.opening.width_mm);
@@ -323,23 +396,36 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
   // largest double, 100 * flux or value * 1000 overflowed to "inf", which the reader refuses
   // (found by fuzz_eulumdat).
   os << Num(d.FluxWithin(90) / flux * 100.0, 8) << "\n"  // DFF: gamma < 90 is downward
-     << "100\n1\n0\n1\n1\n"
-     << (d.photometric ? keyword_or("LAMP", "luminaire (absolute photometry)") : kRadiometricLamp)
-     << "\n"
-     << Num(flux, 10) << "\n-\n-\n"
-     << Num(d.input_watts, 8) << "\n";
-  for (int k = 0; k < 10; ++k) os << "0\n";
+     << Num(flux / lamp_flux * 100.0, 8) << "\n"         // LORL
+     << "1\n0\n"  // conversion factor 1 (cd/klm as written), tilt 0
+     << sets.size() << "\n";
+  for (const LdtLampSet& s : sets)
+    os << s.count << "\n"
+       << field(s.type) << "\n"
+       << Num(s.flux_lm, 10) << "\n"
+       << (field(s.colour_temperature).empty() ? kUnknown : field(s.colour_temperature)) << "\n"
+       << (field(s.colour_rendering).empty() ? kUnknown : field(s.colour_rendering)) << "\n"
+       << Num(s.watts, 8) << "\n";
+  for (double r : LdtDirectRatios(d)) os << Num(r, 4) << "\n";
   // Angles with 15 digits: what was read is written back (Check wants them 1e-6 deg apart).
   for (double c : full) os << Num(c, 15) << "\n";
   for (double g : d.gamma_deg) os << Num(g, 15) << "\n";
   for (size_t c = 0; c < stored.size(); ++c)
     for (size_t g = 0; g < d.gamma_deg.size(); ++g)
-      os << Num(d.At(c, g) / flux * 1000.0, 8) << "\n";
-  return os.str();
+      os << Num(d.At(c, g) / lamp_flux * 1000.0, 8) << "\n";
+  // CR LF: the line ending of the format's DOS origins and of LM-63's text (the reader takes
+  // both).
+  std::string text;
+  for (char ch : os.str()) {
+    if (ch == '\n') text += '\r';
+    text += ch;
+  }
+  return text;
 }
 
-void WriteEulumdat(const IntensityDistribution& d, const std::string& path) {
-  WriteTextAtomically(path, FormatEulumdat(d, path));
+void WriteEulumdat(const IntensityDistribution& d, const std::string& path,
+                   const EulumdatWriteOptions& options) {
+  WriteTextAtomically(path, FormatEulumdat(d, path, options));
 }
 
 }  // namespace lumislab

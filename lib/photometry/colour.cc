@@ -59,6 +59,11 @@ Spectrum Blackbody(double kelvin) {
 
 Spectrum IlluminantD50() { return FromTable(kD50); }
 Spectrum IlluminantD65() { return FromTable(kD65); }
+std::optional<Spectrum> IlluminantByName(const std::string& name) {
+  if (name == "D50") return IlluminantD50();
+  if (name == "D65") return IlluminantD65();
+  return std::nullopt;
+}
 
 Spectrum ColorCheckerReflectance(int k) { return FromTable(kColorCheckerOhta[k]); }
 const char* ColorCheckerPatchName(int k) { return kColorCheckerNames[k]; }

@@ -26,6 +26,8 @@ Spectrum Blackbody(double kelvin);
 // CIE standard illuminants, relative (560 nm = 100).
 Spectrum IlluminantD50();
 Spectrum IlluminantD65();
+// "D50" or "D65": that illuminant; none for any other name.
+std::optional<Spectrum> IlluminantByName(const std::string& name);
 // Spectral reflectance of ColorChecker Classic patch k (0: dark skin ... 23: black), Ohta 1997.
 Spectrum ColorCheckerReflectance(int k);
 const char* ColorCheckerPatchName(int k);

@@ -7,9 +7,13 @@
 
 #include <filesystem>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "lib/lightfield/light_colour.h"
 #include "lib/photo/photo_write.h"
+#include "lib/synthetic/scene.h"
 #include "lib/synthetic/spectral.h"
+#include "lib/synthetic/truth.h"
 
 namespace lumislab {
 namespace {
@@ -68,6 +72,58 @@ TEST(ColourCalibrator, CctOfBlackbodyLightThroughTheFitIsTheTruth) {
     EXPECT_LT(std::abs(colour.cct.duv), 0.005) << kelvin;
     std::printf("%.0f K: recovered %.1f K, Duv %.5f\n", kelvin, colour.cct.kelvin, colour.cct.duv);
   }
+}
+
+TEST(ColourCalibrator, CctOfASyntheticLuminaireFromItsSlab) {
+  // A scene luminaire with a spectrum (emitter field cct_k): its truth slab's total light and far
+  // field through the matrix fitted to the synthetic chart photo give its temperature.
+  const Photo photo =
+      WriteAndDecode(RenderColourChartPhoto({}), "chart_slab.exr", PhotoEncoding::kFloatExr);
+  CheckLog checks("", "test");
+  const ColourCalibration c = Calibrate(photo, {}, &checks);
+  const SlabInfo info = DefaultSlabInfo(5, 5, 5, 24);
+  for (double kelvin : {2700.0, 4000.0, 6500.0}) {
+    const std::string file = (TempDir() / "luminaire.json").string();
+    WriteTextAtomically(file, R"({"schema_version": 1, "luminaire": {"emitters": [
+        {"position_mm": [0.5, -1, -15], "intensity_w_sr": 1.3, "cct_k": )" +
+                                  std::to_string(kelvin) + R"(, "lobe_exponent": 4}]}})");
+    const Luminaire luminaire = LoadLuminaire(file);
+    ASSERT_EQ(luminaire.emitters[0].cct_k, kelvin);
+    std::vector<SlabPosition> positions;
+    for (int j = 0; j < info.grid.nv; ++j)
+      for (int i = 0; i < info.grid.nu; ++i)
+        positions.push_back(TruthPosition(luminaire, info, i, j));
+    const LightColour total = TotalLightColour(info, positions, c);
+    EXPECT_NEAR(total.cct.kelvin, kelvin, 50) << kelvin;
+    const FarFieldColour far =
+        ComputeFarFieldColour(info, positions, {0, 90, 180, 270}, {0, 10, 20}, c);
+    int seen = 0;
+    for (size_t k = 0; k < far.colour.size(); ++k) {
+      // A direction whose far field is negative (the dual filter's lobes at a small grid's
+      // edge) has no chromaticity: NaN, by design.
+      if (!far.seen[k] || !(far.colour[k].xyz.y() > 0)) continue;
+      ++seen;
+      EXPECT_NEAR(far.colour[k].cct.kelvin, kelvin, 50)
+          << kelvin << " direction " << k << " xyz " << far.colour[k].xyz.transpose();
+    }
+    EXPECT_GE(seen, 8);
+    std::printf("%.0f K luminaire: total light %.1f K, xy (%.4f, %.4f); %d directions seen\n",
+                kelvin, total.cct.kelvin, total.xy.x(), total.xy.y(), seen);
+  }
+}
+
+TEST(ColourCalibrator, LuminousEfficacyOfTheScene) {
+  SynthScene scene = DefaultScene();  // RGB emitters, no spectrum: the documented default
+  EXPECT_NEAR(scene.LuminousEfficacy(), DefaultLuminousEfficacy(), 1e-12);
+  EXPECT_NEAR(DefaultLuminousEfficacy(), 683 * Cmf1931().col(1).mean(), 1e-9);
+  for (Emitter& e : scene.luminaire.emitters) {
+    e.cct_k = 2856;  // CIE illuminant A's temperature
+    e.radiant_w_sr = 1;
+  }
+  // Planck at 2856 K over 380 - 780 nm: ~ 683 x 0.2 = 137 lm/W (of the visible radiant power).
+  EXPECT_NEAR(scene.LuminousEfficacy(), LuminousEfficacy(Blackbody(2856)), 1e-9);
+  std::printf("luminous efficacy: default %.2f lm/W, 2856 K %.2f lm/W\n", DefaultLuminousEfficacy(),
+              scene.LuminousEfficacy());
 }
 
 TEST(ColourCalibrator, RefusesAPhotoWithoutAChart) {

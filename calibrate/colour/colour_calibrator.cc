@@ -220,7 +220,7 @@ ColourCalibration CalibrateColour(const ChartPatches& patches, const ColourOptio
                      options.illuminant + ": expected a residual Delta E*ab of at most " +
                      Num(options.max_mean_delta_e) + " mean and " + Num(options.max_delta_e) +
                      " max, got " + Num(c.mean_delta_e) + " and " + Num(c.max_delta_e) +
-                     " (not a ColorChecker Classic, or not lit by " + options.illuminant + ")",
+                     " (not a ColorChecker Classic 24, or unevenly lit or glared)",
                  values);
   checks->Pass("colour.fit",
                "RGB -> XYZ fit to the ColorChecker under " + options.illuminant +

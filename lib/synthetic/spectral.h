@@ -33,7 +33,7 @@ Eigen::Vector3d BlackbodyRgbPerWatt(double kelvin);
 // ("D50" or "D65"), seen slightly in perspective. Values: CameraRgb of reflectance x illuminant
 // (illuminant scaled to mean 1) x `exposure`, normalised linear (3 channels, RGB).
 struct ColourChartPhotoSpec {
-  int width = 1200, height = 900;  // px
+  int width = 800, height = 600;  // px
   std::string illuminant = "D65";
   double exposure = 0.8;        // the white patch (~0.9 reflectance) comes out ~0.7
   double chart_fraction = 0.7;  // chart width / photo width

@@ -12,6 +12,7 @@
 #include "core/parallel.h"
 #include "lib/synthetic/calibration_captures.h"
 #include "lib/synthetic/camera_views.h"
+#include "lib/synthetic/spectral.h"
 
 namespace lumislab {
 namespace {
@@ -41,7 +42,21 @@ std::vector<Frame> FrameList(const SynthScene& scene, const std::string& ext) {
     frames.push_back({CaptureKind::kResponse,
                       "calibration/response/response_" + BracketsEffect::Tag(stop) + "." + ext,
                       e0 * std::exp2(stop)});
+  // Lit by its own lamp, exposed for it (the white patch ~0.7 of full scale), not at e0.
+  if (!c.colour_chart.empty())
+    frames.push_back({CaptureKind::kColourChart, "calibration/colour/chart." + ext, 1.0});
   return frames;
+}
+
+// The ColorChecker photo at the camera's size (lib/synthetic/spectral.h), before effects: the
+// effects add the camera's noise.
+ImageF ColourChartRender(const SynthScene& scene) {
+  ColourChartPhotoSpec spec;
+  spec.width = scene.camera.width;
+  spec.height = scene.camera.height;
+  spec.illuminant = scene.captures->colour_chart;
+  spec.noise = 0;
+  return RenderColourChartPhoto(spec);
 }
 
 nlohmann::json Rgb(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
@@ -77,7 +92,10 @@ void WriteTruth(const SynthScene& scene, const Dataset& dataset, const std::stri
 void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
                               const std::string& dir, const PhotoStore& store, int threads) {
   if (!scene.captures) return;
-  for (const char* sub : {"/calibration/dark", "/calibration/flat", "/calibration/response"}) {
+  std::vector<std::string> subs = {"/calibration/dark", "/calibration/flat",
+                                   "/calibration/response"};
+  if (!scene.captures->colour_chart.empty()) subs.push_back("/calibration/colour");
+  for (const std::string& sub : subs) {
     MakeDirectories(dir + sub);
     RemoveOrphanedTemporaries(dir + sub);
   }
@@ -85,9 +103,10 @@ void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
   const std::vector<Frame> frames = FrameList(scene, StoredExtension(scene, store));
   ParallelFor(int(frames.size()), threads, [&](int k) {
     const Frame& f = frames[k];
-    ImageF photo = f.kind == CaptureKind::kFlat ? FlatFrameRender(scene, f.exposure)
-                   : f.kind == CaptureKind::kResponse
-                       ? ResponseSceneRender(scene, f.exposure)
+    ImageF photo = f.kind == CaptureKind::kFlat       ? FlatFrameRender(scene, f.exposure)
+                   : f.kind == CaptureKind::kResponse ? ResponseSceneRender(scene, f.exposure)
+                   : f.kind == CaptureKind::kColourChart
+                       ? ColourChartRender(scene)
                        : ImageF(scene.camera.width, scene.camera.height, 3);
     PhotoContext context;
     context.photo_index = int(dataset.photos.size()) + k;  // after every slide photo
@@ -99,6 +118,12 @@ void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
   manifest["schema_version"] = 1;
   for (const char* key : {"dark", "flat", "response"}) manifest[key] = nlohmann::json::array();
   for (const Frame& f : frames) {
+    if (f.kind == CaptureKind::kColourChart) {
+      manifest["colour"] = {{"file", f.file},
+                            {"chart", "ColorChecker Classic 24"},
+                            {"illuminant", scene.captures->colour_chart}};
+      continue;
+    }
     const char* key = f.kind == CaptureKind::kDark   ? "dark"
                       : f.kind == CaptureKind::kFlat ? "flat"
                                                      : "response";

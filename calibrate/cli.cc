@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "calibrate/cli_camera.h"
+#include "calibrate/cli_colour.h"
 #include "calibrate/cli_radiometric.h"
 #include "calibrate/cli_screen.h"
 #include "core/command_line.h"
@@ -16,7 +17,8 @@ int RunCalibrate(int argc, char** argv) {
   CLI::App app{
       "lumislab-calibrate: camera, screen and radiometric calibration into <dataset>/calib/ "
       "(docs/formats.md §5, §12 - §16). Order: response, dark, screen, flat, scale (flat "
-      "and scale need the screen); each later step decodes its frames with the earlier steps' "
+      "and scale need the screen; colour, from a ColorChecker photo, any time); each later step "
+      "decodes its frames with the earlier steps' "
       "corrections"};
   app.require_subcommand(1);
   CommonOptions common;
@@ -27,10 +29,13 @@ int RunCalibrate(int argc, char** argv) {
   AddCameraCommand(&app, &common, &camera);
   RadiometricCommand radiometric;
   AddRadiometricCommands(&app, &common, &radiometric);
+  ColourCommand colour;
+  AddColourCommand(&app, &common, &colour);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("calibrate", common);
   cv::setNumThreads(threads);
   if (camera.sub->parsed()) return RunCameraCommand(&camera, threads);
+  if (colour.sub->parsed()) return RunColourCommand(&colour);
   if (!screen.sub->parsed()) return RunRadiometricCommand(radiometric);
   return RunScreenCommand(&screen, threads);
 }

@@ -37,7 +37,8 @@ bool Applies(const std::string& type, CaptureKind kind) {
   if (kind == CaptureKind::kDark)
     return type != "vignetting" && type != "screen_gain" && type != "ambient";
   if (kind == CaptureKind::kFlat) return type != "ambient";
-  if (kind == CaptureKind::kCameraView) return type != "screen_gain" && type != "ambient";
+  if (kind == CaptureKind::kCameraView || kind == CaptureKind::kColourChart)
+    return type != "screen_gain" && type != "ambient";
   return true;
 }
 
@@ -45,13 +46,14 @@ bool Applies(const std::string& type, CaptureKind kind) {
 
 CalibrationCaptures ParseCalibrationCaptures(const JsonView& block, const SynthScene& scene) {
   CheckMembers(block, {"dark_frames", "dark_stops", "flat_frames", "flat_level", "response_stops",
-                       "reference"});
+                       "reference", "colour_chart"});
   CalibrationCaptures c;
   if (block.Has("dark_frames")) c.dark_frames = block["dark_frames"].IntIn(0, 64);
   if (block.Has("dark_stops")) c.dark_stops = Stops(block["dark_stops"], 1, 9);
   if (block.Has("flat_frames")) c.flat_frames = block["flat_frames"].IntIn(0, 64);
   if (block.Has("flat_level")) c.flat_level = block["flat_level"].NumberIn(1e-3, 1);
   if (block.Has("response_stops")) c.response_stops = Stops(block["response_stops"], 2, 16);
+  if (block.Has("colour_chart")) c.colour_chart = block["colour_chart"].OneOf({"D50", "D65"});
   if (block.Has("reference")) {
     const JsonView ref = block["reference"];
     CheckMembers(ref, {"position", "point_mm"});

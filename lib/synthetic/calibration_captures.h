@@ -25,6 +25,9 @@ struct CalibrationCaptures {
   bool reference = false;              // a radiometer reading at `point_mm` for position (i, j)
   int reference_i = 0, reference_j = 0;
   Eigen::Vector2d point_mm{0, 0};  // lab, on the screen
+  // "D50" or "D65": a photo of a ColorChecker Classic 24 under that illuminant
+  // (lib/synthetic/spectral.h) for lumislab-calibrate colour; empty: none.
+  std::string colour_chart;
 };
 
 // Parses and checks the block (unknown members refused; errors name the scene file and field).
@@ -38,6 +41,7 @@ enum class CaptureKind {
   kResponse,    // the unfiltered luminaire lighting the screen: every effect
   kCameraView,  // a board in the room (camera_views.h), not the screen: all but screen_gain,
                 // ambient
+  kColourChart,  // a ColorChecker in the room, lit by its own lamp: as kCameraView
 };
 // Applies the scene's effects that act on a photo of `kind`, in list order.
 void ApplyCaptureEffects(const SynthScene& scene, CaptureKind kind, const PhotoContext& context,

@@ -38,6 +38,12 @@ struct Emitter {
   Eigen::Vector3d intensity_w_sr;  // I0 per RGB channel, W/sr (a measured lobe's peak)
   double lobe_exponent = 0;        // n >= 0
   std::shared_ptr<const MeasuredLobe> measured = nullptr;  // set: replaces cos^n
+  // > 0: the emitter's light is a blackbody at this temperature (scene field "cct_k", with
+  // intensity_w_sr a single number, the radiant intensity over 380 - 780 nm, W/sr = radiant_w_sr);
+  // intensity_w_sr then holds the synthetic camera's RGB of that spectrum (lib/synthetic/
+  // spectral.h: a flat spectrum of 1 W/sr would give 1 in every channel). 0: no spectrum.
+  double cct_k = 0;
+  double radiant_w_sr = 0;
 
   // cos^n(angle of the unit direction w to +z) or the measured lobe, zero for w_z <= 0.
   double Shape(const Eigen::Vector3d& w) const;

@@ -5,7 +5,9 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/json.h"
+#include "lib/synthetic/spectral.h"
 
 namespace lumislab {
 namespace {
@@ -100,6 +102,8 @@ Luminaire ParseLuminaire(const JsonView& root, double default_cell_mm) {
       e.Fail(
           "exactly one of lobe_exponent, distribution (a measured IES / EULUMDAT file) or "
           "rays (a TM-25 ray file)");
+    if (e.Has("rays") && e.Has("cct_k"))
+      e["cct_k"].Fail("no cct_k with rays (rays.rgb weighs the channels)");
     if (e.Has("rays")) {
       // The file's origin anywhere: its rays are checked one by one (RaySource::Load).
       if (e.Has("intensity_w_sr"))
@@ -114,8 +118,16 @@ Luminaire ParseLuminaire(const JsonView& root, double default_cell_mm) {
     if (!(emitter.position_mm.z() < 0))
       e["position_mm"].Fail("a point behind the filter plane S (z < 0 mm)");
     const JsonView intensity = e["intensity_w_sr"];
-    for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
-    if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr");
+    if (e.Has("cct_k")) {
+      // A blackbody-like emitter: its radiant intensity and temperature; the camera's RGB of
+      // that spectrum (docs/testing.md, "Colour").
+      emitter.cct_k = e["cct_k"].NumberIn(1000, 25000);
+      emitter.radiant_w_sr = intensity.NumberIn(0, 1e9);
+      emitter.intensity_w_sr = emitter.radiant_w_sr * BlackbodyRgbPerWatt(emitter.cct_k);
+    } else {
+      for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
+      if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr (or one number with cct_k)");
+    }
     if (e.Has("lobe_exponent")) {
       emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
     } else {
@@ -303,6 +315,31 @@ SynthScene ParseScene(const JsonDocument& doc, const std::string& name) {
   if (root.Has("calibration_captures"))
     scene.captures = ParseCalibrationCaptures(root["calibration_captures"], scene);
   return scene;
+}
+
+double DefaultLuminousEfficacy() { return LuminousEfficacy(Spectrum::Ones()); }
+
+double SynthScene::LuminousEfficacy() const {
+  if (luminaire.emitters.empty() || !luminaire.ray_sources.empty())
+    return DefaultLuminousEfficacy();
+  double lumens = 0, watts = 0;
+  for (const Emitter& e : luminaire.emitters) {
+    if (!(e.cct_k > 0)) return DefaultLuminousEfficacy();
+    // Radiant flux (W) = I0 x the lobe's solid angle: a midpoint sum over the front hemisphere.
+    constexpr int kSteps = 90;
+    double solid_angle = 0;
+    for (int a = 0; a < kSteps; ++a)
+      for (int b = 0; b < 2 * kSteps; ++b) {
+        const double theta = (a + 0.5) * 0.5 * kPi / kSteps, phi = (b + 0.5) * kPi / kSteps;
+        const Eigen::Vector3d w(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                std::cos(theta));
+        solid_angle += e.Shape(w) * std::sin(theta) * (0.5 * kPi / kSteps) * (kPi / kSteps);
+      }
+    const double flux = e.radiant_w_sr * solid_angle;
+    lumens += flux * lumislab::LuminousEfficacy(Blackbody(e.cct_k));
+    watts += flux;
+  }
+  return watts > 0 ? lumens / watts : DefaultLuminousEfficacy();
 }
 
 SynthScene LoadScene(const std::string& path_or_default) {

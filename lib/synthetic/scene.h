@@ -18,6 +18,11 @@ namespace lumislab {
 
 constexpr int kSceneSchemaVersion = 1;
 
+// The luminous efficacy of a scene without spectra: that of an equal-energy spectrum over 380 -
+// 780 nm (lm/W, ~180), the light the synthetic camera's channels count in W (a flat spectrum of
+// 1 W gives 1 W in every channel, lib/synthetic/spectral.h).
+double DefaultLuminousEfficacy();
+
 struct SynthScene {
   std::string source;      // scene file name, or "default"
   double distance_mm = 0;  // d, luminaire frame
@@ -34,6 +39,11 @@ struct SynthScene {
   std::optional<CalibrationCaptures> captures;
 
   DualFilter Filter() const { return DualFilter::Truncated(k_max); }
+  // Luminous efficacy of radiation of the luminaire's light, lm/W: the truth lux meter reads
+  // lux = K x W/m^2 and the truth in lm = K x W. With a spectrum on every point emitter (cct_k)
+  // and no ray source: 683 x sum(V S) / sum(S) of the emitters' spectra S weighted by their
+  // radiant flux. Otherwise kDefaultLuminousEfficacy.
+  double LuminousEfficacy() const;
   bool Quantized() const;  // photos are 16-bit PNG (else float EXR, or JPEG with a response)
   // The listed effect of that type, or null (each is listed at most once).
   const BracketsEffect* Brackets() const;

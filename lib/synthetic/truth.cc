@@ -119,6 +119,10 @@ void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
     const Emitter& e = luminaire.emitters[k];
     nlohmann::json j = {{"position_mm", Vec(e.position_mm)},
                         {"intensity_w_sr", Vec(e.intensity_w_sr)}};
+    if (e.cct_k > 0) {  // as the scene gave it: the camera's RGB follows from the spectrum
+      j["intensity_w_sr"] = e.radiant_w_sr;
+      j["cct_k"] = e.cct_k;
+    }
     if (e.measured) {
       // A copy of the measured file beside luminaire.json, so the dataset stands on its own.
       const std::string name = "emitter_" + std::to_string(k) +

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "lib/synthetic/camera.h"
 #include "lib/synthetic/luminaire.h"
+#include "lib/synthetic/spectral.h"
 
 namespace lumislab {
 namespace {
@@ -48,6 +49,25 @@ TEST(SceneFile, DefaultSceneIsValid) {
 
 // An emitter's measured distribution (an IES or EULUMDAT file) instead of cos^n: exactly one of
 // the two, the file named when it is bad.
+TEST(SceneFile, EmitterWithABlackbodySpectrum) {
+  // "cct_k": the emitter's RGB is the synthetic camera's of a blackbody of that radiant
+  // intensity; the other emitter keeps its RGB, and the default scene (no cct_k) is unchanged.
+  std::string text = DefaultSceneJson();
+  const std::string rgb = "\"intensity_w_sr\": [1.0, 0.9, 0.8]";
+  text.replace(text.find(rgb), rgb.size(), "\"intensity_w_sr\": 2, \"cct_k\": 3000");
+  const SynthScene scene = ParseScene(text, "scene.json");
+  const Emitter& e = scene.luminaire.emitters[0];
+  EXPECT_EQ(e.cct_k, 3000);
+  EXPECT_EQ(e.radiant_w_sr, 2);
+  EXPECT_NEAR((e.intensity_w_sr - 2 * BlackbodyRgbPerWatt(3000)).norm(), 0, 1e-12);
+  EXPECT_GT(e.intensity_w_sr.x(), e.intensity_w_sr.z());  // 3000 K: red above blue
+  EXPECT_EQ(scene.luminaire.emitters[1].cct_k, 0);
+  EXPECT_EQ(DefaultScene().luminaire.emitters[0].intensity_w_sr, Eigen::Vector3d(1.0, 0.9, 0.8));
+  EXPECT_NE(ParseError(rgb, rgb + ", \"cct_k\": 3000").find("intensity_w_sr"), std::string::npos);
+  EXPECT_NE(ParseError(rgb, "\"intensity_w_sr\": 1, \"cct_k\": 500").find("cct_k"),
+            std::string::npos);
+}
+
 TEST(SceneFile, MeasuredDistributionEmitters) {
   const std::string ies = std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/ies/7.ies";
   const std::string measured =

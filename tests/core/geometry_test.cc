@@ -103,6 +103,17 @@ TEST(GeometryTest, TypeCDirectionTurnsFromPlusXThroughMinusY) {
       EXPECT_NEAR(back.x(), c, 1e-9) << c << " " << g;
       EXPECT_NEAR(back.y(), g, 1e-9) << c << " " << g;
     }
+  // Radiance's reading of the same directions: its frame is ours turned 180 degrees about x (a
+  // rotation, not a mirror: the nadir -Z is our +z, X is x), the ray D points back towards the
+  // source, and source.cal 2.10 takes phi = Atan2(-Dy, -Dx), theta = Acos(Dz).
+  const Eigen::Matrix3d radiance_from_luminaire = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  ASSERT_NEAR(radiance_from_luminaire.determinant(), 1, 1e-12);
+  for (double c = 15; c < 360; c += 45) {
+    const Eigen::Vector3d d = -(radiance_from_luminaire * TypeCDirection(c, 35));
+    const double phi = std::atan2(-d.y(), -d.x()) * 180 / kPi, theta = std::acos(d.z()) * 180 / kPi;
+    EXPECT_NEAR(phi < 0 ? phi + 360 : phi, c, 1e-9);
+    EXPECT_NEAR(theta, 35, 1e-9);
+  }
   EXPECT_EQ(TypeCAngles(Eigen::Vector3d(0, 0, 1)), Eigen::Vector2d(0, 0));
   EXPECT_NEAR(TypeCAngles(Eigen::Vector3d(-1, -0.0, 0)).x(), 180, 1e-12);
 }

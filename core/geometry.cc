@@ -39,6 +39,19 @@ Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees) {
       .toRotationMatrix();
 }
 
+Eigen::Vector3d TypeCDirection(double c_deg, double gamma_deg) {
+  const double c = c_deg * kPi / 180, g = gamma_deg * kPi / 180;
+  return {std::sin(g) * std::cos(c), -std::sin(g) * std::sin(c), std::cos(g)};
+}
+
+Eigen::Vector2d TypeCAngles(const Eigen::Vector3d& w) {
+  const double gamma = std::atan2(std::hypot(w.x(), w.y()), w.z()) * 180 / kPi;
+  double c = std::atan2(-w.y(), w.x()) * 180 / kPi;
+  if (c < 0) c += 360;
+  if (c >= 360) c -= 360;
+  return {c, gamma};
+}
+
 Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& r) {
   const double angle = r.norm();
   return angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix()

@@ -23,6 +23,16 @@ Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees);
 // formula takes; the calibrations' poses); the identity for the zero vector.
 Eigen::Matrix3d RotationFromVector(const Eigen::Vector3d& r);
 
+// Type C photometry in the luminaire frame (docs/formats.md §17, "Orientation"): gamma = 0 along
+// +z (towards the screen), C = 0 towards +x, C = 90 towards -y, so that C counts
+// counter-clockwise seen looking along gamma = 0, as IES LM-63 and Radiance's ies2rad count it
+// "viewed from above" with gamma = 0 pointing down. The unit direction of (C, gamma), degrees:
+// (sin gamma cos C, -sin gamma sin C, cos gamma).
+Eigen::Vector3d TypeCDirection(double c_deg, double gamma_deg);
+// Its inverse for any non-zero w: (C in [0, 360), gamma in [0, 180]) in degrees; C = 0 on the
+// gamma = 0 and 180 axis.
+Eigen::Vector2d TypeCAngles(const Eigen::Vector3d& w);
+
 // Where the line from point p (luminaire frame, mm) through q crosses the plane z = z_plane.
 Eigen::Vector2d IntersectPlaneZ(const Eigen::Vector3d& p, const Eigen::Vector3d& q, double z_plane);
 

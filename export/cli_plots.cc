@@ -162,7 +162,8 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       "irradiance",
       "the slab's irradiance (illuminance for a lux slab) on the plane z = D of the luminaire "
       "frame, by the exact CPU reference: .png false colour (viridis, colour bar in W/m² or lx, "
-      "iso-lines at its ticks, a length scale) or .exr linear");
+      "iso-lines at its ticks, a length scale) or .exr linear; +x right, +y up (the plane seen "
+      "from behind it, looking back at the luminaire)");
   irr->add_option("--slab", irradiance->slab_dir, "slab folder")->required();
   irr->add_option("--distance-mm", irradiance->distance_mm, "D: the plane's distance from S (mm)")
       ->required()
@@ -189,7 +190,8 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
   CLI::App* pol = app.add_subcommand(
       "polar",
       "the far-field polar diagram of the slab (intensity in cd or W/sr against gamma, planes "
-      "C0-C180 and C90-C270, up to the largest gamma the slab saw in all four)");
+      "C0-C180 and C90-C270, C0 (+x) and C90 (-y) on the right, up to the largest gamma the "
+      "slab saw in all four)");
   pol->add_option("--slab", polar->slab_dir, "slab folder")->required();
   pol->add_option("--out", polar->out, ".svg or .png")->required();
   pol->add_option("--gamma-step", polar->gamma_step_deg, "degrees between the curves' points")

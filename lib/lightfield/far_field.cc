@@ -246,11 +246,11 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
   out.values.assign(count, 0.0);
   out.seen.assign(count, 0);
   ParallelFor(int(count), options.threads, [&](int k) {
-    const double c = c_deg[k / ng] * kPi / 180, g = gamma_deg[k % ng] * kPi / 180;
-    const double cos_g = std::cos(g);
-    if (!(cos_g > 1e-9)) return;           // light leaves S only towards +z
-    const double reach = d * std::tan(g);  // (s, t) - (u, v) on M, mm
-    const double ds = reach * std::cos(c), dt = reach * std::sin(c);
+    const Eigen::Vector3d w = TypeCDirection(c_deg[k / ng], gamma_deg[k % ng]);
+    const double cos_g = w.z();
+    if (!(cos_g > 1e-9)) return;  // light leaves S only towards +z
+    // (s, t) - (u, v) on M, mm: where the direction meets M from a point of S.
+    const double ds = d * w.x() / cos_g, dt = d * w.y() / cos_g;
     double sum = 0;
     for (int j = 0; j < info.grid.nv; ++j) {
       for (int i = 0; i < info.grid.nu; ++i) {
@@ -273,7 +273,7 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
   });
   for (size_t k = 0; k < count; ++k) {
     if (!out.seen[k]) ++out.unseen;
-    if (!out.seen[k] && !(std::cos(gamma_deg[k % ng] * kPi / 180) > 1e-9)) ++out.behind;
+    if (!out.seen[k] && !(TypeCDirection(0, gamma_deg[k % ng]).z() > 1e-9)) ++out.behind;
   }
   return out;
 }

@@ -21,7 +21,7 @@ struct FarFieldOptions {
 };
 
 // I on a C / gamma grid (degrees, type C: gamma = 0 along +z, C = 0 towards +x, C = 90 towards
-// +y; docs/formats.md §17).
+// -y, TypeCDirection; docs/formats.md §17).
 struct FarField {
   std::vector<double> c_deg, gamma_deg;
   std::vector<double> values;  // values[ic * gamma_deg.size() + ig]: W/sr (cd for lux slabs)
@@ -31,12 +31,13 @@ struct FarField {
 };
 
 // I(w) = d^2 / (cos^3 theta 10^6) sum_ij sum_k (w_k / h^2) E_ij(q_k + d tan(theta) (cos C,
-// sin C)) (W/sr): the exact model's radiance (R^2 / cos^2 theta) E_ij / h^2 with R = d / cos
-// theta for every point q of S, times cos theta, integrated over S with the bell quadrature of
-// each position (BellQuadrature, N x N points q_k of weight w_k). A direction is seen when every
-// point lands inside the window on texels whose bilinear neighbours are all seen (mask 1);
-// otherwise, and for gamma >= 90 (light leaves S towards +z only), its value is 0. Positions
-// with an empty image are left out (the caller decides whether a partial slab may be used).
+// -sin C)) (W/sr), w = TypeCDirection(C, theta): the exact model's radiance (R^2 / cos^2 theta)
+// E_ij / h^2 with R = d / cos theta for every point q of S, times cos theta, integrated over S with
+// the bell quadrature of each position (BellQuadrature, N x N points q_k of weight w_k). A
+// direction is seen when every point lands inside the window on texels whose bilinear neighbours
+// are all seen (mask 1); otherwise, and for gamma >= 90 (light leaves S towards +z only), its value
+// is 0. Positions with an empty image are left out (the caller decides whether a partial slab may
+// be used).
 FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& positions,
                          const std::vector<double>& c_deg, const std::vector<double>& gamma_deg,
                          const FarFieldOptions& options);

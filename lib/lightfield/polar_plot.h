@@ -1,6 +1,7 @@
 // The photometric polar diagram (docs/method.md §4.9): intensity against gamma in the planes
-// C0-C180 and C90-C270 (photometry type C, docs/formats.md §17), gamma = 0 pointing down as in a
-// lab's report, C0 and C90 to the right, C180 and C270 to the left; grid circles labelled in the
+// C0-C180 and C90-C270 (photometry type C, docs/formats.md §17: C0 towards +x, C90 towards -y of
+// the luminaire frame), gamma = 0 pointing down as in a lab's report, C0 and C90 to the right,
+// C180 and C270 to the left (a layout, not a view from any side); grid circles labelled in the
 // intensity's unit, radial lines every 15 degrees labelled every 30. One drawing (PolarPlot)
 // written either as SVG text or as an RGB picture (drawn at twice the size and averaged down:
 // anti-aliased).

@@ -1,8 +1,9 @@
 // A far-field intensity distribution as the lighting industry's files hold it (docs/formats.md
 // §17): type C photometry, intensity on a grid of C planes (azimuth) and gamma angles (polar), in
 // candela (photometric) or W/sr (radiometric). gamma = 0 along +z of the luminaire frame, C = 0
-// towards +x, C = 90 towards +y. The grid covers only the part of the sphere the symmetry leaves
-// (IES LM-63 and EULUMDAT store it the same way); Intensity() and TotalFlux() apply the symmetry.
+// towards +x, C = 90 towards -y (core/geometry.h TypeCDirection). The grid covers only the part of
+// the sphere the symmetry leaves (IES LM-63 and EULUMDAT store it the same way); Intensity() and
+// TotalFlux() apply the symmetry.
 #pragma once
 
 #include <string>
@@ -22,8 +23,8 @@ enum class CSymmetry {
 const char* CSymmetryName(CSymmetry s);
 
 // The luminous opening, mm, in LM-63's convention: length along the C0-C180 axis (x), width
-// along the C90-C270 axis (y), height along gamma = 0 (z); a negative width/length is a round
-// opening of that diameter (LM-63 §"luminous opening"); all 0: a point.
+// along the C90-C270 axis (y; C90 towards -y), height along gamma = 0 (z); a negative width/length
+// is a round opening of that diameter (LM-63 §"luminous opening"); all 0: a point.
 struct LuminousOpening {
   double width_mm = 0;
   double length_mm = 0;

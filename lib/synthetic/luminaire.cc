@@ -37,10 +37,9 @@ MeasuredLobe MeasuredLobe::Load(const std::string& file, const Eigen::Vector3d& 
 }
 
 double MeasuredLobe::Shape(const Eigen::Vector3d& w) const {
-  const Eigen::Vector3d local = luminaire_from_file.transpose() * w;
-  const double gamma = std::acos(std::clamp(local.z(), -1.0, 1.0)) * 180 / kPi;
-  const double c = std::atan2(local.y(), local.x()) * 180 / kPi;
-  return distribution->Intensity(c, gamma) / peak;
+  // The file's (C, gamma) of w: type C in the file's frame (TypeCAngles, docs/formats.md §17).
+  const Eigen::Vector2d c_gamma = TypeCAngles(luminaire_from_file.transpose() * w);
+  return distribution->Intensity(c_gamma.x(), c_gamma.y()) / peak;
 }
 
 double Emitter::Shape(const Eigen::Vector3d& w) const {

@@ -81,5 +81,42 @@ TEST(GeometryTest, RotationZyxDegreesAppliesXThenYThenZ) {
   EXPECT_TRUE(z.isApprox((Eigen::Matrix3d() << c, -s, 0, s, c, 0, 0, 0, 1).finished(), 1e-12)) << z;
 }
 
+// Type C in the luminaire frame (docs/formats.md §17, "Orientation"): gamma = 0 along +z, C = 0
+// towards +x, C = 90 towards -y, so C turns counter-clockwise seen looking along +z (from +x
+// through -y to -x and +y), as LM-63 counts it looking down along gamma = 0. Radiance's
+// source.cal (since 2008: atan2(-Dy, -Dx), D the ray towards the source) with nadir -Z puts
+// C = 90 along its +Y; turning its frame so that the nadir is our +z (x kept) takes its +Y to
+// our -y.
+TEST(GeometryTest, TypeCDirectionTurnsFromPlusXThroughMinusY) {
+  EXPECT_TRUE(TypeCDirection(0, 0).isApprox(Eigen::Vector3d(0, 0, 1), 1e-12));
+  EXPECT_TRUE(TypeCDirection(0, 90).isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
+  EXPECT_TRUE(TypeCDirection(90, 90).isApprox(Eigen::Vector3d(0, -1, 0), 1e-12));
+  EXPECT_TRUE(TypeCDirection(180, 90).isApprox(Eigen::Vector3d(-1, 0, 0), 1e-12));
+  EXPECT_TRUE(TypeCDirection(270, 90).isApprox(Eigen::Vector3d(0, 1, 0), 1e-12));
+  // A turn from a to b looks counter-clockwise to a viewer looking along v when its axis a x b
+  // points back at the viewer, (a x b) . v < 0: here x x -y = -z, for v = +z.
+  EXPECT_LT(TypeCDirection(0, 90).cross(TypeCDirection(90, 90)).dot(Eigen::Vector3d::UnitZ()), 0);
+  // The inverse, over the sphere, with C in [0, 360) and the length of w ignored.
+  for (double c = 0; c < 360; c += 30)
+    for (double g = 10; g < 180; g += 40) {
+      const Eigen::Vector2d back = TypeCAngles(2.5 * TypeCDirection(c, g));
+      EXPECT_NEAR(back.x(), c, 1e-9) << c << " " << g;
+      EXPECT_NEAR(back.y(), g, 1e-9) << c << " " << g;
+    }
+  // Radiance's reading of the same directions: its frame is ours turned 180 degrees about x (a
+  // rotation, not a mirror: the nadir -Z is our +z, X is x), the ray D points back towards the
+  // source, and source.cal 2.10 takes phi = Atan2(-Dy, -Dx), theta = Acos(Dz).
+  const Eigen::Matrix3d radiance_from_luminaire = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  ASSERT_NEAR(radiance_from_luminaire.determinant(), 1, 1e-12);
+  for (double c = 15; c < 360; c += 45) {
+    const Eigen::Vector3d d = -(radiance_from_luminaire * TypeCDirection(c, 35));
+    const double phi = std::atan2(-d.y(), -d.x()) * 180 / kPi, theta = std::acos(d.z()) * 180 / kPi;
+    EXPECT_NEAR(phi < 0 ? phi + 360 : phi, c, 1e-9);
+    EXPECT_NEAR(theta, 35, 1e-9);
+  }
+  EXPECT_EQ(TypeCAngles(Eigen::Vector3d(0, 0, 1)), Eigen::Vector2d(0, 0));
+  EXPECT_NEAR(TypeCAngles(Eigen::Vector3d(-1, -0.0, 0)).x(), 180, 1e-12);
+}
+
 }  // namespace
 }  // namespace lumislab

@@ -39,8 +39,7 @@ struct Fixture {
     WriteTruthSlab(luminaire, info, dir + "/ds/slab", 2);
   }
   double Truth(double c_deg, double gamma_deg) const {
-    const double c = c_deg * kPi / 180, g = gamma_deg * kPi / 180;
-    const Eigen::Vector3d w(std::sin(g) * std::cos(c), std::sin(g) * std::sin(c), std::cos(g));
+    const Eigen::Vector3d w = TypeCDirection(c_deg, gamma_deg);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Emitter& e : luminaire.emitters) sum += e.Intensity(w);
     return LuminanceWeights().dot(sum);

@@ -31,8 +31,7 @@ struct Fixture {
   }
   // The luminaire's far-field intensity (Rec. 709 luminance of the emitters' sum), W/sr.
   double Truth(double c_deg, double gamma_deg) const {
-    const double c = c_deg * kPi / 180, g = gamma_deg * kPi / 180;
-    const Eigen::Vector3d w(std::sin(g) * std::cos(c), std::sin(g) * std::sin(c), std::cos(g));
+    const Eigen::Vector3d w = TypeCDirection(c_deg, gamma_deg);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Emitter& e : scene.luminaire.emitters) sum += e.Intensity(w);
     return LuminanceWeights().dot(sum);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <regex>
 
 #include "core/error.h"
@@ -93,6 +94,26 @@ TEST(SceneFile, MeasuredDistributionEmitters) {
                        "\"distribution\": {\"file\": \"" + ies + "\", \"rotate\": 1}")
                 .find("luminaire.emitters[0].distribution.rotate: expected file or rotation_deg"),
             std::string::npos);
+}
+
+// The reader's side of the C convention (docs/formats.md §17, "Orientation"): a file whose only
+// bright direction is C = 90, gamma = 45 lights the luminaire frame's -y side, not +y; C = 0 is
+// +x. The rotation then turns the file's frame: Rz(90) takes its -y (C = 90) to +x.
+TEST(SceneFile, MeasuredDistributionsCNinetyIsMinusY) {
+  const std::string ies = ::testing::TempDir() + "/c90_lobe.ies";
+  {
+    std::ofstream out(ies);
+    out << "IESNA:LM-63-2002\n[TEST] c90\nTILT=NONE\n1 -1 1 3 5 1 2 0 0 0\n1 1 0\n0 45 90\n"
+        << "0 90 180 270 360\n10 10 10\n10 100 10\n10 10 10\n10 10 10\n10 10 10\n";
+  }
+  const double s = std::sqrt(0.5);
+  const MeasuredLobe lobe = MeasuredLobe::Load(ies, Eigen::Vector3d::Zero());
+  EXPECT_NEAR(lobe.Shape(Eigen::Vector3d(0, -s, s)), 1, 1e-12);
+  EXPECT_NEAR(lobe.Shape(Eigen::Vector3d(0, s, s)), 0.1, 1e-12);
+  EXPECT_NEAR(lobe.Shape(Eigen::Vector3d(s, 0, s)), 0.1, 1e-12);
+  const MeasuredLobe turned = MeasuredLobe::Load(ies, Eigen::Vector3d(0, 0, 90));
+  EXPECT_NEAR(turned.Shape(Eigen::Vector3d(s, 0, s)), 1, 1e-12);
+  EXPECT_NEAR(turned.Shape(Eigen::Vector3d(0, -s, s)), 0.1, 1e-12);
 }
 
 TEST(SceneFile, BadFieldsNameFileAndField) {

@@ -310,6 +310,8 @@ SynthScene LoadScene(const std::string& path_or_default) {
   return ParseScene(JsonDocument::Load(path_or_default), path_or_default);
 }
 
+double SynthScene::LuminousEfficacy() const { return kDefaultLuminousEfficacy; }
+
 SynthScene DefaultScene() {
   SynthScene scene = ParseScene(kDefaultSceneJson, "default scene");
   scene.source = "default";

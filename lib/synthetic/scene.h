@@ -47,7 +47,17 @@ struct SynthScene {
   // Sum of the listed effects' stage offsets at position (i, j) (mm, lab frame; 0 without
   // stage_error).
   Eigen::Vector2d StageOffsetMm(int i, int j) const;
+  // Luminous efficacy of the emitters' radiation, K (lm/W): what the synthetic lux meter
+  // (`acquire synth --meter lux`) multiplies the luminance-weighted irradiance by (lux =
+  // K x W/m^2), and so what turns the truth's W into lm. Today kDefaultLuminousEfficacy for every
+  // scene; to be computed from the emitters' spectrum (issue 29, colour).
+  double LuminousEfficacy() const;
 };
+
+// lm/W: the efficacy of an equal-energy white over 380-780 nm, 683 lm/W x (integral of V(lambda),
+// 106.9 nm) / 400 nm = 182.5, rounded: a documented stand-in for the white emitters of the scenes
+// until a scene carries a spectrum.
+constexpr double kDefaultLuminousEfficacy = 183.0;
 
 // "default" or a scene file; errors name the file and the field (exit 2).
 SynthScene LoadScene(const std::string& path_or_default);

@@ -63,12 +63,24 @@ void WriteReferenceReading(const SynthScene& scene, const Dataset& dataset, cons
   SynthScene read = scene;
   if (!read.captures || !read.captures->reference) {
     if (!lux) return;  // a radiometer reading only where the scene asks for one
-    // A lux meter at the screen's centre for the centre position.
+    // A lux meter at the screen's centre, read at the grid position where the slides' signal
+    // there (T+ minus T-) is largest: calibrate scale divides by it, and a position whose
+    // slide p holds no light (an emitter under the negative lobe) gives no scale.
     CalibrationCaptures c = read.captures ? *read.captures : CalibrationCaptures{};
     c.reference = true;
-    c.reference_i = (scene.grid.nu - 1) / 2;
-    c.reference_j = (scene.grid.nv - 1) / 2;
     c.point_mm = {0, 0};
+    double best = -1;
+    for (int j = 0; j < scene.grid.nv; ++j)
+      for (int i = 0; i < scene.grid.nu; ++i) {
+        CalibrationCaptures at = c;
+        at.reference_i = i;
+        at.reference_j = j;
+        read.captures = at;
+        Eigen::Vector3d plus, minus;
+        ReferenceIrradiance(read, *dataset.radiometric_scale, &plus, &minus);
+        const double signal = Luminance(plus) - Luminance(minus);
+        if (signal > best) best = signal, c = at;
+      }
     read.captures = c;
   }
   const CalibrationCaptures& c = *read.captures;

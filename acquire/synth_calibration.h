@@ -24,7 +24,7 @@ void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
 // `lumislab-calibrate scale --reference`. A radiometer (W/m2) where the scene's
 // calibration_captures ask for a reading; a lux meter (`meter` "lux": lux = K x W/m2, K =
 // SynthScene::LuminousEfficacy()) always, at the scene's reference point or else at the screen's
-// centre (lab (0, 0)) for the centre grid position.
+// centre (lab (0, 0)) for the grid position of the largest signal there (T+ minus T-).
 void WriteReferenceReading(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
                            const std::string& meter);
 

@@ -410,8 +410,7 @@ int RunFarField(const FarFieldCommand& c, int threads) {
           " allow_partial=", c.allow_partial ? "yes" : "no", " max_asymmetry=", c.max_asymmetry_pct,
           " accredited=", c.accredited ? "yes" : "no",
           " lumen_scaled=", c.lumen_scaled ? "yes" : "no", " input_watts=", c.input_watts);
-  CheckOutputPath(c.out);
-  RefuseExistingOutput(c.out, c.force);
+  CheckExportOutput(c.out, c.force);
   DirectionGrid(c);  // refuses a bad grid before the slab is read, and bad keywords
   const auto keywords = ResolveKeywords(c.keywords);
   if (c.format == "ies") CheckIesRequiredKeywords(keywords, c.out);
@@ -529,8 +528,7 @@ Coverage RayCoverage(const Slab& slab, int threads, CheckLog& checks) {
 int RunRays(const RayCommand& c, int threads) {
   LogInfo("parameters: slab=", c.slab, " out=", c.out, " rays=", c.rays, " seed=", c.seed,
           " force=", c.force ? "yes" : "no", " allow_partial=", c.allow_partial ? "yes" : "no");
-  CheckOutputPath(c.out);
-  RefuseExistingOutput(c.out, c.force);
+  CheckExportOutput(c.out, c.force);
   CheckLog checks = SlabChecks(c.slab, "export tm25");
   const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
   const Coverage coverage = RayCoverage(slab, threads, checks);

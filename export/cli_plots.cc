@@ -56,8 +56,7 @@ int RunIrradiance(IrradianceOptions o, int threads) {
           " scale=", o.scale, " out=", o.out);
   const std::string ext = Extension(o.out);
   if (ext != ".png" && ext != ".exr") throw BadInput(o.out + ": --out must end in .png or .exr");
-  CheckOutputPath(o.out);
-  RefuseExistingOutput(o.out, o.force);
+  CheckExportOutput(o.out, o.force);
   if (o.extent_mm != 0 && !(o.extent_mm >= 1 && o.extent_mm <= kMaxDistanceMm))
     throw InputError("--extent-mm", "", "0 (default) or a length in [1, 1e5] mm",
                      std::to_string(o.extent_mm));
@@ -147,8 +146,7 @@ int RunPolar(PolarOptions o, int threads) {
           " size=", o.size, " out=", o.out);
   const std::string ext = Extension(o.out);
   if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
-  CheckOutputPath(o.out);
-  RefuseExistingOutput(o.out, o.force);
+  CheckExportOutput(o.out, o.force);
   const PolarPlot plot = MakePolarPlot(PolarDataFromSlab(o, threads), o.size);
   if (ext == ".svg") {
     WriteTextAtomically(o.out, PolarPlotSvg(plot));

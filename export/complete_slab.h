@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/slab.h"
 
@@ -21,9 +22,14 @@ inline std::string ResolveSlabDir(const std::string& path) {
                  "/slab (--slab takes a dataset folder or its slab/)");
 }
 
-// An export never replaces a file silently nor keeps an old one while reporting success: an
-// existing `out` is exit 2 naming it unless `force`.
-inline void RefuseExistingOutput(const std::string& out, bool force) {
+// Before any work: `out` can be written (CheckOutputPath: no link, special file or folder; its
+// folder exists: exit 3), and an export never replaces a file silently nor keeps an old one
+// while reporting success: an existing `out` is exit 2 naming it unless `force`.
+inline void CheckExportOutput(const std::string& out, bool force) {
+  CheckOutputPath(out);
+  const std::filesystem::path folder = std::filesystem::absolute(out).parent_path();
+  if (!std::filesystem::is_directory(folder))
+    throw IoError(out, "cannot write it: the folder " + folder.string() + " does not exist");
   if (!force && std::filesystem::exists(out))
     throw BadInput(out + ": exists (--force rewrites it)");
 }

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/geometry.h"
+#include "core/json.h"
 #include "core/log.h"
 #include "core/slab_light.h"
 #include "lib/synthetic/scene.h"
@@ -23,6 +24,19 @@ std::string TruthLuminaireFile(const std::string& slab_dir) {
 Eigen::Vector3d Direction(double c_deg, double gamma_deg) {
   const double c = c_deg * kPi / 180, g = gamma_deg * kPi / 180;
   return {std::sin(g) * std::cos(c), -std::sin(g) * std::sin(c), std::cos(g)};
+}
+
+// K (lm/W) of a synthetic dataset's lux meter: truth/reference.json's luminous_efficacy_lm_w
+// (acquire synth --meter lux records it), else the scenes' default.
+double TruthEfficacy(const std::string& slab_dir) {
+  const std::string file =
+      std::filesystem::path(TruthLuminaireFile(slab_dir)).parent_path() / "reference.json";
+  if (std::filesystem::is_regular_file(file)) {
+    const JsonDocument doc = JsonDocument::Load(file);
+    if (doc.root().Has("luminous_efficacy_lm_w"))
+      return doc.root()["luminous_efficacy_lm_w"].Number();
+  }
+  return kDefaultLuminousEfficacy;
 }
 
 std::string Pct(double share) { return Num(100 * share, 3) + " %"; }
@@ -52,7 +66,7 @@ Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const 
     const Luminaire luminaire = LoadLuminaire(TruthLuminaireFile(slab_dir));
     if (luminaire.ray_sources.empty()) {
       c.analytic = true;
-      const double k = lux ? DefaultScene().LuminousEfficacy() : 1.0;  // lm = K x W
+      const double k = lux ? TruthEfficacy(slab_dir) : 1.0;  // lm = K x W
       for (size_t ic = 0; ic < d.c_deg.size(); ++ic)
         for (size_t ig = 0; ig < ng; ++ig) {
           const Eigen::Vector3d w = Direction(d.c_deg[ic], d.gamma_deg[ig]);

@@ -39,9 +39,10 @@ struct Coverage {
 
 // The coverage of the grid of `d` by the far field `ff` (computed on the same grid), with the
 // model's flux there: the analytic luminaire of `slab_dir`/../truth/luminaire.json when the slab
-// is a synthetic dataset's (point emitters; lm = K x W for a lux slab, K =
-// SynthScene::LuminousEfficacy()), else a Lambertian emitter, I = I0 cos(gamma) for gamma < 90,
-// matched to the seen flux (a model: the capture cannot say what it did not see).
+// is a synthetic dataset's (point emitters; lm = K x W for a lux slab, K the dataset's lux
+// meter's, truth/reference.json luminous_efficacy_lm_w, else kDefaultLuminousEfficacy), else a
+// Lambertian emitter, I = I0 cos(gamma) for gamma < 90, matched to the seen flux (a model: the
+// capture cannot say what it did not see).
 Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const SlabInfo& info,
                       const std::string& slab_dir);
 

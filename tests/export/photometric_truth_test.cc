@@ -117,8 +117,10 @@ TEST(PhotometricTruth, PartialCoverageIsRefusedOrStated) {
   j = InfoJson(data.dir + "/x.ldt");
   EXPECT_EQ(j["coverage"].get<std::string>().rfind("partial: gamma<=37.5 seen", 0), 0u) << j;
   EXPECT_EQ(j["keywords"]["TEST"].get<std::string>().rfind("R-2; partial: ", 0), 0u) << j;
-  r = RunTool("lumislab-export", refusals[2] + " --allow-partial");
+  // (TM-25's texts are UTF-32: a name beyond ASCII round-trips; it was cut to 7 bits.)
+  r = RunTool("lumislab-export", refusals[2] + " --allow-partial --name 'Leuchte \u00e9\u00e8'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(ReadTm25(data.dir + "/x.ray").name, "Leuchte \u00e9\u00e8");
   j = InfoJson(data.dir + "/x.ray");
   EXPECT_NE(j["coverage"].get<std::string>().find(
                 "partial: rays only in the cone the screen saw: gamma 0-37.5 deg"),

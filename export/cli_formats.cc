@@ -209,12 +209,14 @@ IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
   return d;
 }
 
-// IES and EULUMDAT hold candela: only a slab scaled with a lux meter has them.
-void RequireLuxSlab(const Slab& slab, const std::string& format) {
-  if (slab.info.units == "lux") return;
-  const std::string dataset =
-      DatasetOfSlab(slab.dir).empty() ? "<dataset>" : DatasetOfSlab(slab.dir);
-  throw InputError(slab.dir + "/slab.json", "units",
+// IES and EULUMDAT hold candela: only a slab scaled with a lux meter has them. Checked on
+// slab.json alone, before the positions are read.
+void RequireLuxSlab(const std::string& path, const std::string& format) {
+  const std::string dir = ResolveSlabDir(path);
+  const SlabInfo info = SlabInfo::Load(dir);
+  if (info.units == "lux") return;
+  const std::string dataset = DatasetOfSlab(dir).empty() ? "<dataset>" : DatasetOfSlab(dir);
+  throw InputError(dir + "/slab.json", "units",
                    "lux (" + format +
                        " holds candela and lumen: calibrate the scale with a lux meter reading, "
                        "lumislab-calibrate scale --dataset " +
@@ -222,7 +224,7 @@ void RequireLuxSlab(const Slab& slab, const std::string& format) {
                        " --position i,j --point-mm x,y --reading-p LX --reading-n LX --unit lux, "
                        "then lumislab-reconstruct --dataset " +
                        dataset + " --force; lumislab-export tm25 writes radiometric rays)",
-                   slab.info.units);
+                   info.units);
 }
 
 // The far field on the grid of `d`. A symmetric subset of the C range (--c-angles 0..90,
@@ -414,9 +416,9 @@ int RunFarField(const FarFieldCommand& c, int threads) {
   DirectionGrid(c);  // refuses a bad grid before the slab is read, and bad keywords
   const auto keywords = ResolveKeywords(c.keywords);
   if (c.format == "ies") CheckIesRequiredKeywords(keywords, c.out);
+  RequireLuxSlab(c.slab, c.format == "ies" ? "IES" : "EULUMDAT");
   CheckLog checks = SlabChecks(c.slab, "export " + c.format);
   const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
-  RequireLuxSlab(slab, c.format == "ies" ? "IES" : "EULUMDAT");
   bool simulation = false;
   const IntensityDistribution d = SlabDistribution(c, slab, threads, checks, &simulation);
   checks.Save();

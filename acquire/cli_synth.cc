@@ -59,6 +59,15 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
                       "calibration/camera/")
       ->check(CLI::Range(0, kMaxCalibrationViews))
       ->capture_default_str();
+  cmd->add_option("--meter", o.meter,
+                  "the meter of truth/reference.json: radiometer (W/m2, where the scene's "
+                  "calibration_captures ask for a reading) or lux (a lux meter: lux = K x W/m2, K "
+                  "the scene's luminous efficacy, " +
+                      Num(DefaultLuminousEfficacy(), 4) +
+                      " lm/W by default; truth/ in lux; for lumislab-calibrate scale --reference "
+                      "and photometric exports)")
+      ->check(CLI::IsMember({"radiometer", "lux"}))
+      ->capture_default_str();
   cmd->add_flag("--print-scene", c->print_scene,
                 "print the scene as JSON (the built-in one for --scene default) and exit");
   AddCommonOptions(cmd, common);
@@ -75,7 +84,8 @@ int RunSynthCommand(const SynthCommand& command, int threads) {
          << (synth.interval_s >= 0 ? std::to_string(synth.interval_s) + " s" : "none")
          << " force=" << (synth.force ? "yes" : "no") << " photo_format=" << synth.photo_format
          << " camera_folder=" << (synth.camera_folder ? "yes" : "no")
-         << " calibration_views=" << synth.calibration_views << " threads=" << synth.threads;
+         << " calibration_views=" << synth.calibration_views << " meter=" << synth.meter
+         << " threads=" << synth.threads;
   LogInfo("parameters: ", params.str());
   const StopSignalScope stop_signals;  // Ctrl-C: finish the photos in hand, then stop
   const SynthReport r = RunSynth(synth);

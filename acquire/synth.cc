@@ -58,6 +58,8 @@ void SynthOptions::Check() const {
   if (truth_resolution < 1 || truth_resolution > kMaxSlabResolution)
     throw BadInput("--truth-resolution: expected 1 .. " + std::to_string(kMaxSlabResolution) +
                    ", got " + std::to_string(truth_resolution));
+  if (meter != "radiometer" && meter != "lux")
+    throw BadInput("--meter: expected radiometer or lux, got " + meter);
 }
 
 double ChooseRadiometricScale(const SynthScene& scene, int threads) {
@@ -205,9 +207,11 @@ int WriteDataset(const SynthScene& scene, const Dataset& dataset, const std::str
   WriteTruthCamera(scene, dir + "/truth/camera.json");
   WriteTruthLuminaire(scene.luminaire, dir + "/truth/luminaire.json");
   if (scene.Response()) WriteTruthResponse(*scene.Response(), dir + "/truth/response.json");
-  WriteTruthSlab(scene.luminaire, SlabInfo::FromDataset(dataset, options.truth_resolution),
-                 dir + "/truth", threads);
+  SlabInfo truth = SlabInfo::FromDataset(dataset, options.truth_resolution);
+  if (options.meter == "lux") truth.units = "lux";  // K x W/m^2, as the meter reads
+  WriteTruthSlab(scene.luminaire, truth, dir + "/truth", threads, scene.LuminousEfficacy());
   WriteCalibrationCaptures(scene, dataset, dir, store, threads);  // scene.captures only
+  WriteReferenceReading(scene, dataset, dir, options.meter);
   WriteCameraViews(scene, dataset, dir, store, options.calibration_views, threads);
   return CapturePositions(scene, dataset, dir, options, store, threads);
 }

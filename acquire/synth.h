@@ -28,6 +28,11 @@ struct SynthOptions {
   bool camera_folder = false;
   // Photos of a free-standing board for lumislab-calibrate camera (calibration/camera/).
   int calibration_views = 0;
+  // The meter of truth/reference.json: "radiometer" (W/m2, written for a scene whose
+  // calibration_captures ask for a reference reading) or "lux" (a lux meter, lux = K x W/m2 with
+  // K = SynthScene::LuminousEfficacy(), always written; truth/ then holds lux too), so that
+  // `lumislab-calibrate scale --reference <out>/truth/reference.json` gives a photometric slab.
+  std::string meter = "radiometer";
 
   void Check() const;  // BadInput naming the option
 };

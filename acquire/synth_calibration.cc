@@ -68,26 +68,57 @@ void WriteTruth(const SynthScene& scene, const Dataset& dataset, const std::stri
   WriteExr(dir + "/truth/flat.exr", TruthFlatGain(scene), {"Y"}, {}, {false, ExrCompression::kPiz});
   WriteExr(dir + "/truth/dark.exr", TruthDarkMap(scene), {"black", "current", "hot"}, {},
            {false, ExrCompression::kPiz});
-  const CalibrationCaptures& c = *scene.captures;
-  if (!c.reference) return;
+}
+
+}  // namespace
+
+void WriteReferenceReading(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
+                           const std::string& meter) {
+  const bool lux = meter == "lux";
+  SynthScene read = scene;
+  if (!read.captures || !read.captures->reference) {
+    if (!lux) return;  // a radiometer reading only where the scene asks for one
+    // A lux meter at the screen's centre, read at the grid position where the slides' signal
+    // there (T+ minus T-) is largest: calibrate scale divides by it, and a position whose
+    // slide p holds no light (an emitter under the negative lobe) gives no scale.
+    CalibrationCaptures c = read.captures ? *read.captures : CalibrationCaptures{};
+    c.reference = true;
+    c.point_mm = {0, 0};
+    double best = -1;
+    for (int j = 0; j < scene.grid.nv; ++j)
+      for (int i = 0; i < scene.grid.nu; ++i) {
+        CalibrationCaptures at = c;
+        at.reference_i = i;
+        at.reference_j = j;
+        read.captures = at;
+        Eigen::Vector3d plus, minus;
+        ReferenceIrradiance(read, *dataset.radiometric_scale, &plus, &minus);
+        const double signal = Luminance(plus) - Luminance(minus);
+        if (signal > best) best = signal, c = at;
+      }
+    read.captures = c;
+  }
+  const CalibrationCaptures& c = *read.captures;
   Eigen::Vector3d plus, minus;
-  ReferenceIrradiance(scene, *dataset.radiometric_scale, &plus, &minus);
+  ReferenceIrradiance(read, *dataset.radiometric_scale, &plus, &minus);
+  const double k = lux ? scene.LuminousEfficacy() : 1.0;  // lux = K x W/m^2
   nlohmann::json j;
   j["schema_version"] = 1;
   j["position"] = {c.reference_i, c.reference_j};
   j["point_mm"] = {c.point_mm.x(), c.point_mm.y()};
-  j["unit"] = "W/m2";
-  j["reading_p"] = Luminance(plus);
-  j["reading_n"] = Luminance(minus);
+  j["unit"] = lux ? "lux" : "W/m2";
+  j["reading_p"] = k * Luminance(plus);
+  j["reading_n"] = k * Luminance(minus);
   j["irradiance_p_w_m2"] = Rgb(plus);
   j["irradiance_n_w_m2"] = Rgb(minus);
-  j["note"] =
-      "radiometer readings (Rec. 709 luminance of the RGB irradiance) at point_mm (lab, screen) "
-      "with slide p and n in at position [i, j], ambient light included";
+  if (lux) j["luminous_efficacy_lm_w"] = k;
+  j["note"] = std::string(lux ? "lux meter readings (K x the Rec. 709 luminance of the RGB "
+                                "irradiance, K = luminous_efficacy_lm_w)"
+                              : "radiometer readings (Rec. 709 luminance of the RGB irradiance)") +
+              " at point_mm (lab, screen) with slide p and n in at position [i, j], ambient "
+              "light included";
   WriteJsonAtomically(dir + "/truth/reference.json", j);
 }
-
-}  // namespace
 
 void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
                               const std::string& dir, const PhotoStore& store, int threads) {

@@ -20,6 +20,14 @@ namespace lumislab {
 void WriteCalibrationCaptures(const SynthScene& scene, const Dataset& dataset,
                               const std::string& dir, const PhotoStore& store, int threads);
 
+// truth/reference.json: the meter's readings at the reference point through T+ and T-, for
+// `lumislab-calibrate scale --reference`. A radiometer (W/m2) where the scene's
+// calibration_captures ask for a reading; a lux meter (`meter` "lux": lux = K x W/m2, K =
+// SynthScene::LuminousEfficacy()) always, at the scene's reference point or else at the screen's
+// centre (lab (0, 0)) for the grid position of the largest signal there (T+ minus T-).
+void WriteReferenceReading(const SynthScene& scene, const Dataset& dataset, const std::string& dir,
+                           const std::string& meter);
+
 // `acquire synth --calibration-views N`: N photos of a free-standing board
 // (lib/synthetic/camera_views.h) in calibration/camera/view_<kk>.<ext>, stored like the slide
 // photos (every effect but screen_gain and ambient; noise streams after the slide photos' and

@@ -14,6 +14,7 @@
 #include "core/log.h"
 #include "core/slab.h"
 #include "export/complete_slab.h"
+#include "export/coverage.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
 #include "lib/photometry/eulumdat.h"
@@ -29,15 +30,6 @@ constexpr int kMetadataSchemaVersion = 1;
 constexpr int64_t kMaxRays = 50000000;  // 1.4 GB of TM-25 rays
 
 // ---- the slab -----------------------------------------------------------------------------
-
-// A dataset folder or its slab/: the folder holding slab.json.
-std::string ResolveSlabDir(const std::string& path) {
-  namespace fs = std::filesystem;
-  if (fs::is_regular_file(path + "/slab.json")) return path;
-  if (fs::is_regular_file(path + "/slab/slab.json")) return path + "/slab";
-  throw BadInput(path + ": no slab.json there nor in " + path +
-                 "/slab (--slab takes a dataset folder or its slab/)");
-}
 
 struct Slab {
   std::string dir;
@@ -167,6 +159,10 @@ struct FarFieldCommand {
   int samples = 4;
   std::vector<double> opening_mm;
   bool force = false;
+  bool allow_partial = false;
+  double max_asymmetry_pct = 5;
+  bool accredited = false, lumen_scaled = false;
+  double input_watts = 0;
   Keywords keywords;
 };
 
@@ -194,8 +190,6 @@ std::vector<double> Steps(double step, double last, const std::string& option, i
   return v;
 }
 
-// The far field of the slab on the requested grid, with the file's keywords: the distribution
-// the writers take.
 // The requested C/gamma grid, checked (kMaxCPlanes, kMaxGammaAngles) before any work: a
 // distribution of zeros the far field fills in.
 IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
@@ -215,35 +209,198 @@ IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
   return d;
 }
 
+// IES and EULUMDAT hold candela: only a slab scaled with a lux meter has them. Checked on
+// slab.json alone, before the positions are read.
+void RequireLuxSlab(const std::string& path, const std::string& format) {
+  const std::string dir = ResolveSlabDir(path);
+  const SlabInfo info = SlabInfo::Load(dir);
+  if (info.units == "lux") return;
+  const std::string dataset = DatasetOfSlab(dir).empty() ? "<dataset>" : DatasetOfSlab(dir);
+  throw InputError(dir + "/slab.json", "units",
+                   "lux (" + format +
+                       " holds candela and lumen: calibrate the scale with a lux meter reading, "
+                       "lumislab-calibrate scale --dataset " +
+                       dataset +
+                       " --position i,j --point-mm x,y --reading-p LX --reading-n LX --unit lux, "
+                       "then lumislab-reconstruct --dataset " +
+                       dataset + " --force; lumislab-export tm25 writes radiometric rays)",
+                   info.units);
+}
+
+// The far field on the grid of `d`. A symmetric subset of the C range (--c-angles 0..90,
+// 0..180, 90..270 or one plane) is computed at every mirror image of each plane, so that the
+// subset carries the whole luminaire's light, and written as their mean; the asymmetry is the
+// flux-weighted mean absolute deviation of the images from that mean, relative to it:
+// sum over cells of dOmega mean_k |I_k - I_mean| / sum over cells of dOmega I_mean.
+struct GridFarField {
+  FarField ff;            // on d's grid: values (the images' mean) and seen (every image seen)
+  double asymmetry = -1;  // -1: not a subset
+  size_t images = 1;      // mirror images per plane
+};
+
+std::vector<double> MirrorImages(double c, CSymmetry symmetry) {
+  std::vector<double> images;
+  switch (symmetry) {
+    case CSymmetry::kQuadrant:
+      images = {c, 180 - c, 180 + c, 360 - c};
+      break;
+    case CSymmetry::kC0C180:
+      images = {c, 360 - c};
+      break;
+    case CSymmetry::kC90C270:
+      images = {c, 180 - c};
+      break;
+    case CSymmetry::kAxial:  // rotational symmetry: 24 planes 15 degrees apart
+      for (int k = 0; k < 24; ++k) images.push_back(c + 15 * k);
+      break;
+    case CSymmetry::kNone:
+      images = {c};
+      break;
+  }
+  std::vector<double> distinct;  // in [0, 360), each once
+  for (double x : images) {
+    x = std::fmod(std::fmod(x, 360.0) + 360.0, 360.0);
+    if (x > 360 - 1e-9) x = 0;
+    bool seen = false;
+    for (double y : distinct) seen = seen || std::abs(x - y) < 1e-9;
+    if (!seen) distinct.push_back(x);
+  }
+  return distinct;
+}
+
+GridFarField ComputeGridFarField(const IntensityDistribution& d, const Slab& slab,
+                                 const FarFieldOptions& options, CheckLog& checks) {
+  GridFarField out;
+  const CSymmetry symmetry = d.Symmetry();
+  if (symmetry == CSymmetry::kNone) {
+    out.ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
+    CheckFarFieldLight(out.ff, slab.info, slab.dir, checks);
+    return out;
+  }
+  std::vector<std::vector<double>> images(d.c_deg.size());
+  std::vector<double> all;
+  for (size_t ic = 0; ic < d.c_deg.size(); ++ic) {
+    images[ic] = MirrorImages(d.c_deg[ic], symmetry);
+    all.insert(all.end(), images[ic].begin(), images[ic].end());
+  }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end(),
+                        [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+            all.end());
+  const FarField full = ComputeFarField(slab.info, slab.positions, all, d.gamma_deg, options);
+  CheckFarFieldLight(full, slab.info, slab.dir, checks);
+  const size_t ng = d.gamma_deg.size();
+  out.ff.c_deg = d.c_deg;
+  out.ff.gamma_deg = d.gamma_deg;
+  out.ff.values.assign(d.values.size(), 0.0);
+  out.ff.seen.assign(d.values.size(), 1);
+  IntensityDistribution deviation = d, mean = d;
+  for (size_t ic = 0; ic < d.c_deg.size(); ++ic) {
+    std::vector<size_t> at;
+    for (double x : images[ic])
+      at.push_back(size_t(std::lower_bound(all.begin(), all.end(), x - 1e-9) - all.begin()));
+    out.images = std::max(out.images, at.size());
+    for (size_t ig = 0; ig < ng; ++ig) {
+      double sum = 0;
+      bool seen = true;
+      for (size_t k : at) {
+        sum += std::max(0.0, full.values[k * ng + ig]);
+        seen = seen && full.seen[k * ng + ig];
+      }
+      const double m = sum / at.size();
+      double dev = 0;
+      for (size_t k : at) dev += std::abs(std::max(0.0, full.values[k * ng + ig]) - m);
+      out.ff.values[ic * ng + ig] = m;
+      out.ff.seen[ic * ng + ig] = seen;
+      out.ff.unseen += !seen;
+      mean.values[ic * ng + ig] = m;
+      deviation.values[ic * ng + ig] = dev / at.size();
+    }
+  }
+  const double flux = mean.TotalFlux();
+  out.asymmetry = flux > 0 ? deviation.TotalFlux() / flux : 0;
+  return out;
+}
+
+// The far field of the slab on the requested grid, with the file's keywords: the distribution
+// the writers take. Refuses (exit 2) a grid the capture did not see where a model of the
+// luminaire has light, unless --allow-partial, and a symmetric subset of a luminaire more
+// asymmetric than --max-asymmetry.
 IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& slab, int threads,
-                                       CheckLog& checks) {
+                                       CheckLog& checks, bool* simulation) {
   IntensityDistribution d = DirectionGrid(c);
   FarFieldOptions options;
   options.samples = c.samples;
   options.threads = threads;
-  const FarField ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
-  CheckFarFieldLight(ff, slab.info, slab.dir, checks);
-  d.values = ff.values;
+  const GridFarField grid = ComputeGridFarField(d, slab, options, checks);
+  d.values = grid.ff.values;
   for (double& v : d.values) v = std::max(v, 0.0);  // ringing of the fit: no negative intensity
   d.photometric = Photometric(slab.info);
+  d.input_watts = c.input_watts;
   const SamplingGrid& g = slab.info.grid;
   if (c.opening_mm.size() == 3) {
     d.opening = {c.opening_mm[0], c.opening_mm[1], c.opening_mm[2]};
   } else {  // the basis supports' extent on S: the largest opening the slab represents
     d.opening = {(g.nv + 1) * g.spacing_mm, (g.nu + 1) * g.spacing_mm, 0.0};
   }
-  d.keywords = ResolveKeywords(c.keywords);
-  std::ostringstream note;
-  note << "lumislab-export " << c.format << " from the light slab " << slab.dir << " (" << g.nu
-       << " x " << g.nv << " positions, h " << g.spacing_mm << " mm, d " << slab.info.distance_mm
-       << " mm); directions the screen did not see are 0";
-  d.keywords.push_back({"FILEGENINFO", note.str()});
-  if (ff.unseen > 0)
-    LogWarning(ff.unseen, " of ", ff.values.size(), " directions were not seen by the screen (",
-               ff.behind, " of them behind S, gamma >= 90), written as 0");
   const char* unit = d.photometric ? " lm" : " W";
+  const Coverage coverage = GridCoverage(d, grid.ff, slab.info, slab.dir);
+  *simulation = SyntheticSlab(slab.dir);
   LogInfo("far field: ", d.c_deg.size(), " C planes x ", d.gamma_deg.size(), " gamma angles, flux ",
-          Num(d.TotalFlux(), 6), unit, " over the seen directions");
+          Num(d.TotalFlux(), 6), unit, " over the seen directions; ", coverage.SeenCone(), "; ",
+          coverage.unseen, " of ", coverage.directions, " grid directions not seen; ",
+          coverage.analytic ? "the analytic luminaire emits " : "a Lambertian model emits ",
+          Num(coverage.model_flux, 6), unit, ", ", Num(100 * coverage.model_unseen_share, 3),
+          " % of it in the unseen directions");
+  if (coverage.Partial() && !c.allow_partial)
+    throw BadInput(c.out +
+                   ": the capture did not see every direction of the grid: " + coverage.Text() +
+                   ". The file would carry 0 there (--allow-partial writes it with the coverage "
+                   "stated; --gamma-angles can keep the grid within the seen cone)");
+  d.keywords = ResolveKeywords(c.keywords);
+  const std::string coverage_text =
+      coverage.Partial() ? coverage.Text()
+      : coverage.unseen > 0
+          ? "complete where the model has light: " + std::to_string(coverage.unseen) +
+                " grid directions not seen (written as 0), where " + coverage.model +
+                " puts no flux"
+          : "complete: every grid direction seen";
+  if (c.format == "ies") {
+    d.keywords.push_back({"_COVERAGE", coverage_text});
+  } else if (coverage.Partial()) {
+    // EULUMDAT has no keywords: the coverage goes into the measurement report field (line 8)
+    // after the report number, where every reader shows it ("T-1; partial: ...").
+    bool found = false;
+    for (auto& [key, value] : d.keywords)
+      if (key == "TEST") value += "; " + coverage.Short(), found = true;
+    if (!found) d.keywords.push_back({"TEST", coverage.Short()});
+  }
+  if (coverage.Partial()) LogWarning(c.out, ": written with partial coverage: ", coverage.Text());
+  if (grid.asymmetry >= 0) {
+    const std::string text = std::string(CSymmetryName(d.Symmetry())) +
+                             " subset: each plane the mean of its " + std::to_string(grid.images) +
+                             " mirror images; asymmetry " + Num(100 * grid.asymmetry, 3) +
+                             " % (flux-weighted mean |I - mean| / mean over the images), at most " +
+                             Num(c.max_asymmetry_pct, 4) + " % allowed";
+    LogInfo("far field: ", text);
+    if (100 * grid.asymmetry > c.max_asymmetry_pct)
+      throw BadInput("--c-angles: expected a luminaire symmetric within " +
+                     Num(c.max_asymmetry_pct, 4) + " % for the " + CSymmetryName(d.Symmetry()) +
+                     " subset, got an asymmetry of " + Num(100 * grid.asymmetry, 3) +
+                     " % (flux-weighted mean |I - mean| / mean over the mirror images; write "
+                     "the full C range 0-360, or raise --max-asymmetry)");
+    if (c.format == "ies") d.keywords.push_back({"_ASYMMETRY", text});
+  }
+  // Where the file comes from, without the folder's absolute path (a file is handed on).
+  std::filesystem::path folder = std::filesystem::absolute(slab.dir).lexically_normal();
+  if (folder.filename().empty()) folder = folder.parent_path();
+  if (folder.filename() == "slab") folder = folder.parent_path();  // a dataset's slab/
+  const std::string name = folder.filename().string();
+  std::ostringstream note;
+  note << "lumislab-export " << c.format << " from the light slab of " << name << " (" << g.nu
+       << " x " << g.nv << " positions, h " << g.spacing_mm << " mm, d " << slab.info.distance_mm
+       << " mm)";
+  d.keywords.push_back({"FILEGENINFO", note.str()});
   return d;
 }
 
@@ -251,22 +408,40 @@ int RunFarField(const FarFieldCommand& c, int threads) {
   LogInfo("parameters: slab=", c.slab, " out=", c.out, " c_step=", c.c_step,
           " gamma_step=", c.gamma_step, " c_angles=", c.c_angles.size(),
           " gamma_angles=", c.gamma_angles.size(), " samples=", c.samples,
-          " metadata=", c.keywords.metadata, " force=", c.force ? "yes" : "no");
-  CheckOutputPath(c.out);
-  if (!c.force && std::filesystem::exists(c.out)) {
-    LogInfo(c.out, " exists: skipped (--force rewrites it)");
-    std::printf("%s: %s\n", c.format.c_str(), c.out.c_str());
-    return 0;
-  }
-  DirectionGrid(c);  // refuses a bad grid before the slab is read
+          " metadata=", c.keywords.metadata, " force=", c.force ? "yes" : "no",
+          " allow_partial=", c.allow_partial ? "yes" : "no", " max_asymmetry=", c.max_asymmetry_pct,
+          " accredited=", c.accredited ? "yes" : "no",
+          " lumen_scaled=", c.lumen_scaled ? "yes" : "no", " input_watts=", c.input_watts);
+  CheckExportOutput(c.out, c.force);
+  DirectionGrid(c);  // refuses a bad grid before the slab is read, and bad keywords
+  const auto keywords = ResolveKeywords(c.keywords);
+  if (c.format == "ies") CheckIesRequiredKeywords(keywords, c.out);
+  RequireLuxSlab(c.slab, c.format == "ies" ? "IES" : "EULUMDAT");
   CheckLog checks = SlabChecks(c.slab, "export " + c.format);
   const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
-  const IntensityDistribution d = SlabDistribution(c, slab, threads, checks);
+  bool simulation = false;
+  const IntensityDistribution d = SlabDistribution(c, slab, threads, checks, &simulation);
   checks.Save();
-  if (c.format == "ies")
-    WriteIes(d, c.out);
-  else
+  if (c.format == "ies") {
+    // The far field is computed from the slab on the requested grid, not measured at those
+    // angles: LM-63-2019's "interpolated angle set". A synthetic dataset's slab is a computer
+    // simulation, whatever the flags say.
+    FileGenerationType type;
+    type.simulation = simulation;
+    type.accredited = c.accredited;
+    type.interpolated = true;
+    type.lumen_scaled = c.lumen_scaled;
+    if (simulation && (c.accredited || c.lumen_scaled))
+      LogWarning("a synthetic dataset: file generation type 1.00010 (computer simulation); ",
+                 "--accredited and --lumen-scaled do not apply");
+    IesWriteOptions options;
+    options.file_generation_type = type.Code();
+    LogInfo("file generation type ", options.file_generation_type, ": ",
+            FileGenerationTypeName(options.file_generation_type));
+    WriteIes(d, c.out, options);
+  } else {
     WriteEulumdat(d, c.out);
+  }
   std::printf("%s: %s\n", c.format.c_str(), c.out.c_str());
   return 0;
 }
@@ -275,14 +450,18 @@ CLI::App* AddFarFieldCommand(CLI::App& app, const std::string& format, FarFieldC
                              CommonOptions* common) {
   c->format = format;
   CLI::App* cmd = app.add_subcommand(
-      format, format == "ies" ? "the slab's far-field intensity as an IES LM-63-2019 file"
-                              : "the slab's far-field intensity as an EULUMDAT file");
+      format, format == "ies" ? "the slab's far-field intensity as an IES LM-63-2019 file (a "
+                                "slab in lux: candela)"
+                              : "the slab's far-field intensity as an EULUMDAT file (a slab in "
+                                "lux: candela)");
   cmd->add_option("--slab", c->slab, "dataset folder or its slab/")->required();
   cmd->add_option("--out", c->out, "file to write")->required();
   cmd->add_option("--c-step", c->c_step, "degrees between C planes, 0-360")->capture_default_str();
   cmd->add_option("--gamma-step", c->gamma_step, "degrees between gamma angles, 0-90")
       ->capture_default_str();
-  cmd->add_option("--c-angles", c->c_angles, "explicit C planes (degrees, comma separated)")
+  cmd->add_option("--c-angles", c->c_angles,
+                  "explicit C planes (degrees, comma separated); a symmetric range (0..90, "
+                  "0..180, 90..270, one plane) is the mean of each plane's mirror images")
       ->delimiter(',');
   cmd->add_option("--gamma-angles", c->gamma_angles, "explicit gamma angles (degrees)")
       ->delimiter(',');
@@ -294,7 +473,28 @@ CLI::App* AddFarFieldCommand(CLI::App& app, const std::string& format, FarFieldC
       ->check(FiniteIn(-1e6, 1e6))
       ->delimiter(',')
       ->expected(3);
-  cmd->add_flag("--force", c->force, "rewrite the output if it exists");
+  cmd->add_flag("--force", c->force, "rewrite the output if it exists (else exit 2)");
+  cmd->add_flag("--allow-partial", c->allow_partial,
+                "write a grid the capture did not wholly see (0 there), with the coverage "
+                "stated in the file" +
+                    std::string(format == "ies" ? " ([_COVERAGE])"
+                                                : " (the measurement report field, line 8)"));
+  cmd->add_option("--max-asymmetry", c->max_asymmetry_pct,
+                  "a symmetric --c-angles subset: the largest asymmetry (percent, flux-weighted "
+                  "mean |I - mean| / mean over the mirror images) written")
+      ->check(FiniteIn(0, 100))
+      ->capture_default_str();
+  cmd->add_option("--input-watts", c->input_watts,
+                  "the luminaire's input power, W (IES line 12, EULUMDAT's lamp wattage; gives "
+                  "the efficacy)")
+      ->check(FiniteIn(0, 1e7));
+  if (format == "ies") {
+    cmd->add_flag("--accredited", c->accredited,
+                  "the lab is accredited for this test (file generation type 1.1xxxx)");
+    cmd->add_flag("--lumen-scaled", c->lumen_scaled,
+                  "the candela were scaled to another lumen rating (file generation type "
+                  "1.xx1xx)");
+  }
   AddKeywordOptions(cmd, &c->keywords);
   AddCommonOptions(cmd, common);
   return cmd;
@@ -308,27 +508,48 @@ struct RayCommand {
   uint64_t seed = 0;
   std::string name, manufacturer;
   bool force = false;
+  bool allow_partial = false;
 };
+
+// What the rays cover: they leave S through the window, so only the cone the screen saw. The
+// far field on a 5 x 2.5 degree grid over the hemisphere says which cone, and a model what
+// share of the luminaire's flux falls outside it (GridCoverage).
+Coverage RayCoverage(const Slab& slab, int threads, CheckLog& checks) {
+  IntensityDistribution d;
+  d.c_deg = Steps(5, 355, "C", kMaxCPlanes);
+  d.gamma_deg = Steps(2.5, 90, "gamma", kMaxGammaAngles);
+  d.values.assign(d.c_deg.size() * d.gamma_deg.size(), 0.0);
+  FarFieldOptions options;
+  options.samples = 2;
+  options.threads = threads;
+  const FarField ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
+  CheckFarFieldLight(ff, slab.info, slab.dir, checks);
+  return GridCoverage(d, ff, slab.info, slab.dir);
+}
 
 int RunRays(const RayCommand& c, int threads) {
   LogInfo("parameters: slab=", c.slab, " out=", c.out, " rays=", c.rays, " seed=", c.seed,
-          " force=", c.force ? "yes" : "no");
-  CheckOutputPath(c.out);
-  if (!c.force && std::filesystem::exists(c.out)) {
-    LogInfo(c.out, " exists: skipped (--force rewrites it)");
-    std::printf("tm25: %s\n", c.out.c_str());
-    return 0;
-  }
+          " force=", c.force ? "yes" : "no", " allow_partial=", c.allow_partial ? "yes" : "no");
+  CheckExportOutput(c.out, c.force);
   CheckLog checks = SlabChecks(c.slab, "export tm25");
   const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
+  const Coverage coverage = RayCoverage(slab, threads, checks);
   checks.Save();
+  const std::string cone =
+      "rays only in the cone the screen saw: " + coverage.SeenCone() +
+      " (5 x 2.5 degree grid); outside it " +
+      (coverage.analytic ? "the analytic luminaire puts " : "the model puts ") +
+      Num(100 * coverage.model_unseen_share, 3) + " % of its flux (" + coverage.model + ")";
+  LogInfo("coverage: ", cone);
+  if (coverage.Partial() && !c.allow_partial)
+    throw BadInput(c.out + ": the rays would miss light the capture did not see: " + cone +
+                   " (--allow-partial writes them with the cone stated in additional_info)");
   const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed, threads);
   Tm25RaySet set;
   set.photometric = Photometric(slab.info);
   const double nan = std::nan("");
   set.luminous_flux_lm = set.photometric ? drawn.total_flux : nan;
   set.radiant_flux_w = set.photometric ? nan : drawn.total_flux;
-  set.creation_method = 1;  // measured
   set.date_time = NowUtc("%Y-%m-%dT%H:%M:%SZ");
   set.name = c.name;
   set.manufacturer = c.manufacturer;
@@ -338,7 +559,9 @@ int RunRays(const RayCommand& c, int threads) {
                   Num(slab.info.grid.spacing_mm, 6) + " mm, d " + Num(slab.info.distance_mm, 6) +
                   " mm";
   set.additional_info = "rays drawn from the slab's light field, seed " + std::to_string(c.seed) +
-                        "; origins on the sampling plane z = 0 (mm, luminaire frame)";
+                        "; origins on the sampling plane z = 0 (mm, luminaire frame); coverage: " +
+                        (coverage.Partial() ? "partial: " : "complete: ") + cone;
+  set.creation_method = SyntheticSlab(slab.dir) ? 0 : 1;  // simulated (synthetic) or measured
   set.rays.reserve(drawn.rays.size());
   for (const SlabRay& r : drawn.rays)
     set.rays.push_back({float(r.origin_mm.x()), float(r.origin_mm.y()), float(r.origin_mm.z()),
@@ -376,7 +599,10 @@ CLI::App* AddRayCommand(CLI::App& app, RayCommand* c, CommonOptions* common) {
       ->capture_default_str();
   cmd->add_option("--name", c->name, "name of the light source (header)");
   cmd->add_option("--manufacturer", c->manufacturer, "its manufacturer (header)");
-  cmd->add_flag("--force", c->force, "rewrite the output if it exists");
+  cmd->add_flag("--force", c->force, "rewrite the output if it exists (else exit 2)");
+  cmd->add_flag("--allow-partial", c->allow_partial,
+                "write rays although the capture saw only a cone of the luminaire's light (the "
+                "cone stated in additional_info)");
   AddCommonOptions(cmd, common);
   return cmd;
 }

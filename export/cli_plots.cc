@@ -31,6 +31,7 @@ struct IrradianceOptions {
   int size = 512;
   int samples = 2;
   std::string range = "auto", scale = "linear";
+  bool force = false;
 };
 
 struct PolarOptions {
@@ -39,6 +40,7 @@ struct PolarOptions {
   int samples = 4;
   int size = 600;
   std::string title;
+  bool force = false;
 };
 
 std::string Extension(const std::string& path) {
@@ -47,13 +49,14 @@ std::string Extension(const std::string& path) {
 
 // The slab's irradiance on the plane z = D by the exact CPU reference (docs/method.md §4.5;
 // nothing in the way, so no visibility rays), through the false colour of docs/method.md §4.9.
-int RunIrradiance(const IrradianceOptions& o, int threads) {
+int RunIrradiance(IrradianceOptions o, int threads) {
+  o.slab_dir = ResolveSlabDir(o.slab_dir);
   LogInfo("parameters: slab=", o.slab_dir, " distance_mm=", o.distance_mm,
           " extent_mm=", o.extent_mm, " size=", o.size, " samples=", o.samples, " range=", o.range,
           " scale=", o.scale, " out=", o.out);
   const std::string ext = Extension(o.out);
   if (ext != ".png" && ext != ".exr") throw BadInput(o.out + ": --out must end in .png or .exr");
-  CheckOutputPath(o.out);
+  CheckExportOutput(o.out, o.force);
   if (o.extent_mm != 0 && !(o.extent_mm >= 1 && o.extent_mm <= kMaxDistanceMm))
     throw InputError("--extent-mm", "", "0 (default) or a length in [1, 1e5] mm",
                      std::to_string(o.extent_mm));
@@ -137,12 +140,13 @@ PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
   return data;
 }
 
-int RunPolar(const PolarOptions& o, int threads) {
+int RunPolar(PolarOptions o, int threads) {
+  o.slab_dir = ResolveSlabDir(o.slab_dir);
   LogInfo("parameters: slab=", o.slab_dir, " gamma_step=", o.gamma_step_deg, " samples=", o.samples,
           " size=", o.size, " out=", o.out);
   const std::string ext = Extension(o.out);
   if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
-  CheckOutputPath(o.out);
+  CheckExportOutput(o.out, o.force);
   const PolarPlot plot = MakePolarPlot(PolarDataFromSlab(o, threads), o.size);
   if (ext == ".svg") {
     WriteTextAtomically(o.out, PolarPlotSvg(plot));
@@ -164,7 +168,7 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       "frame, by the exact CPU reference: .png false colour (viridis, colour bar in W/m² or lx, "
       "iso-lines at its ticks, a length scale) or .exr linear; +x right, +y up (the plane seen "
       "from behind it, looking back at the luminaire)");
-  irr->add_option("--slab", irradiance->slab_dir, "slab folder")->required();
+  irr->add_option("--slab", irradiance->slab_dir, "dataset folder or its slab/")->required();
   irr->add_option("--distance-mm", irradiance->distance_mm, "D: the plane's distance from S (mm)")
       ->required()
       ->check(FiniteIn(kMinDistanceMm, kMaxDistanceMm));
@@ -184,6 +188,7 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       ->check(CLI::IsMember({"linear", "log"}))
       ->capture_default_str();
   irr->add_option("--out", irradiance->out, ".png (false colour) or .exr (linear)")->required();
+  irr->add_flag("--force", irradiance->force, "rewrite the output if it exists");
   AddCommonOptions(irr, common);
 
   auto polar = std::make_shared<PolarOptions>();
@@ -192,7 +197,7 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       "the far-field polar diagram of the slab (intensity in cd or W/sr against gamma, planes "
       "C0-C180 and C90-C270, C0 (+x) and C90 (-y) on the right, up to the largest gamma the "
       "slab saw in all four)");
-  pol->add_option("--slab", polar->slab_dir, "slab folder")->required();
+  pol->add_option("--slab", polar->slab_dir, "dataset folder or its slab/")->required();
   pol->add_option("--out", polar->out, ".svg or .png")->required();
   pol->add_option("--gamma-step", polar->gamma_step_deg, "degrees between the curves' points")
       ->check(FiniteIn(0.1, 45))
@@ -204,6 +209,7 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       ->check(CLI::Range(200, 4096))
       ->capture_default_str();
   pol->add_option("--title", polar->title, "the title above the diagram");
+  pol->add_flag("--force", polar->force, "rewrite the output if it exists");
   AddCommonOptions(pol, common);
 
   return [irr, pol, irradiance, polar](int threads) -> std::optional<int> {

@@ -7,6 +7,10 @@
 #       [--lab L] [--manufacturer M] [--metadata meta.json] [--dry-run] [--summary-only]
 #
 # A dataset is a folder with dataset.json; any other folder stands for the datasets directly in it.
+# The IES and EULUMDAT files need --lab and --manufacturer (or --metadata) and a slab in lux: a
+# dataset's lux meter reading (reference.json; a synthetic dataset's truth/reference.json from
+# `acquire synth --meter lux`) scales it in the calibrate stage; without them the export stage
+# fails, and the summary says why.
 # A dataset named summary.csv is refused (exit 2): the summary is <out>/summary.csv.
 # --jobs N: the cores to use (default, and at most: all there are; more is all, with a notice);
 #   min(N, datasets) datasets run at once, each stage with N / that many threads. Resumable: a

@@ -7,9 +7,16 @@
 #
 # <stage>: calibrate | reconstruct | export | tm25 | preview. <out>: the batch's output folder.
 # The dataset's name is its folder's name. What each stage writes (docs/architecture.md §6):
-#   calibrate    <dataset>/calib/screen.json        (lumislab-calibrate screen)
+#   calibrate    <dataset>/calib/screen.json        (lumislab-calibrate screen), and
+#                <dataset>/calib/scale.json from a lux meter reading when the dataset has one
+#                (lumislab-calibrate scale --reference): <dataset>/reference.json (the lab's,
+#                docs/formats.md) or, for a synthetic dataset, truth/reference.json when its
+#                unit is lux (`acquire synth --meter lux`): IES and EULUMDAT need a lux slab
 #   reconstruct  <dataset>/slab/                    (lumislab-reconstruct)
-#   export       <out>/<name>/<name>.ies, <name>.ldt, polar.png, irradiance_<D>mm.png
+#   export       <out>/<name>/<name>.ies, <name>.ldt, polar.png, irradiance_<D>mm.png; the
+#                IES/EULUMDAT name the lab and the maker: --lab and --manufacturer (or
+#                --metadata) are required (exit 2 without), and state their coverage of the
+#                C/gamma grid (--allow-partial: the screen sees a cone of it; [_COVERAGE])
 #   tm25         <out>/<name>/<name>.ray            (lumislab-export tm25)
 #   preview      <out>/<name>/preview.png           (lumislab-preview, the crypt)
 # and always <out>/log/<name>/<stage>.log (the tools' output), and <stage>.time (seconds) when the
@@ -55,6 +62,17 @@ run() {
 
 calibrate() {
   run "$bin/lumislab-calibrate" screen --dataset "$dataset" --force --threads "$threads"
+  local reference=""
+  if [ -f "$dataset/reference.json" ]; then
+    reference="$dataset/reference.json"
+  elif [ -f "$dataset/truth/reference.json" ] &&
+    tr -d ' \t\r\n' <"$dataset/truth/reference.json" | grep -q '"unit":"lux"'; then
+    reference="$dataset/truth/reference.json"  # the synthetic lux meter's reading
+  fi
+  if [ -n "$reference" ]; then
+    run "$bin/lumislab-calibrate" scale --dataset "$dataset" --reference "$reference" --force \
+      --threads "$threads"
+  fi
 }
 
 reconstruct() {
@@ -70,22 +88,29 @@ reconstruct() {
 export_files() {
   local export="$bin/lumislab-export" slab="$dataset/slab"
   mkdir -p "$dest"
-  # A lab's IES file must name the test, the lab and the maker (docs/architecture.md §7.8); the test is the dataset.
-  local ids=(--test "$name")
-  [ ${#keywords[@]} -gt 0 ] || ids+=(--lab unspecified --manufacturer unspecified)
-  run "$export" ies --slab "$slab" --out "$dest/$name.ies" --force --threads "$threads" \
-    "${ids[@]}" "${keywords[@]}"
-  run "$export" ldt --slab "$slab" --out "$dest/$name.ldt" --force --threads "$threads" \
-    "${ids[@]}" "${keywords[@]}"
-  run "$export" polar --slab "$slab" --out "$dest/polar.png" --title "$name" --threads "$threads"
+  # A lab's IES file must name the test, the lab and the maker (docs/architecture.md §7.8); the
+  # test is the dataset. No made-up lab: without them the stage fails (and the summary says so).
+  local ids=(--test "$name") given=" ${keywords[*]-} "
+  if [[ "$given" != *" --metadata "* ]] &&
+    { [[ "$given" != *" --lab "* ]] || [[ "$given" != *" --manufacturer "* ]]; }; then
+    echo "export: IES and EULUMDAT files name the lab and the luminaire's maker: give --lab and" \
+      "--manufacturer (or --metadata meta.json)" | tee -a "$log" >&2
+    exit 2
+  fi
+  run "$export" ies --slab "$slab" --out "$dest/$name.ies" --force --allow-partial \
+    --threads "$threads" "${ids[@]}" "${keywords[@]}"
+  run "$export" ldt --slab "$slab" --out "$dest/$name.ldt" --force --allow-partial \
+    --threads "$threads" "${ids[@]}" "${keywords[@]}"
+  run "$export" polar --slab "$slab" --out "$dest/polar.png" --title "$name" --force \
+    --threads "$threads"
   run "$export" irradiance --slab "$slab" --distance-mm "$distance" \
-    --out "$dest/irradiance_${distance}mm.png" --threads "$threads"
+    --out "$dest/irradiance_${distance}mm.png" --force --threads "$threads"
 }
 
 tm25() {
   mkdir -p "$dest"
   run "$bin/lumislab-export" tm25 --slab "$dataset/slab" --out "$dest/$name.ray" --rays "$rays" \
-    --name "$name" --force --threads "$threads"
+    --name "$name" --force --allow-partial --threads "$threads"
 }
 
 preview() {

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <vector>
 
@@ -147,7 +148,9 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
     const int s = e.positive ? 0 : 1;
     if (const auto v = AddPhoto(photo, pixel, r, &slides[s])) {
       const double y[3] = {v->x(), v->y(), v->z()};
-      bracket_values[s].push_back({{"file", photo.path},
+      // The photo as dataset.json names it: a dataset folder's name need not be UTF-8 (JSON
+      // must), and the report stays valid when the folder moves.
+      bracket_values[s].push_back({{"file", e.file},
                                    {"value", Luminance(y)},
                                    {"level", Luminance(y) * photo.spec.exposure}});
     }
@@ -188,7 +191,12 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
                      std::to_string(scale.scale));
   nlohmann::json& j = *report;
   j["photos_through_srgb_curve"] = srgb;
-  j["reference"] = reference.source;
+  // A reading file in the dataset folder by its path there: the folder's name need not be UTF-8
+  // (JSON must be), and the report stays valid when the folder moves.
+  const std::filesystem::path relative =
+      std::filesystem::path(reference.source).lexically_relative(dataset.dir);
+  j["reference"] =
+      !relative.empty() && *relative.begin() != ".." ? relative.string() : reference.source;
   j["position"] = {reference.i, reference.j};
   j["point_mm"] = {reference.point_mm.x(), reference.point_mm.y()};
   j["pixel"] = {pixel.x(), pixel.y()};
@@ -201,7 +209,10 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
   j["peak_value_p"] = peak_p;
   j["bracket_values_p"] = bracket_values[0];
   j["bracket_values_n"] = bracket_values[1];
-  if (dataset.radiometric_scale) j["dataset_scale_w_m2"] = *dataset.radiometric_scale;
+  // A lux meter's scale is K (lm/W, the source's spectrum: unknown here) times a radiometer's:
+  // only a W/m2 reading is compared with dataset.json's (scale.matches_dataset).
+  if (dataset.radiometric_scale && reference.unit != "lux")
+    j["dataset_scale_w_m2"] = *dataset.radiometric_scale;
   j["corrections_applied"] = {{"dark", corrections && corrections->dark != nullptr},
                               {"response", corrections && corrections->response != nullptr},
                               {"flat", corrections && corrections->flat != nullptr}};

@@ -7,6 +7,7 @@
 
 #include "core/input_file.h"
 #include "core/log.h"
+#include "lib/photometry/ies.h"
 #include "lib/photometry/intensity_distribution.h"
 #include "lib/photometry/tm25.h"
 
@@ -41,6 +42,10 @@ nlohmann::json PhotometricFileInfo(const std::string& path) {
     j["name"] = set.name;
     j["manufacturer"] = set.manufacturer;
     j["rayfile_creator"] = set.rayfile_creator;
+    j["additional_info"] = set.additional_info;
+    // lumislab's ray files state their coverage in additional_info ("coverage: ...").
+    const size_t at = set.additional_info.find("coverage: ");
+    if (at != std::string::npos) j["coverage"] = set.additional_info.substr(at + 10);
     return j;
   }
   const IntensityDistribution d = ReadIntensityFile(path);
@@ -63,10 +68,27 @@ nlohmann::json PhotometricFileInfo(const std::string& path) {
                      {"length", d.opening.length_mm},
                      {"height", d.opening.height_mm}};
   j["input_watts"] = d.input_watts;
+  // lm/W (W/W radiometric) when the file gives the input power.
+  j["efficacy"] = d.input_watts > 0 ? nlohmann::json(d.TotalFlux() / d.input_watts) : nullptr;
+  if (!d.lamps.empty()) j["lamps"] = d.lamps;
+  if (!d.file_generation_type.empty() && d.format == "IES LM-63-2019")
+    j["file_generation_type"] = {{"code", d.file_generation_type},
+                                 {"meaning", FileGenerationTypeName(d.file_generation_type)}};
   nlohmann::json keywords = nlohmann::json::object();
   for (const auto& [key, value] : d.keywords)
     if (!key.empty()) keywords[key] = value;
   j["keywords"] = keywords;
+  // Coverage as lumislab states it: IES [_COVERAGE]; EULUMDAT the measurement report field
+  // (line 8, read as TEST) after "; partial: ".
+  if (!d.Keyword("_COVERAGE").empty()) {
+    std::string text = d.Keyword("_COVERAGE");  // its [MORE] lines are one sentence
+    std::replace(text.begin(), text.end(), '\n', ' ');
+    j["coverage"] = text;
+  } else {
+    const std::string test = d.Keyword("TEST");
+    const size_t at = test.find("partial: ");
+    if (at != std::string::npos) j["coverage"] = test.substr(at);
+  }
   return j;
 }
 
@@ -91,12 +113,23 @@ std::string FormatPhotometricFileInfo(const nlohmann::json& j, bool json) {
        << "peak: " << Num(j["peak"]["intensity"], 6) << " "
        << j["intensity_unit"].get<std::string>() << " at C " << Num(j["peak"]["c_deg"], 6)
        << ", gamma " << Num(j["peak"]["gamma_deg"], 6) << "\n";
+    if (j.contains("lamps")) os << "lamps: " << j["lamps"].get<std::string>() << "\n";
+    if (j.contains("file_generation_type"))
+      os << "file generation type: " << j["file_generation_type"]["code"].get<std::string>() << " ("
+         << j["file_generation_type"]["meaning"].get<std::string>() << ")\n";
     for (const auto& [key, value] : j["keywords"].items()) {
       std::string text = value.get<std::string>();
       std::replace(text.begin(), text.end(), '\n', ' ');
-      os << "[" << key << "] " << text.substr(0, 90) << "\n";
+      // At most 90 bytes, cut before a UTF-8 continuation byte (no character split).
+      size_t n = std::min<size_t>(text.size(), 90);
+      while (n > 0 && n < text.size() && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
+      os << "[" << key << "] " << text.substr(0, n) << (n < text.size() ? "..." : "") << "\n";
     }
   }
+  if (j.contains("coverage")) os << "coverage: " << j["coverage"].get<std::string>() << "\n";
+  if (j.contains("input_watts") && j["input_watts"].get<double>() > 0)
+    os << "input power: " << Num(j["input_watts"], 6) << " W, efficacy " << Num(j["efficacy"], 4)
+       << " " << unit << "/W\n";
   os << "flux: " << Num(j["flux"], 7) << " " << unit << "\n";
   return os.str();
 }

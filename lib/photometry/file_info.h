@@ -14,7 +14,10 @@ bool IsTm25File(const std::string& path);
 // TILT= line, anything else EULUMDAT) and describes it: format, photometric, flux_unit, flux
 // (the rays' sum, or the distribution's total flux) and for a ray file rays and the header's
 // totals and text, for a distribution the symmetry, the C and gamma grids, the peak, the
-// opening, input_watts and the keywords. Bad input: BadInput naming the file and the field.
+// opening, input_watts and efficacy (flux / input_watts, null without), the IES lamp line and
+// file generation type (with its meaning), and the keywords; `coverage` when lumislab stated it
+// (IES [_COVERAGE], EULUMDAT's report field after "partial: ", TM-25 additional_info after
+// "coverage: "). Bad input: BadInput naming the file and the field.
 nlohmann::json PhotometricFileInfo(const std::string& path);
 
 // The description as `info` prints it: JSON (`json`; text from the file that is not UTF-8 is

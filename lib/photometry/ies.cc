@@ -86,6 +86,7 @@ class Numbers {
     return v;
   }
   int Line() const { return next_ < tokens_.size() ? tokens_[next_].line : -1; }
+  std::string Text() const { return next_ < tokens_.size() ? tokens_[next_].text : ""; }
   size_t Left() const { return tokens_.size() - next_; }
 
  private:
@@ -179,6 +180,8 @@ IntensityDistribution ParseIes(const std::string& text, const std::string& name)
   d.opening.length_mm = in.Next("luminous length") * to_mm;
   d.opening.height_mm = in.Next("luminous height") * to_mm;
   const double ballast = in.NextPositive("ballast factor");
+  // 2002's "future use" and 2019's file generation type: kept as written (2019's is a code).
+  if (!old_factor) d.file_generation_type = in.Text();
   const double second =
       in.Next(old_factor ? "ballast-lamp photometric factor" : "future use / file generation type");
   d.input_watts = in.Next("input watts");
@@ -210,9 +213,8 @@ IntensityDistribution ParseIes(const std::string& text, const std::string& name)
                    "counts on the line of the number of angles do not match the data)");
   const std::string units_keyword = d.Keyword("_UNITS");
   d.photometric = units_keyword.rfind("W/sr", 0) != 0;
-  d.keywords.push_back(
-      {"_LAMPS", std::to_string(lamps) + " x " +
-                     (lumens < 0 ? std::string("absolute photometry") : Num(lumens, 8) + " lm")});
+  d.lamps = std::to_string(lamps) + " x " +
+            (lumens < 0 ? std::string("absolute photometry") : Num(lumens, 8) + " lm");
   d.Check(name);
   return d;
 }
@@ -240,35 +242,81 @@ bool IsKeywordName(const std::string& key) {
   return true;
 }
 
+// Bytes of `s` from `at` to take for a line of at most `max` bytes: up to and with the last
+// space when there is one in its second half (a reader joining the lines with a line break, as
+// ParseIes does, keeps words whole), else ending before a UTF-8 continuation byte (10xxxxxx) so
+// that no character is split; at least one character.
+size_t Utf8Prefix(const std::string& s, size_t at, size_t max) {
+  if (s.size() - at <= max) return s.size() - at;
+  const size_t space = s.rfind(' ', at + max - 1);
+  if (space != std::string::npos && space >= at + max / 2) return space + 1 - at;
+  size_t n = max;
+  while (n > 1 && (static_cast<unsigned char>(s[at + n]) & 0xC0) == 0x80) --n;
+  return n;
+}
+
 }  // namespace
+
+void CheckIesRequiredKeywords(const std::vector<std::pair<std::string, std::string>>& keywords,
+                              const std::string& name) {
+  for (const char* key : kIesRequiredKeywords) {
+    bool found = false;
+    for (const auto& [k, value] : keywords) found = found || (k == key && !Trim(value).empty());
+    if (!found)
+      throw InputError(name, std::string("[") + key + "]",
+                       "a value (LM-63-2019 requires it: give it as a flag or in the metadata)",
+                       "nothing (missing)");
+  }
+}
+
+std::string FileGenerationType::Code() const {
+  if (simulation) return "1.00010";
+  std::string code = "1.";
+  for (bool digit : {accredited, interpolated, lumen_scaled, false, false})
+    code += digit ? '1' : '0';
+  return code;
+}
+
+std::string FileGenerationTypeName(const std::string& code) {
+  if (code == "1.00001") return "undefined";
+  if (code == "1.00010") return "computer simulation";
+  const bool table = code.size() == 7 && code.compare(0, 2, "1.") == 0 &&
+                     code.find_first_not_of("01", 2) == std::string::npos &&
+                     code.compare(5, 2, "00") == 0;
+  if (!table) return "not in LM-63-2019's table";
+  std::string name = code[2] == '1' ? "test at an accredited lab" : "test at an unaccredited lab";
+  if (code[3] == '1') name += ", interpolated angle set";
+  if (code[4] == '1') name += ", lumen scaled";
+  return name;
+}
 
 std::string FormatIes(const IntensityDistribution& d, const IesWriteOptions& options,
                       const std::string& name) {
   d.Check(name);
   std::ostringstream os;
   os << "IES:LM-63-2019\n";
+  // A keyword's lines of over 240 bytes go on in [MORE] lines (LM-63-2019 limits a line to 256
+  // characters), cut between UTF-8 characters: no text is lost and no character is split.
   auto write_keyword = [&](const std::string& key, const std::string& value) {
     std::istringstream lines(value);
     std::string line;
     bool first = true;
     while (std::getline(lines, line)) {
-      os << "[" << (first ? key : "MORE") << "] " << line.substr(0, 240) << "\n";
-      first = false;
+      size_t at = 0;
+      do {
+        const size_t n = Utf8Prefix(line, at, 240);
+        os << "[" << (first ? key : "MORE") << "] " << line.substr(at, n) << "\n";
+        first = false;
+        at += n;
+      } while (at < line.size());
     }
   };
-  for (const char* key : kIesRequiredKeywords) {
-    const std::string value = d.Keyword(key);
-    if (Trim(value).empty())
-      throw InputError(name, std::string("[") + key + "]",
-                       "a value (LM-63-2019 requires it: give it as a flag or in the metadata)",
-                       "nothing (missing)");
-    write_keyword(key, value);
-  }
+  CheckIesRequiredKeywords(d.keywords, name);
+  for (const char* key : kIesRequiredKeywords) write_keyword(key, d.Keyword(key));
   for (const auto& [key, value] : d.keywords) {
     bool required = false;
     for (const char* r : kIesRequiredKeywords) required = required || key == r;
-    if (required || key == "_UNITS" || key == "_LAMPS" || key == "TILT" || !IsKeywordName(key) ||
-        Trim(value).empty())
+    if (required || key == "_UNITS" || key == "TILT" || !IsKeywordName(key) || Trim(value).empty())
       continue;
     write_keyword(key, value);
   }

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lib/photometry/intensity_distribution.h"
 
@@ -21,13 +23,31 @@ IntensityDistribution ReadIes(const std::string& path);
 // The keywords LM-63-2019 requires (§5.2 of the standard); WriteIes refuses a distribution
 // without them.
 extern const char* const kIesRequiredKeywords[4];  // TEST, TESTLAB, ISSUEDATE, MANUFAC
+// BadInput naming `name` and the first required keyword without a value in `keywords`.
+void CheckIesRequiredKeywords(const std::vector<std::pair<std::string, std::string>>& keywords,
+                              const std::string& name);
+
+// LM-63-2019's file generation type (line 11, second value; the standard's Table 2): "1." and
+// five digits, each a yes/no, read left to right: tested at an accredited lab, interpolated
+// angle set, lumen scaled, computer simulation, undefined. So 1.00000 is a test at an
+// unaccredited lab, 1.01000 the same with an interpolated angle set, 1.10100 an accredited lab's
+// lumen-scaled test, 1.00010 a computer simulation and 1.00001 undefined.
+struct FileGenerationType {
+  bool accredited = false;    // the photometry lab is accredited (for this test)
+  bool interpolated = false;  // the angle set was interpolated from other measured angles
+  bool lumen_scaled = false;  // the candela were scaled to another lumen rating
+  bool simulation = false;    // computed, not measured (the other digits are then 0)
+
+  std::string Code() const;  // "1.01000", ...
+};
+// What a line-11 value says in words ("test at an unaccredited lab, interpolated angle set");
+// a value outside the table: "not in LM-63-2019's table".
+std::string FileGenerationTypeName(const std::string& code);
 
 struct IesWriteOptions {
-  // LM-63-2019's file generation type (line 11, second value), written as given. The default
-  // 1.00010 is "computer simulation" in the standard's table (Table 1), not "test at an
-  // unaccredited lab, interpolated angle set" (that is 1.01000); which one a distribution
-  // computed from a slab should carry is issue 29's to settle.
-  std::string file_generation_type = "1.00010";
+  // Written on line 11 as given. The default, 1.00001, is "undefined": a writer that knows
+  // passes FileGenerationType::Code() (lumislab-export ies does, docs/formats.md §17).
+  std::string file_generation_type = "1.00001";
 };
 
 // LM-63-2019 text: the keywords of `d` (the required ones first), TILT=NONE, absolute

@@ -43,6 +43,9 @@ struct IntensityDistribution {
   // (company -> "MANUFAC", luminaire name -> "LUMINAIRE", ...), else "_LDT_<FIELD>".
   std::vector<std::pair<std::string, std::string>> keywords;
   double input_watts = 0;  // luminaire input power, W (0: unknown)
+  // Read from IES files, not keywords (what `export info` lists as keywords is in the file):
+  std::string lamps;                 // line 10: "<number of lamps> x <lm per lamp | absolute ...>"
+  std::string file_generation_type;  // LM-63-2002/2019 line 11's second value as written
 
   double At(size_t ic, size_t ig) const { return values[ic * gamma_deg.size() + ig]; }
   CSymmetry Symmetry() const;

@@ -14,6 +14,26 @@
 namespace lumislab {
 namespace {
 
+// Appends code point c as UTF-8 (a value outside Unicode as U+FFFD).
+void AppendUtf8(char32_t c, std::string* s) {
+  if (c > 0x10FFFF || (c >= 0xD800 && c <= 0xDFFF)) c = 0xFFFD;
+  if (c < 0x80) {
+    *s += char(c);
+  } else if (c < 0x800) {
+    *s += char(0xC0 | (c >> 6));
+    *s += char(0x80 | (c & 0x3F));
+  } else if (c < 0x10000) {
+    *s += char(0xE0 | (c >> 12));
+    *s += char(0x80 | ((c >> 6) & 0x3F));
+    *s += char(0x80 | (c & 0x3F));
+  } else {
+    *s += char(0xF0 | (c >> 18));
+    *s += char(0x80 | ((c >> 12) & 0x3F));
+    *s += char(0x80 | ((c >> 6) & 0x3F));
+    *s += char(0x80 | (c & 0x3F));
+  }
+}
+
 static_assert(sizeof(float) == 4 && sizeof(char32_t) == 4, "TM-25 needs 32-bit floats");
 constexpr int kTm25Version = 2013;
 constexpr size_t kTextChars = 1000;       // each description field: 1000 UTF-32 characters
@@ -71,7 +91,7 @@ class Reader {
     std::string s;
     for (char32_t c : buffer) {
       if (c == 0) break;
-      s += c < 128 ? char(c) : '?';
+      AppendUtf8(c, &s);
     }
     return s;
   }
@@ -93,9 +113,24 @@ template <typename T>
 void Put(std::string* out, T v) {
   PutBytes(out, &v, sizeof v);
 }
+// UTF-32 of the UTF-8 text `s`, at most `chars` characters, zero-padded; a byte that does not
+// start a valid UTF-8 sequence is U+FFFD (the replacement character).
 void PutText(std::string* out, const std::string& s, size_t chars) {
-  for (size_t k = 0; k < chars; ++k)
-    Put<char32_t>(out, k < s.size() ? char32_t(static_cast<unsigned char>(s[k]) & 0x7f) : 0);
+  std::vector<char32_t> text;
+  for (size_t k = 0; k < s.size() && text.size() < chars;) {
+    const unsigned char b = static_cast<unsigned char>(s[k]);
+    const int n = b < 0x80 ? 1 : (b >> 5) == 6 ? 2 : (b >> 4) == 14 ? 3 : (b >> 3) == 30 ? 4 : 0;
+    char32_t c = n == 1 ? b : n == 2 ? b & 0x1F : n == 3 ? b & 0x0F : b & 0x07;
+    bool valid = n > 0 && k + n <= s.size();
+    for (int m = 1; valid && m < n; ++m) {
+      const unsigned char x = static_cast<unsigned char>(s[k + m]);
+      valid = (x & 0xC0) == 0x80;
+      c = (c << 6) | (x & 0x3F);
+    }
+    text.push_back(valid && c <= 0x10FFFF ? c : 0xFFFD);
+    k += valid ? n : 1;
+  }
+  for (size_t k = 0; k < chars; ++k) Put<char32_t>(out, k < text.size() ? text[k] : 0);
 }
 
 }  // namespace

@@ -24,8 +24,8 @@ struct Tm25RaySet {
   double radiant_flux_w = 0;
   int creation_method = 1;  // 0 simulated, 1 measured
   std::string date_time;    // ISO 8601, at most 28 characters
-  // Description block (4.7.3): UTF-32 in the file, ASCII here (others read as '?'; the writer
-  // keeps each byte's low 7 bits, so a non-ASCII byte is written as another character).
+  // Description block (4.7.3): UTF-32 in the file, UTF-8 here (the writer writes a byte that
+  // is not valid UTF-8 as U+FFFD; at most 1000 characters a field).
   std::string name, manufacturer, model_creator, rayfile_creator, equipment, camera,
       light_source_operation, additional_info, data_reference;
   std::vector<Tm25Ray> rays;

@@ -42,7 +42,7 @@ struct SynthScene {
   // Luminous efficacy of radiation of the luminaire's light, lm/W: the truth lux meter reads
   // lux = K x W/m^2 and the truth in lm = K x W. With a spectrum on every point emitter (cct_k)
   // and no ray source: 683 x sum(V S) / sum(S) of the emitters' spectra S weighted by their
-  // radiant flux. Otherwise kDefaultLuminousEfficacy.
+  // radiant flux. Otherwise DefaultLuminousEfficacy().
   double LuminousEfficacy() const;
   bool Quantized() const;  // photos are 16-bit PNG (else float EXR, or JPEG with a response)
   // The listed effect of that type, or null (each is listed at most once).

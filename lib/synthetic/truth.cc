@@ -52,13 +52,16 @@ bool GridCovers(const Luminaire& luminaire, const SlabInfo& info, const Eigen::V
   return true;
 }
 
-void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir,
-                    int threads) {
+void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir, int threads,
+                    double luminous_efficacy) {
   MakeDirectories(dir);
   info.present.clear();
+  const float scale = info.units == "lux" ? float(luminous_efficacy) : 1.f;
   ParallelFor(info.grid.count(), threads, [&](int q) {
     const int i = q % info.grid.nu, j = q / info.grid.nu;
-    WriteSlabPosition(dir, info, TruthPosition(luminaire, info, i, j));
+    SlabPosition p = TruthPosition(luminaire, info, i, j);
+    for (float& v : p.irradiance.data) v *= scale;
+    WriteSlabPosition(dir, info, p);
   });
   for (int j = 0; j < info.grid.nv; ++j)
     for (int i = 0; i < info.grid.nu; ++i) info.MarkPresent(i, j);

@@ -17,8 +17,10 @@ namespace lumislab {
 SlabPosition TruthPosition(const Luminaire& luminaire, const SlabInfo& info, int i, int j);
 
 // A complete truth slab in `dir`: every position of info.grid and slab.json, positions computed
-// and written on `threads` threads.
-void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir, int threads);
+// and written on `threads` threads. A slab in units "lux" holds what a lux meter reads,
+// `luminous_efficacy` (lm/W, SynthScene::LuminousEfficacy) x the W/m^2 of TruthPosition.
+void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string& dir, int threads,
+                    double luminous_efficacy = DefaultLuminousEfficacy());
 
 // The slab layout of a scene's capture at `resolution` texels per side (d, grid, screen window,
 // filter, W/m^2).

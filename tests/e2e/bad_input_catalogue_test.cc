@@ -1537,6 +1537,7 @@ std::vector<Case> SlabCases() {
     v.push_back(C("slab_negative_light_export_" + args.substr(0, args.find(' ')))
                     .Export(args)
                     .Do(negative_slab)
+                    .Do(SetJson(kSlabJson, "/units", "lux"))  // ies, ldt: lux slabs only
                     .Names(negative)
                     .MustNotExist(args.substr(args.rfind(' ') + 1)));
   v.push_back(C("slab_negative_light_reconstruct_slides_swapped")
@@ -2125,11 +2126,29 @@ std::vector<Case> PhotometryCases() {
                   .Names({"nowhere", "no slab.json"}));
   v.push_back(F("ies", "slab_partial", "")
                   .Do(SetJson(kSlabJson, "/present", {{0, 0}}))
+                  .Do(SetJson(kSlabJson, "/units", "lux"))
                   .Names({kSlabJson, "present"}));
   v.push_back(
       F("ldt", "slab_exr_nan", "")
           .Do(ExrPoison("ds/slab/pos_1_0.exr", "R", std::numeric_limits<float>::quiet_NaN()))
+          .Do(SetJson(kSlabJson, "/units", "lux"))
           .Names({"ds/slab/pos_1_0.exr"}));
+  // Issue 29: IES and EULUMDAT hold candela, from a slab in lux only (this one is W/m^2), naming
+  // how to calibrate; a grid the screen did not wholly see is refused without --allow-partial;
+  // an existing output is exit 2 unless --force, the file left as it was.
+  for (const std::string format : {"ies", "ldt"})
+    v.push_back(
+        F(format, "slab_not_lux", "")
+            .Names({kSlabJson, "units", "expected lux", "lumislab-calibrate scale", "got W/m^2"}));
+  v.push_back(F("ies", "grid_partly_unseen", "")
+                  .Do(SetJson(kSlabJson, "/units", "lux"))
+                  .Names({"x.ies", "did not see every direction", "--allow-partial"}));
+  v.push_back(F("tm25", "rays_partly_unseen", "--rays 10")
+                  .Names({"x.tm25", "rays would miss light", "--allow-partial"}));
+  v.push_back(C("export_ies_out_exists")
+                  .Export("ies --slab ds --out x.ies" + keywords)
+                  .Do(WriteText("x.ies", "an older file\n"))
+                  .Names({"x.ies", "exists", "--force"}));
   v.push_back(C("export_ies_out_folder_missing")
                   .Export("ies --slab ds --out nodir/x.ies" + keywords)
                   .Exit(3)

@@ -42,10 +42,12 @@ CommandResult RunIn(const std::string& cwd, const std::string& command) {
 }
 
 std::string Pipelines() { return std::string(LUMISLAB_SOURCE_DIR) + "/pipelines"; }
+// The IES/EULUMDAT files name the lab and the maker: the batch refuses to make them up.
+const char kLab[] = " --lab 'Batch Lab' --manufacturer Maker";
 std::string BatchConvert() { return ShellQuote(Pipelines() + "/batch-convert.sh"); }
 std::string Snakemake() {
   return "snakemake -s " + ShellQuote(Pipelines() + "/Snakefile") +
-         " --config 'datasets=[data]' out=out --cores 2";
+         " --config 'datasets=[data]' out=out 'lab=Batch Lab' manufacturer=Maker --cores 2";
 }
 bool HaveSnakemake() { return std::system("command -v snakemake >/dev/null 2>&1") == 0; }
 
@@ -115,14 +117,17 @@ class Batch : public ::testing::Test {
     // One folder per process: ctest runs each test in its own process, side by side.
     root_ = testing::FreshDir("batch_" + std::to_string(getpid()));
     testing::WriteFile(root_ + "/scene.json", kTinyScene);
+    // A lux meter's reading in each (truth/reference.json): the calibrate stage scales the slab
+    // with it, so that the IES and EULUMDAT files hold candela.
     for (const char* name : {"lamp_a", "lamp_b", "broken"}) {
       const auto r =
-          testing::RunTool("lumislab-acquire", "synth --scene " + root_ + "/scene.json --out " +
-                                                   root_ + "/data/" + name);
+          testing::RunTool("lumislab-acquire", "synth --meter lux --scene " + root_ +
+                                                   "/scene.json --out " + root_ + "/data/" + name);
       ASSERT_EQ(r.exit_code, 0) << r.output;
     }
-    // A photo cut short, as a failed copy leaves it: reconstruct refuses it (exit 2).
-    fs::resize_file(root_ + "/data/broken/photos/pos_1_0_p.exr", 1000);
+    // A photo cut short, as a failed copy leaves it: reconstruct refuses it (exit 2). Not one of
+    // position (1, 0), where the lux meter read (calibrate scale reads those photos).
+    fs::resize_file(root_ + "/data/broken/photos/pos_0_1_p.exr", 1000);
   }
   static void TearDownTestSuite() {
     if (!::testing::Test::HasFailure()) fs::remove_all(root_);
@@ -136,16 +141,16 @@ TEST_F(Batch, ConvertsReportsTheBrokenDatasetAndResumes) {
     GTEST_SKIP() << "runs the tools many times over; the Release build's (the tools' own tests "
                     "run sanitized)";
   // Before anything ran: four stages for each of the three datasets.
-  const CommandResult plan = RunIn(root_, BatchConvert() + " data --out out --dry-run");
+  const CommandResult plan = RunIn(root_, BatchConvert() + " data --out out --dry-run" + kLab);
   ASSERT_EQ(plan.exit_code, 0) << plan.output;
   EXPECT_EQ(Lines(plan.output).size(), 12u) << plan.output;
   EXPECT_EQ(Lines(plan.output).count("reconstruct broken"), 1u) << plan.output;
 
-  const CommandResult first = RunIn(root_, BatchConvert() + " data --out out --jobs 2");
+  const CommandResult first = RunIn(root_, BatchConvert() + " data --out out --jobs 2" + kLab);
   ASSERT_EQ(first.exit_code, 1) << first.output;
   // The table names the failing stage and the tool's reason (the photo).
   EXPECT_NE(first.output.find("reconstruct (exit 2)"), std::string::npos) << first.output;
-  EXPECT_NE(first.output.find("pos_1_0_p.exr"), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("pos_0_1_p.exr"), std::string::npos) << first.output;
   auto rows = ReadSummary(root_ + "/out/summary.csv");
   ASSERT_EQ(rows.size(), 3u);
   for (const char* name : {"lamp_a", "lamp_b"}) {
@@ -175,19 +180,23 @@ TEST_F(Batch, ConvertsReportsTheBrokenDatasetAndResumes) {
         "lumislab-export", "info --json " + root_ + "/out/" + name + "/" + name + ".ies");
     EXPECT_EQ(info.exit_code, 0) << info.output;
     EXPECT_NE(info.output.find("\"flux\""), std::string::npos) << info.output;
+    // Candela (the lux meter's scale), the lab as given, the coverage stated (issue 29).
+    EXPECT_NE(info.output.find("\"photometric\": true"), std::string::npos) << info.output;
+    EXPECT_NE(info.output.find("\"TESTLAB\": \"Batch Lab\""), std::string::npos) << info.output;
+    EXPECT_NE(info.output.find("\"coverage\": \"partial: "), std::string::npos) << info.output;
   }
   const Row& broken = rows["broken"];
   EXPECT_EQ(broken.at("status"), "failed");
   EXPECT_EQ(broken.at("ran"), "calibrate reconstruct");
   EXPECT_EQ(broken.at("failure").rfind("reconstruct (exit 2): ", 0), 0u) << broken.at("failure");
-  EXPECT_NE(broken.at("failure").find("pos_1_0_p.exr"), std::string::npos);
+  EXPECT_NE(broken.at("failure").find("pos_0_1_p.exr"), std::string::npos);
   EXPECT_FALSE(fs::exists(root_ + "/out/broken/preview.png"));
   EXPECT_TRUE(fs::is_regular_file(root_ + "/out/log/broken/reconstruct.log"));
   EXPECT_TRUE(testing::TemporaryPaths(testing::SnapshotTree(root_ + "/out")).empty());
 
   // Only the broken dataset's stages from reconstruct on are left, and Snakemake, which decides
   // by the same rules, plans the same jobs.
-  const CommandResult left = RunIn(root_, BatchConvert() + " data --out out -n");
+  const CommandResult left = RunIn(root_, BatchConvert() + " data --out out -n" + kLab);
   EXPECT_EQ(Lines(left.output),
             (std::set<std::string>{"reconstruct broken", "export broken", "preview broken"}))
       << left.output;
@@ -201,7 +210,7 @@ TEST_F(Batch, ConvertsReportsTheBrokenDatasetAndResumes) {
   const auto time_ies = fs::last_write_time(root_ + "/out/lamp_a/lamp_a.ies");
   const auto time_slab = fs::last_write_time(root_ + "/data/lamp_b/slab/slab.json");
   const auto first_rows = rows;
-  const CommandResult again = RunIn(root_, BatchConvert() + " data --out out --jobs 2");
+  const CommandResult again = RunIn(root_, BatchConvert() + " data --out out --jobs 2" + kLab);
   EXPECT_EQ(again.exit_code, 1) << again.output;
   EXPECT_TRUE(
       testing::DiffSnapshots(before_a, testing::SnapshotTree(root_ + "/data/lamp_a")).empty());
@@ -235,7 +244,7 @@ TEST_F(Batch, ConvertsReportsTheBrokenDatasetAndResumes) {
   EXPECT_TRUE(fs::is_regular_file(root_ + "/out/lamp_b/preview.png")) << run.output;
   EXPECT_EQ(fs::last_write_time(root_ + "/out/lamp_b/lamp_b.ies"), ies_time);
   EXPECT_NE(run.output.find("reconstruct (exit 2)"), std::string::npos) << run.output;
-  EXPECT_EQ(Lines(RunIn(root_, BatchConvert() + " data --out out -n").output),
+  EXPECT_EQ(Lines(RunIn(root_, BatchConvert() + " data --out out -n" + kLab).output),
             (std::set<std::string>{"reconstruct broken", "export broken", "preview broken"}));
 }
 
@@ -246,9 +255,9 @@ TEST_F(Batch, SnakefileQuotesFolderNamesAndConfigValues) {
   if (!HaveSnakemake())
     GTEST_SKIP() << "snakemake is not installed (Debian: apt install snakemake)";
   const std::string name = "x'$(touch PWNED)'";
-  const auto synth =
-      testing::RunTool("lumislab-acquire", "synth --scene " + ShellQuote(root_ + "/scene.json") +
-                                               " --out " + ShellQuote(root_ + "/odd/" + name));
+  const auto synth = testing::RunTool(
+      "lumislab-acquire", "synth --meter lux --scene " + ShellQuote(root_ + "/scene.json") +
+                              " --out " + ShellQuote(root_ + "/odd/" + name));
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string lab = "O'Brien's lab", manufacturer = "ACME $(touch PWNED) `touch PWNED`";
   const CommandResult run =
@@ -288,13 +297,22 @@ TEST_F(Batch, RefusesTheSummarysNameAndClampsJobs) {
   const std::string latin1 = "lamp_caf\xe9";
   fs::create_directories(dir + "/l1");
   fs::copy(root_ + "/data/lamp_a", dir + "/l1/" + latin1, fs::copy_options::recursive);
-  const CommandResult run = RunIn(dir, BatchConvert() + " l1 --out out1 --jobs 9999");
+  const CommandResult run = RunIn(dir, BatchConvert() + " l1 --out out1 --jobs 9999" + kLab);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("--jobs 9999 is more than the"), std::string::npos) << run.output;
   auto rows = ReadSummary(dir + "/out1/summary.csv");
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[latin1]["status"], "ok");
   EXPECT_TRUE(fs::exists(dir + "/out1/" + latin1 + "/" + latin1 + ".ies"));
+  // Issue 29: without a lab and a maker the export stage fails, naming them (it wrote
+  // "[TESTLAB] unspecified" and reported ok).
+  const CommandResult nolab = RunIn(dir, BatchConvert() + " l1 --out out2");
+  EXPECT_EQ(nolab.exit_code, 1) << nolab.output;
+  rows = ReadSummary(dir + "/out2/summary.csv");
+  EXPECT_EQ(rows[latin1]["status"], "failed");
+  EXPECT_NE(rows[latin1]["failure"].find("give --lab and --manufacturer"), std::string::npos)
+      << rows[latin1]["failure"];
+  EXPECT_FALSE(fs::exists(dir + "/out2/" + latin1 + "/" + latin1 + ".ies"));
 }
 
 }  // namespace

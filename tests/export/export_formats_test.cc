@@ -25,24 +25,35 @@ using testing::RunTool;
 using testing::ShellQuote;
 
 // The default scene's emitters 1 and 1.5 mm behind S (the slab's parallax error is then 0.1 %,
-// docs/method.md §4.5) on its 9 x 7 grid at 48 texels: a complete truth slab in a folder.
+// docs/method.md §4.5) on its 9 x 7 grid at 48 texels: a complete truth slab in a folder, in
+// lux as a lux meter reads it (K x W/m^2, K = the scene's luminous efficacy), with
+// truth/luminaire.json beside it (a synthetic dataset: the analytic luminaire states coverage).
 // ctest runs each test in its own process, in parallel: the folder is the running test's own (one
 // shared name had two processes clearing and refilling it at once).
 struct Fixture {
   std::string dir = FreshDir(std::string("export_formats_") +
                              ::testing::UnitTest::GetInstance()->current_test_info()->name());
   Luminaire luminaire = DefaultScene().luminaire;
-  SlabInfo info = DefaultSlabInfo(9, 7, 5, 48);
+  SlabInfo info = LuxSlabInfo(9, 7, 5, 48);
+  double k = DefaultScene().LuminousEfficacy();  // lm/W
   Fixture() {
     luminaire.emitters[0].position_mm.z() = -1;
     luminaire.emitters[1].position_mm.z() = -1.5;
-    WriteTruthSlab(luminaire, info, dir + "/ds/slab", 2);
+    WriteTruthSlab(luminaire, info, dir + "/ds/slab", 2, k);
+    std::filesystem::create_directories(dir + "/ds/truth");
+    WriteTruthLuminaire(luminaire, dir + "/ds/truth/luminaire.json");
   }
+  static SlabInfo LuxSlabInfo(int nu, int nv, double h, int resolution) {
+    SlabInfo info = DefaultSlabInfo(nu, nv, h, resolution);
+    info.units = "lux";
+    return info;
+  }
+  // cd: K x the emitters' W/sr (Rec. 709 luminance).
   double Truth(double c_deg, double gamma_deg) const {
     const Eigen::Vector3d w = TypeCDirection(c_deg, gamma_deg);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Emitter& e : luminaire.emitters) sum += e.Intensity(w);
-    return LuminanceWeights().dot(sum);
+    return k * LuminanceWeights().dot(sum);
   }
 };
 const Fixture& Data() {
@@ -52,6 +63,8 @@ const Fixture& Data() {
 
 const char kKeywords[] =
     " --test T-1 --lab 'Test Lab' --manufacturer Maker --issue-date 2026-12-02";
+// The screen sees gamma <= 37.7 degrees (47 diagonally): a full grid is partial coverage.
+const char kPartial[] = " --allow-partial";
 
 // Relative L2 of the file's intensities against the truth over the directions it has light in
 // (the screen saw them), and the flux there against the truth's over the same cone.
@@ -78,7 +91,7 @@ void ExpectMatchesTruth(const IntensityDistribution& d, double tolerance) {
     for (size_t ig = 0; ig < d.gamma_deg.size(); ++ig)
       truth.values[ic * d.gamma_deg.size() + ig] =
           d.At(ic, ig) > 0 ? f.Truth(d.c_deg[ic], d.gamma_deg[ig]) : 0;
-  std::printf("%s: flux %.6g W, truth in the same directions %.6g W\n", d.format.c_str(),
+  std::printf("%s: flux %.6g lm, truth in the same directions %.6g lm\n", d.format.c_str(),
               d.TotalFlux(), truth.TotalFlux());
   EXPECT_NEAR(d.TotalFlux() / truth.TotalFlux(), 1, 0.01);
 }
@@ -87,19 +100,21 @@ TEST(ExportFormats, IesAndLdtHoldTheSlabsFarField) {
   const Fixture& f = Data();
   const std::string ies = f.dir + "/out.ies", ldt = f.dir + "/out.ldt";
   auto r = RunTool("lumislab-export", "ies --slab " + ShellQuote(f.dir + "/ds") + " --out " +
-                                          ShellQuote(ies) + kKeywords + " --threads 2");
+                                          ShellQuote(ies) + kKeywords + kPartial + " --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("directions were not seen by the screen"), std::string::npos);
+  EXPECT_NE(r.output.find("grid directions not seen"), std::string::npos);
   const IntensityDistribution d = ReadIes(ies);
   EXPECT_EQ(d.format, "IES LM-63-2019");
-  EXPECT_FALSE(d.photometric);  // a W/m^2 slab: W/sr
+  EXPECT_TRUE(d.photometric);  // a lux slab: cd
+  EXPECT_EQ(d.Keyword("_UNITS"), "");
   EXPECT_EQ(d.Keyword("TESTLAB"), "Test Lab");
   EXPECT_EQ(d.c_deg.size(), 73u);
   EXPECT_EQ(d.gamma_deg.size(), 37u);
   EXPECT_NEAR(std::abs(d.opening.length_mm), 50, 1e-6);  // (nu + 1) h
   ExpectMatchesTruth(d, 0.005);
   r = RunTool("lumislab-export", "ldt --slab " + ShellQuote(f.dir + "/ds/slab") + " --out " +
-                                     ShellQuote(ldt) + kKeywords + " --c-step 15 --gamma-step 5");
+                                     ShellQuote(ldt) + kKeywords + kPartial +
+                                     " --c-step 15 --gamma-step 5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const IntensityDistribution l = ReadEulumdat(ldt);
   EXPECT_EQ(l.c_deg.size(), 24u);
@@ -111,24 +126,27 @@ TEST(ExportFormats, IesAndLdtHoldTheSlabsFarField) {
   const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
   EXPECT_EQ(j["format"], "EULUMDAT");
   EXPECT_NEAR(j["flux"].get<double>(), l.TotalFlux(), 1e-6 * l.TotalFlux());
-  // An existing output is skipped unless --force.
-  r = RunTool("lumislab-export",
-              "ies --slab " + ShellQuote(f.dir + "/ds") + " --out " + ShellQuote(ies) + kKeywords);
-  EXPECT_EQ(r.exit_code, 0);
-  EXPECT_NE(r.output.find("exists: skipped"), std::string::npos);
+  // An existing output is exit 2 naming it unless --force (issue 29: it was skipped, exit 0).
+  const std::string before = testing::ReadBinaryFile(ies);
+  r = RunTool("lumislab-export", "ies --slab " + ShellQuote(f.dir + "/ds") + " --out " +
+                                     ShellQuote(ies) + kKeywords + kPartial);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("out.ies: exists (--force rewrites it)"), std::string::npos) << r.output;
+  EXPECT_EQ(testing::ReadBinaryFile(ies), before);
 }
 
 TEST(ExportFormats, Tm25RaysCarryTheSlabsFlux) {
   const Fixture& f = Data();
   const std::string ray = f.dir + "/out.ray";
   auto r = RunTool("lumislab-export", "tm25 --slab " + ShellQuote(f.dir + "/ds") + " --out " +
-                                          ShellQuote(ray) + " --rays 20000 --seed 3 --name lamp");
+                                          ShellQuote(ray) +
+                                          " --rays 20000 --seed 3 --name lamp --allow-partial");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Tm25RaySet set = ReadTm25(ray);
   ASSERT_EQ(set.rays.size(), 20000u);
-  EXPECT_FALSE(set.photometric);
+  EXPECT_TRUE(set.photometric);  // a lux slab: lm
   EXPECT_EQ(set.name, "lamp");
-  EXPECT_NEAR(set.FluxSum(), set.radiant_flux_w, 1e-4 * set.radiant_flux_w);
+  EXPECT_NEAR(set.FluxSum(), set.luminous_flux_lm, 1e-4 * set.luminous_flux_lm);
   // The slab's flux: every position's E over the window.
   const std::vector<SlabPosition> positions =
       ReadSlabPositions(f.dir + "/ds/slab", SlabInfo::Load(f.dir + "/ds/slab"), 2);
@@ -156,8 +174,8 @@ TEST(ExportFormats, BadInputIsExitTwoAndWritesNothing) {
     std::string args;
     std::string expected;
   };
-  const std::string nolab =
-      "ies --slab " + ds + " --out " + ShellQuote(out) + " --test T --manufacturer M";
+  const std::string nolab = "ies --slab " + ds + " --out " + ShellQuote(out) +
+                            " --test T --manufacturer M --allow-partial";
   const Case cases[] = {
       {nolab, "bad.ies: [TESTLAB]: expected a value"},
       {"ies --slab " + ds + " --out " + ShellQuote(out) + kKeywords + " --c-step 7",
@@ -182,7 +200,8 @@ TEST(ExportFormats, BadInputIsExitTwoAndWritesNothing) {
                      R"({"schema_version": 1, "test": "R-7", "testlab": "Lab", "manufac": "M",
                          "keywords": {"LUMCAT": "X-1"}})");
   auto r = RunTool("lumislab-export", "ies --slab " + ds + " --out " + ShellQuote(out) +
-                                          " --metadata " + ShellQuote(f.dir + "/meta.json"));
+                                          " --allow-partial --metadata " +
+                                          ShellQuote(f.dir + "/meta.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(ReadIes(out).Keyword("LUMCAT"), "X-1");
   testing::WriteFile(f.dir + "/meta2.json", R"({"schema_version": 1, "tset": "R-7"})");
@@ -193,27 +212,30 @@ TEST(ExportFormats, BadInputIsExitTwoAndWritesNothing) {
       << r.output;
 }
 
-// A slab scaled with a lux meter (units "lux") gives candela and lumen: IES without the
-// radiometric keyword, TM-25 with the luminous flux column.
-TEST(ExportFormats, LuxSlabsArePhotometric) {
-  const std::string dir = FreshDir("export_lux");
-  SlabInfo info = DefaultSlabInfo(3, 3, 5, 16);
-  info.units = "lux";
-  WriteTruthSlab(Data().luminaire, info, dir + "/slab", 2);
-  auto r = RunTool("lumislab-export", "ies --slab " + ShellQuote(dir) + " --out " +
-                                          ShellQuote(dir + "/x.ies") + kKeywords);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find(" lm over the seen directions"), std::string::npos) << r.output;
-  const IntensityDistribution d = ReadIes(dir + "/x.ies");
-  EXPECT_TRUE(d.photometric);
-  EXPECT_EQ(d.Keyword("_UNITS"), "");
-  r = RunTool("lumislab-export", "tm25 --slab " + ShellQuote(dir) + " --out " +
-                                     ShellQuote(dir + "/x.ray") + " --rays 100");
+// IES and EULUMDAT hold candela: a slab in W/m^2 (or relative units) is refused, naming the
+// units and how to calibrate; TM-25 writes its rays radiometric (W) instead.
+TEST(ExportFormats, RadiometricSlabsAreRefusedForIesAndLdt) {
+  const std::string dir = FreshDir("export_radiometric");
+  WriteTruthSlab(Data().luminaire, DefaultSlabInfo(3, 3, 5, 16), dir + "/slab", 2);
+  for (const char* format : {"ies", "ldt"}) {
+    const std::string out = dir + "/x." + format;
+    const auto r =
+        RunTool("lumislab-export", std::string(format) + " --slab " + ShellQuote(dir) + " --out " +
+                                       ShellQuote(out) + kKeywords + kPartial);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("slab.json: units: expected lux"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("lumislab-calibrate scale"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("got W/m^2"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  const auto r =
+      RunTool("lumislab-export", "tm25 --slab " + ShellQuote(dir) + " --out " +
+                                     ShellQuote(dir + "/x.ray") + " --rays 100 --allow-partial");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Tm25RaySet rays = ReadTm25(dir + "/x.ray");
-  EXPECT_TRUE(rays.photometric);
-  EXPECT_NEAR(rays.luminous_flux_lm, rays.FluxSum(), 1e-4 * rays.FluxSum());
-  EXPECT_TRUE(std::isnan(rays.radiant_flux_w));
+  EXPECT_FALSE(rays.photometric);
+  EXPECT_NEAR(rays.radiant_flux_w, rays.FluxSum(), 1e-4 * rays.FluxSum());
+  EXPECT_TRUE(std::isnan(rays.luminous_flux_lm));
 }
 
 // The exported intensity of a luminaire whose one emitter is a measured IES file (1.ies, a real
@@ -225,7 +247,9 @@ double CompareWithMeasured(const std::string& exported, const std::string& measu
   const IntensityDistribution in = ReadIes(measured_file);
   double peak = 0;
   for (double v : in.values) peak = std::max(peak, v);
-  // The emitter's I0 = (1, 1, 1) W/sr is the file's peak: the file's cd times 1 / peak.
+  // The emitter's I0 = (1, 1, 1) W/sr is the file's peak: the file's cd times K / peak (the
+  // exported file is in cd: K lm/W x W/sr).
+  peak /= DefaultScene().LuminousEfficacy();
   IntensityDistribution truth = out;
   double num = 0, den = 0;
   for (size_t ic = 0; ic < out.c_deg.size(); ++ic)
@@ -239,7 +263,7 @@ double CompareWithMeasured(const std::string& exported, const std::string& measu
     }
   const double l2 = std::sqrt(num / den);
   std::printf(
-      "measured emitter %s: relative L2 %.2e, flux %.6g W vs %.6g W in the seen directions\n",
+      "measured emitter %s: relative L2 %.2e, flux %.6g lm vs %.6g lm in the seen directions\n",
       measured_file.c_str(), l2, out.TotalFlux(), truth.TotalFlux());
   EXPECT_NEAR(out.TotalFlux() / truth.TotalFlux(), 1, flux_tolerance);
   return l2;
@@ -258,9 +282,11 @@ TEST(ExportFormats, MeasuredEmitterRoundTripsThroughTheTruthSlab) {
                                                   "]}}");
   const Luminaire luminaire = LoadLuminaire(dir + "/luminaire.json");
   ASSERT_TRUE(luminaire.emitters[0].measured);
-  WriteTruthSlab(luminaire, DefaultSlabInfo(5, 5, 5, 48), dir + "/slab", 2);
-  const auto r = RunTool("lumislab-export", "ies --slab " + ShellQuote(dir + "/slab") + " --out " +
-                                                ShellQuote(dir + "/out.ies") + kKeywords);
+  WriteTruthSlab(luminaire, Fixture::LuxSlabInfo(5, 5, 5, 48), dir + "/slab", 2,
+                 DefaultScene().LuminousEfficacy());
+  const auto r =
+      RunTool("lumislab-export", "ies --slab " + ShellQuote(dir + "/slab") + " --out " +
+                                     ShellQuote(dir + "/out.ies") + kKeywords + kPartial);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_LT(CompareWithMeasured(dir + "/out.ies", dir + "/1.ies", 0.01), 0.02);
   // truth/luminaire.json keeps a copy of the file beside it and reads back.
@@ -296,14 +322,18 @@ TEST_P(MeasuredEmitterCapture, RoundTripsThroughACapture) {
              "look_at_mm": [0, 0, 750]} })");
   const std::string ds = ShellQuote(dir + "/ds");
   auto r = RunTool("lumislab-acquire", "synth --scene " + ShellQuote(dir + "/scene.json") +
-                                           " --out " + ds + " --truth-resolution 16");
+                                           " --out " + ds + " --truth-resolution 16 --meter lux");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = RunTool("lumislab-calibrate", "screen --dataset " + ds);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The synthetic lux meter's reading makes the slab photometric (lux, so cd in the file).
+  r = RunTool("lumislab-calibrate", "scale --dataset " + ds + " --reference " +
+                                        ShellQuote(dir + "/ds/truth/reference.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = RunTool("lumislab-reconstruct", "--dataset " + ds + " --resolution 64");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = RunTool("lumislab-export",
-              "ies --slab " + ds + " --out " + ShellQuote(dir + "/out.ies") + kKeywords);
+              "ies --slab " + ds + " --out " + ShellQuote(dir + "/out.ies") + kKeywords + kPartial);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_LT(CompareWithMeasured(dir + "/out.ies", dir + "/" + file, 0.01), 0.02);
   EXPECT_TRUE(std::filesystem::exists(dir + "/ds/truth/emitter_0.ies"));

@@ -78,6 +78,32 @@ TEST_F(ExportPlots, PolarPlotSvgAndPng) {
   EXPECT_EQ(cv::imread(png).cols, 300);
 }
 
+// Issue 29: polar and irradiance take the dataset folder like ies, ldt and tm25 (the folder
+// holding slab/), and an existing output is exit 2 naming it unless --force (it was replaced
+// silently).
+TEST_F(ExportPlots, DatasetFolderAndExistingOutput) {
+  const std::string svg = Out("d.svg"), png = Out("d.png");
+  ASSERT_EQ(RunExportWith({"polar", "--slab", dir_.string(), "--gamma-step", "10", "--out", svg}),
+            0);
+  ASSERT_EQ(RunExportWith({"irradiance", "--slab", dir_.string(), "--distance-mm", "1500", "--size",
+                           "32", "--samples", "1", "--out", png}),
+            0);
+  const std::string before = ReadTextFile(svg);
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"polar", "--slab", Slab(), "--gamma-step", "5", "--out", svg},
+           {"irradiance", "--slab", Slab(), "--distance-mm", "750", "--size", "32", "--out",
+            png}}) {
+    testing::internal::CaptureStderr();
+    EXPECT_EQ(RunExportWith(args), 2) << args[0];
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(err.find(args.back() + ": exists (--force rewrites it)"), std::string::npos) << err;
+  }
+  EXPECT_EQ(ReadTextFile(svg), before);
+  EXPECT_EQ(
+      RunExportWith({"polar", "--slab", Slab(), "--gamma-step", "5", "--out", svg, "--force"}), 0);
+  EXPECT_NE(ReadTextFile(svg), before);
+}
+
 TEST_F(ExportPlots, BadInputIsExit2AndWritesNothing) {
   const std::string out = Out("bad.png");
   // Each with what its message must name.

@@ -32,6 +32,9 @@ packages=(
   # the linker of every build here (scripts/test.sh's too): several times faster than ld.bfd,
   # and each build links about 70 executables
   lld
+  # lumislab-export report --pdf, and the report's browser check (tests/export/report_test.cc):
+  # headless Chromium prints the HTML to PDF and screenshots it
+  chromium
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -51,11 +51,14 @@ double Edge(const Profile& p, size_t start, int dir, double level, double* reach
 }
 
 // The full angle between the crossings of `fraction` x the peak on either side of it.
-void Spread(const Profile& p, size_t peak, double fraction, double* angle, double* at_least) {
+void Spread(const Profile& p, size_t peak, double fraction, double* angle, double* at_least,
+            double* lo_out, double* hi_out) {
   const double level = fraction * p.value[peak];
   double reached_lo, reached_hi;
   const double lo = Edge(p, peak, -1, level, &reached_lo);
   const double hi = Edge(p, peak, +1, level, &reached_hi);
+  *lo_out = lo;
+  *hi_out = hi;
   *angle = std::isnan(lo) || std::isnan(hi) ? kNan : hi - lo;
   *at_least = (std::isnan(hi) ? reached_hi : hi) - (std::isnan(lo) ? reached_lo : lo);
 }
@@ -74,8 +77,8 @@ bool BeamSpreadOfPair(const IntensityDistribution& d, const std::vector<uint8_t>
     if (p.seen[k] && (!p.seen[peak] || p.value[k] > p.value[peak])) peak = k;
   if (!p.seen[peak] || !(p.value[peak] > 0)) return false;
   s.peak = p.value[peak];
-  Spread(p, peak, 0.5, &s.beam_deg, &s.beam_at_least_deg);
-  Spread(p, peak, 0.1, &s.field_deg, &s.field_at_least_deg);
+  Spread(p, peak, 0.5, &s.beam_deg, &s.beam_at_least_deg, &s.beam_lo_deg, &s.beam_hi_deg);
+  Spread(p, peak, 0.1, &s.field_deg, &s.field_at_least_deg, &s.field_lo_deg, &s.field_hi_deg);
   *out = s;
   return true;
 }

@@ -26,6 +26,9 @@ struct BeamSpread {
   double field_deg = 0;
   double beam_at_least_deg = 0;  // when beam_deg is NaN: the spread the data covers
   double field_at_least_deg = 0;
+  // The edges as signed angles (degrees: + in plane C, - in plane C + 180); an edge not reached
+  // is NaN.
+  double beam_lo_deg = 0, beam_hi_deg = 0, field_lo_deg = 0, field_hi_deg = 0;
 };
 
 // One gamma zone [lo, hi): its flux (lm or W) and share of the total (%).

@@ -19,6 +19,7 @@
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/slab_light.h"
+#include "export/report_uncertainty.h"
 #include "lib/synthetic/truth.h"
 
 namespace lumislab {
@@ -196,6 +197,72 @@ TEST_F(ExportReport, ChromiumPrintsAndRendersIt) {
     for (const std::string& f : {html, pdf, png})
       fs::copy_file(f, fs::path(keep) / fs::path(f).filename(),
                     fs::copy_options::overwrite_existing);
+}
+
+// The plane pictures' orientation: one emitter 40 mm towards +x and 30 mm towards +y lights the
+// plane's right and upper part (+x right, +y up, row 0 on top), as the axes say.
+TEST(ExportReportPlanes, PlusXRightAndPlusYUp) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lumislab_report_xy_" + std::to_string(getpid()));
+  Luminaire luminaire;
+  Emitter e;
+  e.position_mm = {40, 30, -1};
+  e.intensity_w_sr = {1, 1, 1};
+  e.lobe_exponent = 2;
+  luminaire.emitters.push_back(e);
+  WriteTruthSlab(luminaire, DefaultSlabInfo(9, 7, 20, 48), (dir / "slab").string(), 2);
+  ReportOptions o;
+  o.slab = (dir / "slab").string();
+  o.out = (dir / "r.html").string();
+  o.plane_size = 41;
+  o.distances_mm = {750};
+  const ReportData r = MakeReportData(o, 2);
+  const ReportPlane& p = r.planes.at(0);
+  double sum = 0, sx = 0, sy = 0;
+  for (int y = 0; y < p.size; ++y)
+    for (int x = 0; x < p.size; ++x) {
+      const double v = p.luminance[size_t(y) * p.size + x];
+      sum += v;
+      sx += v * ((x + 0.5) / p.size - 0.5) * p.extent_mm;
+      sy += v * (0.5 - (y + 0.5) / p.size) * p.extent_mm;  // row 0 on top: +y up
+    }
+  std::printf("centroid on the plane: %.1f, %.1f mm\n", sx / sum, sy / sum);
+  EXPECT_GT(sx / sum, 20);
+  EXPECT_GT(sy / sum, 15);
+  fs::remove_all(dir);
+}
+
+// The uncertainty: the planner's terms, and calib/scale.json's bracket agreement through
+// (Y+ - Y-): values 10, 10.2, 9.8 (standard error of the mean 0.115) and 2, 2 (0) give
+// 0.1155 / 8 = 1.44 %.
+TEST(ExportReportUncertainty, ScaleBracketsAndPlannerTerms) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lumislab_report_u_" + std::to_string(getpid()));
+  fs::create_directories(dir / "calib");
+  WriteTextAtomically((dir / "calib/scale.json").string(), R"({"schema_version": 1,
+    "kind": "scale", "scale": 1, "units": "lux", "report": {
+    "bracket_values_p": [{"value": 10}, {"value": 10.2}, {"value": 9.8}],
+    "bracket_values_n": [{"value": 2}, {"value": 2}]}})");
+  UncertaintyInput in;
+  in.info = DefaultSlabInfo(9, 7, 5, 48);
+  in.dataset_dir = dir.string();
+  in.light_depth_mm = 20;
+  in.meter_relative = 0.02;
+  const FarFieldUncertainty u = EstimateFarFieldUncertainty(in);
+  double scale = -1, sum2 = 0;
+  for (const UncertaintyTerm& t : u.terms) {
+    if (t.name.find("bracket") != std::string::npos) scale = t.relative;
+    sum2 += t.relative * t.relative;
+  }
+  EXPECT_NEAR(scale, 0.2 / std::sqrt(3.0) / 8, 1e-9);
+  EXPECT_NEAR(u.flux_relative, std::sqrt(sum2), 1e-12);
+  EXPECT_NEAR(u.FluxExpanded(), 2 * u.flux_relative, 1e-12);
+  EXPECT_GT(u.flux_relative, 0.02);
+  const std::string keyword = UncertaintyKeyword(u);
+  EXPECT_EQ(keyword.rfind("flux +-", 0), 0u) << keyword;
+  EXPECT_NE(keyword.find("(expanded, k=2; terms:"), std::string::npos) << keyword;
+  EXPECT_EQ(keyword.back(), ')');
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -233,11 +233,14 @@ int RunReport(const ReportOptions& o, int threads) {
   for (const std::string& path : {o.out, o.pdf}) {
     if (path.empty()) continue;
     CheckOutputPath(path);
+    const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
+    if (!std::filesystem::is_directory(folder))
+      throw IoError(path, "cannot write it: no folder " + folder.string());
     if (!o.force && std::filesystem::exists(path))
       throw BadInput(path + ": exists (--force rewrites it)");
   }
   const ReportData data = MakeReportData(o, threads);
-  WriteTextAtomically(o.out, ReportHtml(data, o.out));
+  WriteTextAtomically(o.out, ReportHtml(data));
   std::printf("report: %s\n", o.out.c_str());
   if (!o.pdf.empty()) {
     PrintPdf(o.out, o.pdf);

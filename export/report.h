@@ -85,9 +85,8 @@ struct ReportData {
 
 // Everything the report shows, from the slab (read on `threads` threads).
 ReportData MakeReportData(const ReportOptions& options, int threads);
-// The HTML document (export/report_html.cc); `out_path`: where it goes (its pictures pass
-// through a temporary PNG beside it).
-std::string ReportHtml(const ReportData& data, const std::string& out_path);
+// The HTML document (export/report_html.cc).
+std::string ReportHtml(const ReportData& data);
 
 // Adds `report` to `app` (its options bound to `common`).
 using ParsedCommand = std::function<std::optional<int>(int threads)>;

@@ -280,7 +280,7 @@ void IsoCandela(Page& p) {
        "every 15&deg;), C as labelled. Grey: not seen.</figcaption></figure></section>\n";
 }
 
-void Planes(Page& p, const std::string& out_path) {
+void Planes(Page& p) {
   const ReportData& r = p.r;
   auto& h = p.html;
   h << "<section class=page><h2>Illuminance on planes</h2><div class=figs>\n";
@@ -300,7 +300,7 @@ void Planes(Page& p, const std::string& out_path) {
     h << "<figure>" << a.Open("x (mm)", "y (mm)");
     h << "<image x=\"" << a.X(a.x0) << "\" y=\"" << a.Y(a.y1) << "\" width=\""
       << a.X(a.x1) - a.X(a.x0) << "\" height=\"" << a.Y(a.y0) - a.Y(a.y1)
-      << "\" preserveAspectRatio=\"none\" href=\"" << PngDataUri(picture, out_path) << "\"/>\n";
+      << "\" preserveAspectRatio=\"none\" href=\"" << PngDataUri(picture) << "\"/>\n";
     // Pixel centres in mm: x right, y up (row 0 on top).
     auto page = [&](double fx, double fy) {
       const double xm = (fx + 0.5) / n * plane.extent_mm - plane.extent_mm / 2;
@@ -451,7 +451,7 @@ void Metadata(Page& p) {
 
 }  // namespace
 
-std::string ReportHtml(const ReportData& data, const std::string& out_path) {
+std::string ReportHtml(const ReportData& data) {
   Page p{data, {}};
   auto& h = p.html;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
@@ -463,7 +463,7 @@ std::string ReportHtml(const ReportData& data, const std::string& out_path) {
   Polar(p);
   Linear(p);
   IsoCandela(p);
-  Planes(p, out_path);
+  Planes(p);
   NearField(p);
   Uncertainty(p);
   Colour(p);

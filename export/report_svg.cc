@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -137,10 +138,13 @@ std::string ContourPath(const std::vector<double>& v, int nx, int ny, double lev
   return os.str();
 }
 
-std::string PngDataUri(const Rgb8Image& image, const std::string& beside) {
+std::string PngDataUri(const Rgb8Image& image) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::absolute(beside).parent_path();
-  const std::string tmp = (dir / (".report_picture_" + std::to_string(getpid()) + ".png")).string();
+  static std::atomic<int> count{0};
+  const std::string tmp =
+      (fs::temp_directory_path() /
+       ("lumislab_report_" + std::to_string(getpid()) + "_" + std::to_string(count++) + ".png"))
+          .string();
   WriteRgb8File(tmp, image.width, image.height, image.rgb);
   const std::string bytes = ReadTextFile(tmp);
   fs::remove(tmp);

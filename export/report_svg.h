@@ -37,9 +37,9 @@ std::string ContourPath(const std::vector<double>& v, int nx, int ny, double lev
                         const std::function<std::pair<double, double>(double, double)>& page,
                         const std::vector<uint8_t>& valid = {});
 
-// "data:image/png;base64,..." of the picture (written through lib/photo's PNG writer into a
-// temporary file next to `beside`, read back and removed).
-std::string PngDataUri(const Rgb8Image& image, const std::string& beside);
+// "data:image/png;base64,..." of the picture (written through lib/photo's PNG writer, the one
+// PNG encoder, into a temporary file, read back and removed).
+std::string PngDataUri(const Rgb8Image& image);
 
 std::string HtmlEscape(const std::string& s);
 // A number with `digits` significant digits; "—" for NaN.

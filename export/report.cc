@@ -294,6 +294,9 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   d.values = ff.values;
   for (double& v : d.values) v = std::max(v, 0.0);  // the fit's ringing: no negative intensity
   d.photometric = r.info.units == "lux";
+  if (o.per_klm && !d.photometric)
+    LogWarning("--per-klm: the slab is in ", r.info.units,
+               " units, not lux: the diagrams stay in W/sr (cd/klm needs lm)");
   d.input_watts = o.input_watts;
   r.seen = ff.seen;
   r.summary = SummarisePhotometry(d, r.seen);

@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/log.h"
 #include "core/slab_light.h"
 #include "export/report_uncertainty.h"
 #include "lib/synthetic/truth.h"
@@ -262,6 +263,37 @@ TEST(ExportReportUncertainty, ScaleBracketsAndPlannerTerms) {
   EXPECT_EQ(keyword.rfind("flux +-", 0), 0u) << keyword;
   EXPECT_NE(keyword.find("(expanded, k=2; terms:"), std::string::npos) << keyword;
   EXPECT_EQ(keyword.back(), ')');
+  fs::remove_all(dir);
+}
+
+// A lux slab: cd and lm, efficacy from --input-watts, and --per-klm's cd/klm in the diagrams and
+// the candela table (cd x 1000 / lm).
+TEST(ExportReportLux, PhotometricUnitsEfficacyAndPerKlm) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lumislab_report_lux_" + std::to_string(getpid()));
+  SlabInfo info = DefaultSlabInfo(5, 5, 5, 24);
+  info.units = "lux";
+  WriteTruthSlab(DefaultScene().luminaire, info, (dir / "slab").string(), 2);
+  ReportOptions o;
+  o.slab = (dir / "slab").string();
+  o.out = (dir / "r.html").string();
+  o.plane_size = 21;
+  o.distances_mm = {750};
+  o.input_watts = 4;
+  o.per_klm = true;
+  const ReportData r = MakeReportData(o, 2);
+  EXPECT_EQ(r.IntensityUnit(), "cd/klm");
+  EXPECT_EQ(r.FluxUnit(), "lm");
+  EXPECT_EQ(r.IlluminanceUnit(), "lx");
+  EXPECT_NEAR(r.summary.efficacy, r.summary.total_flux / 4, 1e-12);
+  const std::string html = ReportHtml(r);
+  EXPECT_NE(html.find("lm/W at 4 W"), std::string::npos);
+  EXPECT_NE(html.find("Candela table (cd/klm)"), std::string::npos);
+  EXPECT_EQ(html.find("not photometric units"), std::string::npos);
+  // The candela table's gamma = 0, C = 0 cell: the far field's value per klm.
+  const double per_klm = r.summary.PerKlm(r.distribution.At(0, 0));
+  EXPECT_NE(html.find("<th>0&deg;</th><td>" + Num(per_klm, 4) + "</td>"), std::string::npos)
+      << Num(per_klm, 4);
   fs::remove_all(dir);
 }
 

@@ -403,13 +403,18 @@ void Uncertainty(Page& p) {
   const FarFieldUncertainty& u = p.r.uncertainty;
   auto& h = p.html;
   h << "<section><h2>Uncertainty</h2><table><tr><th class=l>term</th><th>relative standard "
-       "uncertainty</th><th class=l>basis</th></tr>\n";
+       "uncertainty</th><th class=l>for</th><th class=l>basis</th></tr>\n";
   for (const UncertaintyTerm& t : u.terms)
     h << "<tr><td class=l>" << HtmlEscape(t.name) << "</td><td>" << Num(100 * t.relative, 2)
-      << " %</td><td class=l>" << HtmlEscape(t.basis) << "</td></tr>\n";
+      << " %</td><td class=l>"
+      << (t.flux && t.peak ? "both"
+          : t.flux         ? "flux"
+                           : "peak")
+      << "</td><td class=l>" << HtmlEscape(t.basis) << "</td></tr>\n";
   h << "<tr><th class=l>expanded (k = " << Num(u.coverage_k, 2) << ")</th><th>flux "
     << Num(100 * u.FluxExpanded(), 2) << " %, peak " << Num(100 * u.PeakExpanded(), 2)
-    << " %</th><td class=l>root sum of squares &times; k</td></tr></table>\n<ul class=note>";
+    << " %</th><td></td><td class=l>root sum of squares &times; k</td></tr></table>\n"
+       "<ul class=note>";
   for (const std::string& n : u.notes) h << "<li>" << HtmlEscape(n) << "</li>";
   h << "<li>IES keyword: [_UNCERTAINTY] " << HtmlEscape(UncertaintyKeyword(u)) << "</li>";
   h << "</ul></section>\n";

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "core/basis.h"
 #include "core/json.h"
 #include "core/log.h"
 #include "plan/plan.h"
@@ -83,7 +84,14 @@ FarFieldUncertainty EstimateFarFieldUncertainty(const UncertaintyInput& in) {
                          std::to_string(s.nu) + " x " + std::to_string(s.nv) + ", K " +
                          std::to_string(s.k_max) + ", " + std::to_string(s.resolution) +
                          " texels, light " + Num(in.light_depth_mm, 4) + " mm behind S, D >> d";
-  u.terms.push_back({"model: parallax", e.parallax, at});
+  u.terms.push_back({"model: parallax (L2)", e.parallax, at, true, false});
+  const double bound = ParallaxFirstOrderBound(in.light_depth_mm, plan.distance_mm, kFarAway,
+                                               in.info.filter.Filter());
+  u.terms.push_back({"model: parallax in one direction", bound / std::sqrt(3.0),
+                     "core/basis.h ParallaxFirstOrderBound " + Percent(bound) +
+                         " (2 a sum|c_m|, a = z / (d + z)) as the half-width of a rectangular "
+                         "distribution",
+                     false, true});
   u.terms.push_back({"model: slab fit", e.slab, at});
   u.terms.push_back({"model: quadrature", e.quadrature, at});
   u.terms.push_back({"noise floor (photos, screen calibration, lookups)", e.floor, at});
@@ -96,11 +104,15 @@ FarFieldUncertainty EstimateFarFieldUncertainty(const UncertaintyInput& in) {
     u.notes.push_back("the light's depth behind S taken as 0 (no parallax term)");
   if (in.info.units == "relative")
     u.notes.push_back("relative units: the uncertainty is of the distribution's shape only");
-  double sum2 = 0;
-  for (const UncertaintyTerm& t : u.terms) sum2 += t.relative * t.relative;
-  // The planner's relative L2 of the plane's irradiance stands for both: the flux integrates
-  // it (a conservative bound), the peak is one of its values.
-  u.flux_relative = u.peak_relative = std::sqrt(sum2);
+  // The planner's relative L2 of the plane's irradiance stands for the flux (an integral of such
+  // values: conservative) and, but for the parallax, for the peak.
+  double flux2 = 0, peak2 = 0;
+  for (const UncertaintyTerm& t : u.terms) {
+    if (t.flux) flux2 += t.relative * t.relative;
+    if (t.peak) peak2 += t.relative * t.relative;
+  }
+  u.flux_relative = std::sqrt(flux2);
+  u.peak_relative = std::sqrt(peak2);
   return u;
 }
 
@@ -108,7 +120,12 @@ std::string UncertaintyKeyword(const FarFieldUncertainty& u) {
   std::string text = "flux +-" + Percent(u.FluxExpanded()) + ", peak intensity +-" +
                      Percent(u.PeakExpanded()) + " (expanded, k=" + Num(u.coverage_k, 2) +
                      "; terms:";
-  for (const UncertaintyTerm& t : u.terms) text += " " + t.name + " " + Percent(t.relative) + ",";
+  for (const UncertaintyTerm& t : u.terms)
+    text += " " + t.name +
+            (t.flux && t.peak ? ""
+             : t.flux         ? " (flux)"
+                              : " (peak)") +
+            " " + Percent(t.relative) + ",";
   text.back() = ')';
   return text;
 }

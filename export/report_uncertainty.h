@@ -15,6 +15,8 @@ struct UncertaintyTerm {
   std::string name;     // "planner: slab fit", "scale calibration: bracket agreement", ...
   double relative = 0;  // relative standard uncertainty (1 sigma)
   std::string basis;    // where the number comes from
+  bool flux = true;     // enters the flux's uncertainty
+  bool peak = true;     // enters the peak intensity's
 };
 
 struct FarFieldUncertainty {
@@ -37,7 +39,10 @@ struct UncertaintyInput {
 
 // The terms: the planner's model error (plan/plan.h PredictError) at the slab's h, grid, K and
 // resolution for a receiver far away (|1 - d/D| -> 1), its parallax, slab-fit, quadrature and
-// floor (photos, screen calibration, lookups: the noise floor) terms; the scale calibration's
+// floor (photos, screen calibration, lookups: the noise floor) terms, its parallax (a relative
+// L2) for the flux only: the peak is one direction, which can be off by up to the first-order
+// parallax bound (core/basis.h ParallaxFirstOrderBound), taken as a rectangular distribution of
+// that half-width (u = bound / sqrt 3); the scale calibration's
 // bracket agreement from <dataset>/calib/scale.json (the spread of the photos' values at the
 // reference point, standard error of each slide's mean, propagated through (Y+ - Y-)); the
 // meter's own uncertainty when given.

@@ -253,12 +253,14 @@ TEST(ExportReportUncertainty, ScaleBracketsAndPlannerTerms) {
   double scale = -1, sum2 = 0;
   for (const UncertaintyTerm& t : u.terms) {
     if (t.name.find("bracket") != std::string::npos) scale = t.relative;
-    sum2 += t.relative * t.relative;
+    if (t.flux) sum2 += t.relative * t.relative;
   }
   EXPECT_NEAR(scale, 0.2 / std::sqrt(3.0) / 8, 1e-9);
   EXPECT_NEAR(u.flux_relative, std::sqrt(sum2), 1e-12);
   EXPECT_NEAR(u.FluxExpanded(), 2 * u.flux_relative, 1e-12);
   EXPECT_GT(u.flux_relative, 0.02);
+  // The peak, one direction, takes the parallax bound (2 a sum|c_m| / sqrt 3), not its L2 share.
+  EXPECT_GT(u.peak_relative, u.flux_relative);
   const std::string keyword = UncertaintyKeyword(u);
   EXPECT_EQ(keyword.rfind("flux +-", 0), 0u) << keyword;
   EXPECT_NE(keyword.find("(expanded, k=2; terms:"), std::string::npos) << keyword;

@@ -387,16 +387,22 @@ void CandelaTable(Page& p) {
     << ")</h2><table class=candela><tr><th>&gamma; \\ C</th>";
   for (int ic : planes) h << "<th>" << Num(d.c_deg[ic], 4) << "&deg;</th>";
   h << "</tr>\n";
+  size_t last_seen = 0;  // rows past the last gamma any plane saw are left out
+  for (size_t k = 0; k < r.seen.size(); ++k)
+    if (r.seen[k]) last_seen = std::max(last_seen, k % ng);
   for (size_t ig = 0; ig < ng; ++ig) {
     const double g = d.gamma_deg[ig];
     if (std::abs(g / g_step - std::round(g / g_step)) > 1e-6) continue;
+    if (g > d.gamma_deg[last_seen] + g_step) break;
     h << "<tr><th>" << Num(g, 4) << "&deg;</th>";
     for (int ic : planes)
       h << "<td>" << (r.seen[size_t(ic) * ng + ig] ? Fmt(p.Scale(d.At(ic, ig)), 4) : "\u2014")
         << "</td>";
     h << "</tr>\n";
   }
-  h << "</table><p class=note>&mdash;: not seen by the capture.</p></section>\n";
+  h << "</table><p class=note>&mdash;: not seen by the capture; no direction was seen beyond "
+       "&gamma; = "
+    << Deg(d.gamma_deg[last_seen]) << ".</p></section>\n";
 }
 
 void Uncertainty(Page& p) {

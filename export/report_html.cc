@@ -107,6 +107,29 @@ void Summary(Page& p) {
   h << "</section>\n";
 }
 
+// Beam and field angles of every C-plane pair the grid stores, every 15 degrees (or the grid's
+// step when coarser).
+void SpreadTable(Page& p) {
+  const ReportData& r = p.r;
+  const IntensityDistribution& d = r.distribution;
+  const double step = std::max(15.0, d.c_deg[1] - d.c_deg[0]);
+  auto& h = p.html;
+  h << "<section><h2>Beam and field angles per C-plane pair</h2><table><tr><th "
+       "class=l>pair</th><th>peak ("
+    << r.IntensityUnit() << ")</th><th>beam (50 %)</th><th>field (10 %)</th><th>NEMA</th></tr>\n";
+  for (double c = 0; c < 180 - 1e-9; c += step) {
+    BeamSpread b;
+    if (!BeamSpreadOfPair(d, r.seen, c, &b)) continue;
+    const int nema = NemaBeamType(b.field_deg);
+    h << "<tr><td class=l>" << PairName(c) << "</td><td>" << Fmt(p.Scale(b.peak), 4) << "</td><td>"
+      << SpreadText(b.beam_deg, b.beam_at_least_deg) << "</td><td>"
+      << SpreadText(b.field_deg, b.field_at_least_deg) << "</td><td>"
+      << (nema > 0 ? std::to_string(nema) : "\u2014") << "</td></tr>\n";
+  }
+  h << "</table><p class=note>Edges: the first crossing of 50 % and 10 % of the pair's peak "
+       "going outwards from it, linear in &gamma; between grid angles.</p></section>\n";
+}
+
 void Zonal(Page& p) {
   const ReportData& r = p.r;
   auto& h = p.html;
@@ -470,6 +493,7 @@ std::string ReportHtml(const ReportData& data) {
   h << "<h1>" << HtmlEscape(data.title) << "</h1><p class=note>" << HtmlEscape(data.slab_dir)
     << " &middot; " << data.generated_utc << " &middot; " << HtmlEscape(data.software) << "</p>\n";
   Summary(p);
+  SpreadTable(p);
   Zonal(p);
   Polar(p);
   Linear(p);

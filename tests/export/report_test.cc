@@ -140,9 +140,10 @@ TEST_F(ExportReport, HtmlStatesCoverageAndIsSelfContained) {
   const std::string text = ReadTextFile(html);
   for (const char* needle :
        {"Flux in the measured cone", "Coverage", "Beam / field angle C0\u2013C180",
-        "NEMA beam type", "CIE flux code", "Zonal lumens", "Polar diagram", "Iso-candela",
-        "Illuminance on planes", "Near-field advantage", "Candela table", "Uncertainty",
-        "No colour calibration", "@page", "data:image/png;base64,", "+x (C0)", "W/sr"})
+        "NEMA beam type", "CIE flux code", "C15\u2013C195", "C165\u2013C345", "Zonal lumens",
+        "Polar diagram", "Iso-candela", "Illuminance on planes", "Near-field advantage",
+        "Candela table", "Uncertainty", "No colour calibration", "@page", "data:image/png;base64,",
+        "+x (C0)", "W/sr"})
     EXPECT_NE(text.find(needle), std::string::npos) << needle;
   // Efficacy needs lm: a W/m^2 slab says so instead of printing lm/W.
   EXPECT_NE(text.find("not photometric units"), std::string::npos);

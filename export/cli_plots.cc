@@ -11,15 +11,12 @@
 #include "core/exr_io.h"
 #include "core/log.h"
 #include "core/slab.h"
-#include "core/stop_signal.h"
 #include "export/complete_slab.h"
 #include "export/plane_irradiance.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
 #include "lib/lightfield/polar_plot.h"
-#include "lib/lightfield/reference_render.h"
-#include "lib/lightfield/scene_setup.h"
 #include "lib/photo/photo_write.h"
 
 namespace lumislab {

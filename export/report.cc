@@ -51,7 +51,7 @@ std::string SlabDirOf(const std::string& path) {
                  "/slab (--slab takes a dataset folder or its slab/)");
 }
 
-std::string NowUtc(const char* format) {
+std::string ReportNowUtc(const char* format) {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
   gmtime_r(&now, &tm);
@@ -274,7 +274,7 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   r.info = SlabInfo::Load(r.slab_dir);
   RequireCompleteSlab(r.info, r.slab_dir);
   r.per_klm = o.per_klm;
-  r.generated_utc = NowUtc("%Y-%m-%d %H:%M UTC");
+  r.generated_utc = ReportNowUtc("%Y-%m-%d %H:%M UTC");
   r.software = std::string("lumislab-export ") + LUMISLAB_VERSION;
   r.title = o.title.empty() ? "Photometric report" : o.title;
   CheckLog checks(r.dataset_dir, "export report");

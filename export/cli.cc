@@ -1,5 +1,5 @@
-// lumislab-export's command line: the subcommands come from cli_formats (info, ies, ldt, tm25)
-// and cli_plots (irradiance, polar).
+// lumislab-export's command line: the subcommands come from cli_formats (info, ies, ldt, tm25),
+// cli_plots (irradiance, polar) and report (the lab report).
 #include "export/cli.h"
 
 #include <CLI/CLI.hpp>
@@ -7,6 +7,7 @@
 #include "core/command_line.h"
 #include "export/cli_formats.h"
 #include "export/cli_plots.h"
+#include "export/report.h"
 
 namespace lumislab {
 
@@ -19,10 +20,13 @@ int RunExport(int argc, char** argv) {
   AddCommonOptions(&app, &common);
   const ParsedCommand formats = AddFormatCommands(app, &common);
   const ParsedCommand plots = AddPlotCommands(app, &common);
+  const ParsedCommand report = AddReportCommand(app, &common);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("export", common);
   if (const auto code = formats(threads)) return *code;
   if (const auto code = plots(threads)) return *code;
+  // report: the lab report (export/report.h).
+  if (const auto code = report(threads)) return *code;
   return 2;  // unreachable: CLI11 requires one subcommand
 }
 

@@ -11,14 +11,12 @@
 #include "core/exr_io.h"
 #include "core/log.h"
 #include "core/slab.h"
-#include "core/stop_signal.h"
 #include "export/complete_slab.h"
+#include "export/plane_irradiance.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
 #include "lib/lightfield/polar_plot.h"
-#include "lib/lightfield/reference_render.h"
-#include "lib/lightfield/scene_setup.h"
 #include "lib/photo/photo_write.h"
 
 namespace lumislab {
@@ -73,29 +71,20 @@ int RunIrradiance(IrradianceOptions o, int threads) {
     checks.Save();
     for (SlabPosition& p : positions) irradiance.push_back(std::move(p.irradiance));
   }
-  SceneRequest scene;
-  scene.name = "plane";
-  scene.receiver_plane_mm = o.distance_mm;
-  scene.extent_mm = o.extent_mm;
-  const SceneSetup setup = MakeSceneSetup(scene, info);
-  const ReferenceScene view(setup, o.size, o.size);
-  ReferenceOptions options;
-  options.samples = o.samples;
-  options.threads = threads;
-  options.visibility = false;  // the plane alone: nothing casts a shadow
-  const StopSignalScope stop_signals;
-  const ReferenceImage image = RenderReference(view, info, irradiance, options);
-  if (!image.complete) throw Failure("stopped by a signal; " + o.out + " not written");
+  const PlaneIrradiance plane = RenderPlaneIrradiance(info, irradiance, o.distance_mm, o.extent_mm,
+                                                      o.size, o.samples, threads);
+  if (!plane.complete) throw Failure("stopped by a signal; " + o.out + " not written");
+  const ImageF& irradiance_image = plane.irradiance;
   if (ext == ".exr") {
-    WriteExr(o.out, image.irradiance, {"R", "G", "B"});
+    WriteExr(o.out, irradiance_image, {"R", "G", "B"});
   } else {
     const Rgb8Image picture = FalseColourPicture(
-        image.irradiance, request, IrradianceUnitLabel(info.units), setup.extent / o.size,
-        "plane at " + FormatTick(setup.plane_z, 1) + " mm");
+        irradiance_image, request, IrradianceUnitLabel(info.units), plane.extent_mm / o.size,
+        "plane at " + FormatTick(plane.plane_z_mm, 1) + " mm");
     WriteRgb8File(o.out, picture.width, picture.height, picture.rgb);
   }
-  LogInfo("irradiance on the plane at ", setup.plane_z, " mm, ", setup.extent, " mm wide, ", o.size,
-          "x", o.size, " (", IrradianceUnitLabel(info.units), ") -> ", o.out);
+  LogInfo("irradiance on the plane at ", plane.plane_z_mm, " mm, ", plane.extent_mm, " mm wide, ",
+          o.size, "x", o.size, " (", IrradianceUnitLabel(info.units), ") -> ", o.out);
   return 0;
 }
 

@@ -35,6 +35,9 @@ packages=(
   # tests/export/independent_readers_test.cc: three.js's IESLoader runs under node; the
   # EULUMDAT and TM-25 layout readers (tests/export/readers/*.py) under python3
   nodejs python3
+  # lumislab-export report --pdf, and the report's browser check (tests/export/report_test.cc):
+  # headless Chromium prints the HTML to PDF and screenshots it
+  chromium
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -143,6 +143,16 @@ PolarPlot MakePolarPlot(const PolarPlotData& data, int size) {
   };
   curve(data.c180, data.c0, "C0\u2013C180", kC0, 0);
   curve(data.c270, data.c90, "C90\u2013C270", kC90, 6);
+  for (const PolarPlotData::Mark& m : data.marks) {
+    if (!std::isfinite(m.signed_gamma_deg) || std::abs(m.signed_gamma_deg) > gamma_max) continue;
+    const double a = m.signed_gamma_deg * M_PI / 180;
+    const double ex = std::sin(a), ey = std::cos(a);
+    const Rgb8 colour = m.c90_pair ? kC90 : kC0;
+    plot.lines.push_back({{cx, cy, cx + radius * ex, cy + radius * ey}, colour, 1, 3});
+    // Inside the rim, clear of the gamma labels outside it.
+    plot.texts.push_back({cx + (radius - 8) * ex + (ex < 0 ? -3 : 3), cy + (radius - 8) * ey,
+                          m.label, 10, ex < 0 ? 1 : -1, colour});
+  }
   if (!data.title.empty()) plot.texts.push_back({12, 12, data.title, 13, -1, kLabel});
   if (half) plot.height = std::ceil(cy + radius + 48);  // no empty upper half
   return plot;

@@ -19,6 +19,15 @@ struct PolarPlotData {
   std::vector<double> c0, c180, c90, c270;  // intensity at each gamma; empty: not drawn
   std::string unit = "cd";                  // cd or W/sr
   std::string title;
+  // Angles marked by a thin dashed radial line in the pair's colour with a label at its end (the
+  // report's beam and field edges): signed gamma, + on the C0 / C90 side (right), - on the
+  // C180 / C270 side (left).
+  struct Mark {
+    double signed_gamma_deg = 0;
+    bool c90_pair = false;  // the C90-C270 pair's colour, else C0-C180's
+    std::string label;
+  };
+  std::vector<Mark> marks;
   // Check(): BadInput unless gamma_deg is ascending in [0, 180] with >= 2 values, each curve
   // empty or of its length, at least one curve, values finite and >= 0 (negative noise is
   // clamped to 0 by the caller, not here).

@@ -165,6 +165,22 @@ double IntensityDistribution::Intensity(double c_in, double gamma) const {
   };
   const CSymmetry symmetry = Symmetry();
   if (symmetry == CSymmetry::kAxial) return along_gamma(0);
+  const double c = StoredC(c_in);
+  if (symmetry == CSymmetry::kNone && c > c_deg.back()) {  // periodic gap: last -> 360 (= 0)
+    const double f = (c - c_deg.back()) / (360 - c_deg.back());
+    const double a = along_gamma(c_deg.size() - 1), b = along_gamma(0);
+    return a + f * (b - a);
+  }
+  size_t ic;
+  double fc;
+  if (!Locate(c_deg, c, &ic, &fc)) return 0;
+  const double a = along_gamma(ic);
+  return fc > 0 ? a + fc * (along_gamma(ic + 1) - a) : a;
+}
+
+double IntensityDistribution::StoredC(double c_in) const {
+  const CSymmetry symmetry = Symmetry();
+  if (symmetry == CSymmetry::kAxial) return c_deg.front();
   double c = std::fmod(c_in, 360.0);
   if (c < 0) c += 360;
   switch (symmetry) {
@@ -182,16 +198,14 @@ double IntensityDistribution::Intensity(double c_in, double gamma) const {
     default:
       break;
   }
-  if (symmetry == CSymmetry::kNone && c > c_deg.back()) {  // periodic gap: last -> 360 (= 0)
-    const double f = (c - c_deg.back()) / (360 - c_deg.back());
-    const double a = along_gamma(c_deg.size() - 1), b = along_gamma(0);
-    return a + f * (b - a);
-  }
-  size_t ic;
-  double fc;
-  if (!Locate(c_deg, c, &ic, &fc)) return 0;
-  const double a = along_gamma(ic);
-  return fc > 0 ? a + fc * (along_gamma(ic + 1) - a) : a;
+  return c;
+}
+
+int IntensityDistribution::StoredPlane(double c_in) const {
+  const double c = StoredC(c_in);
+  for (size_t k = 0; k < c_deg.size(); ++k)
+    if (Near(c, c_deg[k]) || (Near(c, 0) && Near(c_deg[k], 360))) return int(k);
+  return -1;
 }
 
 double IntensityDistribution::FluxWithin(double gamma_max_deg) const {

@@ -52,6 +52,11 @@ struct IntensityDistribution {
   // Intensity towards (C, gamma) in degrees (any C; gamma in [0, 180]): the symmetry maps C into
   // the stored range, then bilinear in (C, gamma); 0 beyond the stored gamma range.
   double Intensity(double c_deg, double gamma_deg) const;
+  // C (degrees, any) mapped by the symmetry into the stored range (the periodic gap of kNone
+  // past the last plane left as is): the plane Intensity() reads.
+  double StoredC(double c_deg) const;
+  // The index of the stored plane that C maps to (StoredC within 1e-6 degrees), or -1.
+  int StoredPlane(double c_deg) const;
   // Total flux (lm or W): the zonal sum photometry tools use, I at each grid angle times the
   // solid angle of its cell; cell borders halfway between neighbouring angles, the first and
   // last gamma cells ending at the stored range, C cells spanning the symmetry's range scaled

@@ -1533,7 +1533,8 @@ std::vector<Case> SlabCases() {
   for (const std::string args :
        {"ies --slab ds --out x.ies --test T1 --lab L --manufacturer M", "ldt --slab ds --out x.ldt",
         "tm25 --slab ds --out x.ray", "polar --slab ds/slab --out x.svg",
-        "irradiance --slab ds/slab --distance-mm 1000 --out x.png"})
+        "irradiance --slab ds/slab --distance-mm 1000 --out x.png",
+        "report --slab ds --out x.html"})
     v.push_back(C("slab_negative_light_export_" + args.substr(0, args.find(' ')))
                     .Export(args)
                     .Do(negative_slab)
@@ -2244,6 +2245,22 @@ std::vector<Case> PhotometryCases() {
                   .Export("irradiance --slab ds/slab --distance-mm 1000 --out nodir/i.png")
                   .Exit(3)
                   .Names({"nodir/i.png", "cannot"}));
+  // report (docs/method.md §4.10): the same refusals, nothing written.
+  v.push_back(P("report", "out_txt", "", "r.txt").Names({"r.txt", "--out"}));
+  v.push_back(P("report", "pdf_txt", "--pdf r.txt", "r.html").Names({"r.txt", "--pdf"}));
+  v.push_back(P("report", "c_step_7", "--c-step 7", "r.html").Names({"--c-step", "divid"}));
+  v.push_back(P("report", "gamma_step_zero", "--gamma-step 0", "r.html").Names({"--gamma-step"}));
+  v.push_back(
+      P("report", "distances_zero", "--distances-mm 0", "r.html").Names({"--distances-mm"}));
+  v.push_back(
+      P("report", "input_watts_nan", "--input-watts nan", "r.html").Names({"--input-watts"}));
+  v.push_back(P("report", "slab_partial", "", "r.html")
+                  .Do(SetJson(kSlabJson, "/present", {{0, 0}}))
+                  .Names({kSlabJson, "present"}));
+  v.push_back(C("export_report_out_folder_missing")
+                  .Export("report --slab ds/slab --out nodir/r.html")
+                  .Exit(3)
+                  .Names({"nodir/r.html", "cannot"}));
   v.push_back(C("cli_export_unknown_subcommand").Export("pdf --slab ds").Names({"pdf"}));
   v.push_back(C("cli_export_unknown_option").Export("info x.ies --bogus").Names({"--bogus"}));
   v.push_back(C("cli_export_no_subcommand").Export("").Names({"subcommand"}));

@@ -1,0 +1,95 @@
+// lumislab-export report: the lab report a photometry lab hands its customer (docs/method.md
+// §4.11), from a slab: the summary numbers (lib/photometry/photometric_summary.h), zonal lumens,
+// polar, linear and iso-candela diagrams, the illuminance on planes at user distances, the
+// near-field advantage against the far field's inverse square, a candela table, the stated
+// uncertainty (export/report_uncertainty.h), colour (a hook: ReportColour) and the capture's
+// metadata. One self-contained HTML file (inline SVG and PNG, no network) printable on A4; a PDF
+// through headless Chromium.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/command_line.h"
+#include "core/image.h"
+#include "export/report_uncertainty.h"
+#include "lib/photometry/intensity_distribution.h"
+#include "lib/photometry/photometric_summary.h"
+
+namespace lumislab {
+
+struct ReportOptions {
+  std::string slab;  // dataset folder or its slab/
+  std::string out;   // .html
+  std::string pdf;   // "" or .pdf (headless Chromium)
+  double input_watts = 0;
+  std::vector<double> distances_mm;  // empty: d, 2d, 4d
+  double c_step = 5, gamma_step = 1;
+  int samples = 4;             // far field: N x N quadrature per position
+  int plane_size = 121;        // pixels per side of each plane picture (odd: a centre pixel)
+  int plane_samples = 2;       // the plane's reference render
+  bool per_klm = false;        // diagrams in cd/klm
+  double light_depth_mm = -1;  // -1: from truth/luminaire.json when there, else 0
+  double meter_uncertainty_percent = 0;
+  std::string title;
+  bool force = false;
+};
+
+// The illuminance on one plane: the slab's picture, and on the centre line (y = 0, along +x) the
+// slab's value against the far field's inverse square.
+struct ReportPlane {
+  double distance_mm = 0, extent_mm = 0;
+  std::vector<float> luminance;  // size x size, row 0 on top (+y up), W/m^2 or lx
+  int size = 0;
+  std::vector<double> profile_x_mm, profile_slab, profile_far;  // far: NaN where not seen
+  double centre_slab = 0, centre_far = 0;
+};
+
+// The colour section's content: filled by a hook (ReportColourHook) once lib/photometry/colour.h
+// is wired; absent says "no colour calibration".
+struct ReportColour {
+  bool present = false;
+  double x = 0, y = 0, cct_k = 0;
+  std::string source;             // the calibration file
+  std::vector<std::string> rows;  // further rows "label: value" (per direction), as given
+};
+// Given the dataset folder, the colour section (present = false when there is no
+// calib/colour.json). The default hook says no calibration; the lead sets one that calls
+// lib/photometry/colour.h.
+using ReportColourHook = std::function<ReportColour(const std::string& dataset_dir)>;
+void SetReportColourHook(ReportColourHook hook);
+
+struct ReportData {
+  std::string title, slab_dir, dataset_dir, generated_utc, software;
+  SlabInfo info;
+  IntensityDistribution distribution;  // C 0-360, gamma 0-90 (cd or W/sr)
+  std::vector<uint8_t> seen;           // per value of `distribution`
+  PhotometricSummary summary;
+  double seen_cone_deg = 0;  // every direction seen up to this gamma
+  double seen_fraction = 0;  // of the hemisphere's directions (solid angle) seen
+  double flux_in_cone = 0;   // flux within seen_cone_deg
+  FarFieldUncertainty uncertainty;
+  std::vector<ReportPlane> planes;
+  ReportColour colour;
+  // Metadata rows (label, value): setup, calibration RMS, dates, ...
+  std::vector<std::pair<std::string, std::string>> metadata;
+  bool per_klm = false;
+  std::string IntensityUnit() const;    // "cd", "cd/klm", "W/sr"
+  std::string FluxUnit() const;         // "lm" or "W"
+  std::string IlluminanceUnit() const;  // "lx" or "W/m²"
+};
+
+// Everything the report shows, from the slab (read on `threads` threads).
+ReportData MakeReportData(const ReportOptions& options, int threads);
+// The HTML document (export/report_html.cc).
+std::string ReportHtml(const ReportData& data);
+
+// Adds `report` to `app` (its options bound to `common`).
+using ParsedCommand = std::function<std::optional<int>(int threads)>;
+ParsedCommand AddReportCommand(CLI::App& app, CommonOptions* common);
+
+}  // namespace lumislab

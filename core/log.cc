@@ -1,5 +1,6 @@
 #include "core/log.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <mutex>
@@ -28,6 +29,12 @@ std::string Num(double v, int digits) {
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, "%.*g", digits, v);
   return buffer;
+}
+
+std::string Utf8Head(const std::string& text, size_t max_bytes) {
+  size_t n = std::min(text.size(), max_bytes);
+  while (n > 0 && n < text.size() && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
+  return text.substr(0, n);
 }
 
 void SetLogLevel(LogLevel level) { g_level = static_cast<int>(level); }

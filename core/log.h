@@ -25,6 +25,10 @@ void Append(std::ostringstream& os, const T& v, const Rest&... rest) {
 // A number for a message: %g with `digits` significant digits ("0.0123", "1.5e+04").
 std::string Num(double v, int digits = 4);
 
+// The longest head of `text` of at most `max_bytes` bytes that ends before a UTF-8 continuation
+// byte (10xxxxxx), so that a field cut to a width splits no character.
+std::string Utf8Head(const std::string& text, size_t max_bytes);
+
 template <typename... Args>
 void Log(LogLevel level, const Args&... args) {
   if (level < GetLogLevel()) return;

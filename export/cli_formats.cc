@@ -15,6 +15,7 @@
 #include "core/slab.h"
 #include "export/complete_slab.h"
 #include "export/coverage.h"
+#include "export/report_uncertainty.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
 #include "lib/photometry/eulumdat.h"
@@ -163,6 +164,7 @@ struct FarFieldCommand {
   double max_asymmetry_pct = 5;
   bool accredited = false, lumen_scaled = false;
   double input_watts = 0;
+  UncertaintyOptions uncertainty;
   Keywords keywords;
 };
 
@@ -391,6 +393,30 @@ IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& sla
                      "the full C range 0-360, or raise --max-asymmetry)");
     if (c.format == "ies") d.keywords.push_back({"_ASYMMETRY", text});
   }
+  // The stated uncertainty (export/report_uncertainty.h, as the report states it): IES as
+  // [_UNCERTAINTY]; EULUMDAT, without keywords, in the measurement report field (line 8) after
+  // the report number and coverage when the field's 78 bytes hold it.
+  const FarFieldUncertainty u =
+      EstimateFarFieldUncertainty(slab.info, DatasetOfSlab(slab.dir), c.samples, c.uncertainty);
+  LogInfo("uncertainty: ", UncertaintyKeyword(u));
+  if (c.format == "ies") {
+    d.keywords.push_back({"_UNCERTAINTY", UncertaintyKeyword(u)});
+  } else {
+    const std::string text = "U(k=2) flux " + Num(100 * u.FluxExpanded(), 2) + " %, peak " +
+                             Num(100 * u.PeakExpanded(), 2) + " %";
+    auto test = std::find_if(d.keywords.begin(), d.keywords.end(),
+                             [](const auto& k) { return k.first == "TEST"; });
+    if (test == d.keywords.end()) {
+      d.keywords.push_back({"TEST", text});
+    } else if (test->second.size() + 2 + text.size() <= 78) {
+      test->second += "; " + text;
+    } else {
+      LogWarning(c.out, ": the uncertainty (", text,
+                 ") does not fit the measurement report field after '", test->second,
+                 "' (78 bytes): the EULUMDAT file leaves it out (the IES file and the report "
+                 "carry it)");
+    }
+  }
   // Where the file comes from, without the folder's absolute path (a file is handed on).
   std::filesystem::path folder = std::filesystem::absolute(slab.dir).lexically_normal();
   if (folder.filename().empty()) folder = folder.parent_path();
@@ -495,6 +521,7 @@ CLI::App* AddFarFieldCommand(CLI::App& app, const std::string& format, FarFieldC
                   "the candela were scaled to another lumen rating (file generation type "
                   "1.xx1xx)");
   }
+  AddUncertaintyOptions(cmd, &c->uncertainty);
   AddKeywordOptions(cmd, &c->keywords);
   AddCommonOptions(cmd, common);
   return cmd;

@@ -25,6 +25,8 @@
 #include "export/plane_irradiance.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
+#include "lib/lightfield/light_colour.h"
+#include "lib/photometry/colour.h"
 #include "lib/synthetic/scene.h"
 
 #ifndef LUMISLAB_VERSION
@@ -37,18 +39,67 @@ namespace {
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kChromiumTimeoutS = 120;
 
-ReportColourHook& ColourHook() {
-  static ReportColourHook hook = [](const std::string&) { return ReportColour{}; };
-  return hook;
-}
-
-// A dataset folder or its slab/: the folder holding slab.json (as `ies`, `ldt` take it).
-std::string SlabDirOf(const std::string& path) {
-  namespace fs = std::filesystem;
-  if (fs::is_regular_file(path + "/slab.json")) return path;
-  if (fs::is_regular_file(path + "/slab/slab.json")) return path + "/slab";
-  throw BadInput(path + ": no slab.json there nor in " + path +
-                 "/slab (--slab takes a dataset folder or its slab/)");
+// The colour section: the chromaticity and CCT of the slab's total light and of the far field
+// per direction through the dataset's camera colour calibration (calib/colour.json,
+// lib/lightfield/light_colour.h); not present without one. Directions: C every 45 degrees, gamma
+// every 5 degrees within the measured cone, those whose luminance is at least 10 % of the peak's
+// (dimmer ones carry the dual filter's ringing in their chromaticity).
+ReportColour MakeReportColour(const ReportData& r, const std::vector<SlabPosition>& positions,
+                              int threads) {
+  ReportColour c;
+  const std::optional<ColourCalibration> calibration = ColourCalibration::LoadFor(r.dataset_dir);
+  if (!calibration) return c;
+  c.present = true;
+  c.source = std::filesystem::path(calibration->file).lexically_relative(r.dataset_dir).string();
+  const LightColour total = TotalLightColour(r.info, positions, *calibration);
+  c.x = total.xy.x();
+  c.y = total.xy.y();
+  c.cct_k = total.cct.kelvin;
+  c.rows.push_back("Duv (total light): " + Num(total.cct.duv, 3));
+  std::vector<double> cs, gammas;
+  for (double cd = 0; cd < 360; cd += 45) cs.push_back(cd);
+  for (double g = 0; g <= r.seen_cone_deg + 1e-9; g += 5) gammas.push_back(g);
+  FarFieldOptions options;
+  options.threads = threads;
+  const FarFieldColour ff =
+      ComputeFarFieldColour(r.info, positions, cs, gammas, *calibration, options);
+  double peak_y = 0;
+  for (size_t k = 0; k < ff.colour.size(); ++k)
+    if (ff.seen[k]) peak_y = std::max(peak_y, ff.colour[k].xyz.y());
+  double lo = kNan, hi = kNan;
+  std::string lo_at, hi_at;
+  int counted = 0;
+  for (size_t ic = 0; ic < cs.size(); ++ic)
+    for (size_t ig = 0; ig < gammas.size(); ++ig) {
+      const LightColour& lc = ff.colour[ic * gammas.size() + ig];
+      if (!ff.seen[ic * gammas.size() + ig] || !(lc.xyz.y() >= 0.1 * peak_y) ||
+          !std::isfinite(lc.cct.kelvin))
+        continue;
+      const std::string at = "C " + Num(cs[ic], 3) + ", gamma " + Num(gammas[ig], 3);
+      if (!(lc.cct.kelvin >= lo)) lo = lc.cct.kelvin, lo_at = at;
+      if (!(lc.cct.kelvin <= hi)) hi = lc.cct.kelvin, hi_at = at;
+      ++counted;
+    }
+  if (counted > 0)
+    c.rows.push_back("CCT over " + std::to_string(counted) +
+                     " directions (>= 10 % of the peak luminance, C every 45 deg, gamma every 5 "
+                     "deg within the measured cone): " +
+                     Num(lo, 4) + " K (" + lo_at + ") to " + Num(hi, 4) + " K (" + hi_at + ")");
+  for (double g : {0.0, 10.0, 20.0, 30.0}) {
+    if (g > r.seen_cone_deg) break;
+    const size_t ig = size_t(std::lround(g / 5));
+    std::string row = "gamma " + Num(g, 3) + " deg: ";
+    for (size_t ic = 0; ic < cs.size(); ic += 2) {
+      const LightColour& lc = ff.colour[ic * gammas.size() + ig];
+      row += (ic ? "; C " : "C ") + Num(cs[ic], 3) + " x, y " + Num(lc.xy.x(), 4) + ", " +
+             Num(lc.xy.y(), 4) + ", " +
+             (std::isfinite(lc.cct.kelvin) ? Num(lc.cct.kelvin, 4) + " K" : "no CCT");
+    }
+    c.rows.push_back(row);
+  }
+  LogInfo("report: colour of the total light x ", Num(c.x, 4), " y ", Num(c.y, 4), ", CCT ",
+          Num(c.cct_k, 4), " K (", c.source, ")");
+  return c;
 }
 
 std::string ReportNowUtc(const char* format) {
@@ -80,22 +131,6 @@ std::vector<double> Range(double step, double last) {
   const int n = int(std::lround(last / step));
   for (int k = 0; k <= n; ++k) v.push_back(k * step);
   return v;
-}
-
-// The light's intensity-weighted depth behind S from truth/luminaire.json (synthetic datasets),
-// as plan/plan.cc's PlanInputFromScene takes it; 0 without one.
-double LightDepthOf(const std::string& dataset_dir, std::string* source) {
-  const std::string path = dataset_dir + "/truth/luminaire.json";
-  if (dataset_dir.empty() || !std::filesystem::is_regular_file(path)) return 0;
-  const Luminaire luminaire = LoadLuminaire(path);
-  double wz = 0, w = 0;
-  for (const Emitter& e : luminaire.emitters) {
-    const double weight = e.intensity_w_sr.sum() / 3;
-    wz += weight * -e.position_mm.z();
-    w += weight;
-  }
-  *source = "truth/luminaire.json";
-  return w > 0 ? wz / w : 0;
 }
 
 // Metadata rows from slab.json and whichever calibration files the dataset has.
@@ -251,8 +286,6 @@ int RunReport(const ReportOptions& o, int threads) {
 
 }  // namespace
 
-void SetReportColourHook(ReportColourHook hook) { ColourHook() = std::move(hook); }
-
 std::string ReportData::IntensityUnit() const {
   if (!distribution.photometric) return "W/sr";
   return per_klm ? "cd/klm" : "cd";
@@ -269,7 +302,7 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
     throw InputError("--gamma-step", "", "a step in (0, 10] degrees dividing 90",
                      Num(o.gamma_step, 8));
   ReportData r;
-  r.slab_dir = SlabDirOf(o.slab);
+  r.slab_dir = ResolveSlabDir(o.slab);
   r.dataset_dir = DatasetOfSlab(r.slab_dir);
   r.info = SlabInfo::Load(r.slab_dir);
   RequireCompleteSlab(r.info, r.slab_dir);
@@ -306,19 +339,9 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   for (size_t k = 0; k < seen_sr.values.size(); ++k) seen_sr.values[k] = r.seen[k] ? 1 : 0;
   r.seen_fraction = seen_sr.TotalFlux() / (2 * kPi);
 
-  UncertaintyInput u;
-  u.info = r.info;
-  u.dataset_dir = r.dataset_dir;
-  u.far_field_samples = o.samples;
-  u.meter_relative = o.meter_uncertainty_percent / 100;
-  std::string depth_source = "--light-depth-mm";
-  u.light_depth_mm =
-      o.light_depth_mm >= 0 ? o.light_depth_mm : LightDepthOf(r.dataset_dir, &depth_source);
-  r.uncertainty = EstimateFarFieldUncertainty(u);
-  if (u.light_depth_mm > 0)
-    r.uncertainty.notes.push_back("the light's depth behind S, " + Num(u.light_depth_mm, 4) +
-                                  " mm, from " + depth_source);
+  r.uncertainty = EstimateFarFieldUncertainty(r.info, r.dataset_dir, o.samples, o.uncertainty);
 
+  r.colour = MakeReportColour(r, positions, threads);
   std::vector<ImageF> irradiance;
   for (SlabPosition& p : positions) irradiance.push_back(std::move(p.irradiance));
   positions.clear();
@@ -326,7 +349,6 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   if (distances.empty())
     distances = {r.info.distance_mm, 2 * r.info.distance_mm, 4 * r.info.distance_mm};
   for (double D : distances) r.planes.push_back(MakePlane(r, irradiance, D, o, threads));
-  r.colour = ColourHook()(r.dataset_dir);
   AddMetadata(&r);
   LogInfo("report: flux ", Num(r.summary.total_flux, 6), " ", r.FluxUnit(), ", seen to gamma ",
           Num(r.seen_cone_deg, 4), " deg (", Num(100 * r.seen_fraction, 3),
@@ -361,13 +383,7 @@ ParsedCommand AddReportCommand(CLI::App& app, CommonOptions* common) {
       ->check(CLI::Range(16, 1024))
       ->capture_default_str();
   cmd->add_flag("--per-klm", o->per_klm, "diagrams and candela table in cd/klm (lux slabs)");
-  cmd->add_option("--light-depth-mm", o->light_depth_mm,
-                  "the light's depth behind S for the uncertainty's model terms (default: "
-                  "truth/luminaire.json when there, else 0)")
-      ->check(FiniteIn(0, 1e5));
-  cmd->add_option("--meter-uncertainty", o->meter_uncertainty_percent,
-                  "the reference meter's relative standard uncertainty (%)")
-      ->check(FiniteIn(0, 100));
+  AddUncertaintyOptions(cmd, &o->uncertainty);
   cmd->add_option("--title", o->title, "the report's title");
   cmd->add_flag("--force", o->force, "rewrite the outputs if they exist");
   AddCommonOptions(cmd, common);

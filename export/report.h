@@ -2,7 +2,7 @@
 // §4.11), from a slab: the summary numbers (lib/photometry/photometric_summary.h), zonal lumens,
 // polar, linear and iso-candela diagrams, the illuminance on planes at user distances, the
 // near-field advantage against the far field's inverse square, a candela table, the stated
-// uncertainty (export/report_uncertainty.h), colour (a hook: ReportColour) and the capture's
+// uncertainty (export/report_uncertainty.h), colour (calib/colour.json) and the capture's
 // metadata. One self-contained HTML file (inline SVG and PNG, no network) printable on A4; a PDF
 // through headless Chromium.
 #pragma once
@@ -29,12 +29,11 @@ struct ReportOptions {
   double input_watts = 0;
   std::vector<double> distances_mm;  // empty: d, 2d, 4d
   double c_step = 5, gamma_step = 1;
-  int samples = 4;             // far field: N x N quadrature per position
-  int plane_size = 121;        // pixels per side of each plane picture (odd: a centre pixel)
-  int plane_samples = 2;       // the plane's reference render
-  bool per_klm = false;        // diagrams in cd/klm
-  double light_depth_mm = -1;  // -1: from truth/luminaire.json when there, else 0
-  double meter_uncertainty_percent = 0;
+  int samples = 4;        // far field: N x N quadrature per position
+  int plane_size = 121;   // pixels per side of each plane picture (odd: a centre pixel)
+  int plane_samples = 2;  // the plane's reference render
+  bool per_klm = false;   // diagrams in cd/klm
+  UncertaintyOptions uncertainty;
   std::string title;
   bool force = false;
 };
@@ -49,19 +48,14 @@ struct ReportPlane {
   double centre_slab = 0, centre_far = 0;
 };
 
-// The colour section's content: filled by a hook (ReportColourHook) once lib/photometry/colour.h
-// is wired; absent says "no colour calibration".
+// The colour section's content (calib/colour.json through lib/lightfield/light_colour.h);
+// present = false when the dataset has no colour calibration.
 struct ReportColour {
   bool present = false;
-  double x = 0, y = 0, cct_k = 0;
-  std::string source;             // the calibration file
-  std::vector<std::string> rows;  // further rows "label: value" (per direction), as given
+  double x = 0, y = 0, cct_k = 0;  // the total light's chromaticity and CCT
+  std::string source;              // the calibration file, relative to the dataset
+  std::vector<std::string> rows;   // Duv, the CCT's range over directions, per-direction values
 };
-// Given the dataset folder, the colour section (present = false when there is no
-// calib/colour.json). The default hook says no calibration; the lead sets one that calls
-// lib/photometry/colour.h.
-using ReportColourHook = std::function<ReportColour(const std::string& dataset_dir)>;
-void SetReportColourHook(ReportColourHook hook);
 
 struct ReportData {
   std::string title, slab_dir, dataset_dir, generated_utc, software;

@@ -479,7 +479,8 @@ void Metadata(Page& p) {
     << Num(p.r.distribution.c_deg[1] - p.r.distribution.c_deg[0], 4)
     << "&deg;, &gamma; 0&ndash;90&deg; by "
     << Num(p.r.distribution.gamma_deg[1] - p.r.distribution.gamma_deg[0], 4)
-    << "&deg;; &gamma; = 0 along +z (towards the screen), C = 0 towards +x</td></tr>\n";
+    << "&deg;; &gamma; = 0 along +z (towards the screen), C = 0 towards +x, C = 90 towards "
+       "&minus;y (LM-63: counter-clockwise looking along &gamma; = 0)</td></tr>\n";
   h << "</table></section>\n";
 }
 

@@ -4,8 +4,10 @@
 #include <filesystem>
 
 #include "core/basis.h"
+#include "core/command_line.h"
 #include "core/json.h"
 #include "core/log.h"
+#include "lib/synthetic/scene.h"
 #include "plan/plan.h"
 
 namespace lumislab {
@@ -113,6 +115,47 @@ FarFieldUncertainty EstimateFarFieldUncertainty(const UncertaintyInput& in) {
   }
   u.flux_relative = std::sqrt(flux2);
   u.peak_relative = std::sqrt(peak2);
+  return u;
+}
+
+void AddUncertaintyOptions(CLI::App* cmd, UncertaintyOptions* options) {
+  cmd->add_option("--light-depth-mm", options->light_depth_mm,
+                  "the light's depth behind S for the uncertainty's model terms (default: "
+                  "truth/luminaire.json when there, else 0)")
+      ->check(FiniteIn(0, 1e5));
+  cmd->add_option("--meter-uncertainty", options->meter_uncertainty_percent,
+                  "the reference meter's relative standard uncertainty (%)")
+      ->check(FiniteIn(0, 100));
+}
+
+FarFieldUncertainty EstimateFarFieldUncertainty(const SlabInfo& info,
+                                                const std::string& dataset_dir, int samples,
+                                                const UncertaintyOptions& options) {
+  UncertaintyInput in;
+  in.info = info;
+  in.dataset_dir = dataset_dir;
+  in.far_field_samples = samples;
+  in.meter_relative = options.meter_uncertainty_percent / 100;
+  std::string source = "--light-depth-mm";
+  in.light_depth_mm = options.light_depth_mm;
+  const std::string truth = dataset_dir + "/truth/luminaire.json";
+  if (in.light_depth_mm < 0) {
+    in.light_depth_mm = 0;
+    if (!dataset_dir.empty() && std::filesystem::is_regular_file(truth)) {
+      double wz = 0, w = 0;
+      for (const Emitter& e : LoadLuminaire(truth).emitters) {
+        const double weight = e.intensity_w_sr.sum() / 3;
+        wz += weight * -e.position_mm.z();
+        w += weight;
+      }
+      in.light_depth_mm = w > 0 ? wz / w : 0;
+      source = "truth/luminaire.json";
+    }
+  }
+  FarFieldUncertainty u = EstimateFarFieldUncertainty(in);
+  if (in.light_depth_mm > 0)
+    u.notes.push_back("the light's depth behind S, " + Num(in.light_depth_mm, 4) + " mm, from " +
+                      source);
   return u;
 }
 

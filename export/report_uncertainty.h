@@ -4,6 +4,7 @@
 // keyword (UncertaintyKeyword).
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,21 @@ struct UncertaintyInput {
 // reference point, standard error of each slide's mean, propagated through (Y+ - Y-)); the
 // meter's own uncertainty when given.
 FarFieldUncertainty EstimateFarFieldUncertainty(const UncertaintyInput& in);
+
+// What a lab gives for the uncertainty (report, ies, ldt: AddUncertaintyOptions).
+struct UncertaintyOptions {
+  double light_depth_mm = -1;  // -1: from truth/luminaire.json when there, else 0
+  double meter_uncertainty_percent = 0;
+};
+void AddUncertaintyOptions(CLI::App* cmd, UncertaintyOptions* options);
+
+// EstimateFarFieldUncertainty for a slab of `dataset_dir` ("" when in none) whose far field is
+// computed with `samples` x `samples` points: the light's depth from the options, else the
+// intensity-weighted depth of a synthetic dataset's truth/luminaire.json (as plan/plan.cc's
+// PlanInputFromScene takes it), else 0; a note says which.
+FarFieldUncertainty EstimateFarFieldUncertainty(const SlabInfo& info,
+                                                const std::string& dataset_dir, int samples,
+                                                const UncertaintyOptions& options);
 
 // The `[_UNCERTAINTY]` keyword's text: "flux +-U % (k=2), peak intensity +-U % (k=2); <terms>".
 std::string UncertaintyKeyword(const FarFieldUncertainty& u);

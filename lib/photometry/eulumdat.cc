@@ -344,9 +344,10 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
   std::vector<double> full = symmetry == CSymmetry::kAxial ? planes : FullCircle(planes, symmetry);
   std::vector<double> stored = planes;
   if (symmetry == CSymmetry::kNone && std::abs(stored.back() - 360) < 1e-6) stored.pop_back();
-  // A text field: its first line, at most 78 characters (the format's field width).
+  // A text field: its first line, at most 78 bytes (the format's field width), no UTF-8
+  // character split.
   auto field = [](const std::string& s) {
-    return s.substr(0, std::min(s.find_first_of("\r\n"), size_t(78)));
+    return Utf8Head(s.substr(0, s.find_first_of("\r\n")), 78);
   };
   auto keyword_or = [&](const char* key, const std::string& fallback) {
     const std::string v = field(d.Keyword(key));

@@ -120,10 +120,8 @@ std::string FormatPhotometricFileInfo(const nlohmann::json& j, bool json) {
     for (const auto& [key, value] : j["keywords"].items()) {
       std::string text = value.get<std::string>();
       std::replace(text.begin(), text.end(), '\n', ' ');
-      // At most 90 bytes, cut before a UTF-8 continuation byte (no character split).
-      size_t n = std::min<size_t>(text.size(), 90);
-      while (n > 0 && n < text.size() && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
-      os << "[" << key << "] " << text.substr(0, n) << (n < text.size() ? "..." : "") << "\n";
+      const std::string head = Utf8Head(text, 90);  // no character split
+      os << "[" << key << "] " << head << (head.size() < text.size() ? "..." : "") << "\n";
     }
   }
   if (j.contains("coverage")) os << "coverage: " << j["coverage"].get<std::string>() << "\n";

@@ -98,6 +98,12 @@ TEST(PhotometricTruth, PartialCoverageIsRefusedOrStated) {
   const std::string coverage = OneLine(d.Keyword("_COVERAGE"));
   EXPECT_EQ(coverage.rfind("partial: gamma 0-37.5 deg seen in every C plane", 0), 0u) << coverage;
   EXPECT_NE(coverage.find("the analytic luminaire puts 22."), std::string::npos) << coverage;
+  // The stated uncertainty, as the report states it (export/report_uncertainty.h), with the
+  // synthetic light's depth from truth/luminaire.json (a parallax term for flux and peak).
+  const std::string uncertainty = OneLine(d.Keyword("_UNCERTAINTY"));
+  EXPECT_EQ(uncertainty.rfind("flux +-", 0), 0u) << uncertainty;
+  EXPECT_NE(uncertainty.find("(expanded, k=2; terms: model: parallax"), std::string::npos)
+      << uncertainty;
   // The stated share is the file's: 1 - file flux / truth flux (lm = K x W).
   const double k = DefaultScene().LuminousEfficacy();
   const size_t at = r.output.find("the analytic luminaire emits ");

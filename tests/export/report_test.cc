@@ -15,12 +15,15 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calibrate/colour/colour_calibrator.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/log.h"
 #include "core/slab_light.h"
 #include "export/report_uncertainty.h"
+#include "lib/photo/photo_write.h"
+#include "lib/synthetic/spectral.h"
 #include "lib/synthetic/truth.h"
 
 namespace lumislab {
@@ -297,6 +300,60 @@ TEST(ExportReportLux, PhotometricUnitsEfficacyAndPerKlm) {
   const double per_klm = r.summary.PerKlm(r.distribution.At(0, 0));
   EXPECT_NE(html.find("<th>0&deg;</th><td>" + Num(per_klm, 4) + "</td>"), std::string::npos)
       << Num(per_klm, 4);
+  fs::remove_all(dir);
+}
+
+// Colour: a luminaire of blackbody-like emitters (scene field cct_k) whose dataset has a colour
+// calibration fitted to the synthetic ColorChecker photo (lumislab-calibrate colour's fit): the
+// report's CCT of the total light is the emitters' temperature within 50 K (issue 29), and a
+// second, cooler and wider lobe makes the CCT rise away from the axis.
+TEST(ExportReportColour, CctOfTheTotalLightAndPerDirection) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lumislab_report_colour_" + std::to_string(getpid()));
+  fs::create_directories(dir / "ds/calib");
+  const std::string chart = (dir / "chart.exr").string();
+  WritePhoto(chart, RenderColourChartPhoto({}), PhotoEncoding::kFloatExr);
+  const Photo photo = DecodePhoto(chart);
+  const ChartPatches patches =
+      FindColourChart(photo, ChartReferenceXyz("D65"), ReferenceWhite("D65"));
+  nlohmann::json fit_report;
+  CheckLog checks("", "test");
+  const ColourCalibration calibration =
+      CalibrateColour(patches, {}, photo.path, &fit_report, &checks);
+  SaveColourCalibration((dir / "ds/calib/colour.json").string(), calibration, fit_report);
+  // A dataset folder (the report finds calib/ through dataset.json beside slab/); its content is
+  // not read.
+  WriteTextAtomically((dir / "ds/dataset.json").string(), "{}");
+  const SlabInfo info = DefaultSlabInfo(7, 7, 5, 32);
+  for (const bool two_lobes : {false, true}) {
+    const std::string file = (dir / "luminaire.json").string();
+    WriteTextAtomically(file,
+                        std::string(R"({"schema_version": 1, "luminaire": {"emitters": [
+        {"position_mm": [0.5, -1, -2], "intensity_w_sr": 1.3, "cct_k": 3000, "lobe_exponent": 8})") +
+                            (two_lobes ? R"(, {"position_mm": [-1, 0.5, -1], "intensity_w_sr": 0.8,
+                    "cct_k": 6500, "lobe_exponent": 2})"
+                                       : "") +
+                            "]}}");
+    WriteTruthSlab(LoadLuminaire(file), info, (dir / "ds/slab").string(), 2);
+    ReportOptions o;
+    o.slab = (dir / "ds").string();
+    o.out = (dir / "r.html").string();
+    o.plane_size = 21;
+    o.distances_mm = {750};
+    const ReportData r = MakeReportData(o, 2);
+    ASSERT_TRUE(r.colour.present);
+    std::printf("%s: total light x %.4f y %.4f, CCT %.1f K\n",
+                two_lobes ? "3000 K + 6500 K" : "3000 K", r.colour.x, r.colour.y, r.colour.cct_k);
+    if (!two_lobes) {
+      EXPECT_NEAR(r.colour.cct_k, 3000, 50);
+    } else {
+      EXPECT_GT(r.colour.cct_k, 3100);  // the cooler lobe's share
+      EXPECT_LT(r.colour.cct_k, 6400);
+      const std::string html = ReportHtml(r);
+      EXPECT_NE(html.find("CCT over "), std::string::npos);
+      EXPECT_EQ(html.find("No colour calibration"), std::string::npos);
+    }
+  }
   fs::remove_all(dir);
 }
 

@@ -43,7 +43,8 @@ constexpr double kChromiumTimeoutS = 120;
 // per direction through the dataset's camera colour calibration (calib/colour.json,
 // lib/lightfield/light_colour.h); not present without one. Directions: C every 45 degrees, gamma
 // every 5 degrees within the measured cone, those whose luminance is at least 10 % of the peak's
-// (dimmer ones carry the dual filter's ringing in their chromaticity).
+// (dimmer ones carry the dual filter's ringing in their chromaticity); the table: gamma 0, 10, 20,
+// 30 degrees within the measured cone in C 0, 90, 180, 270.
 ReportColour MakeReportColour(const ReportData& r, const std::vector<SlabPosition>& positions,
                               int threads) {
   ReportColour c;
@@ -56,6 +57,9 @@ ReportColour MakeReportColour(const ReportData& r, const std::vector<SlabPositio
   c.y = total.xy.y();
   c.cct_k = total.cct.kelvin;
   c.rows.push_back("Duv (total light): " + Num(total.cct.duv, 3));
+  c.rows.push_back("camera RGB -> CIE XYZ: " + calibration->chart + " under " +
+                   calibration->illuminant + ", fit Delta E*ab mean " +
+                   Num(calibration->mean_delta_e, 3) + ", max " + Num(calibration->max_delta_e, 3));
   std::vector<double> cs, gammas;
   for (double cd = 0; cd < 360; cd += 45) cs.push_back(cd);
   for (double g = 0; g <= r.seen_cone_deg + 1e-9; g += 5) gammas.push_back(g);
@@ -87,15 +91,15 @@ ReportColour MakeReportColour(const ReportData& r, const std::vector<SlabPositio
                      Num(lo, 4) + " K (" + lo_at + ") to " + Num(hi, 4) + " K (" + hi_at + ")");
   for (double g : {0.0, 10.0, 20.0, 30.0}) {
     if (g > r.seen_cone_deg) break;
+    c.table_gamma.push_back(g);
     const size_t ig = size_t(std::lround(g / 5));
-    std::string row = "gamma " + Num(g, 3) + " deg: ";
     for (size_t ic = 0; ic < cs.size(); ic += 2) {
-      const LightColour& lc = ff.colour[ic * gammas.size() + ig];
-      row += (ic ? "; C " : "C ") + Num(cs[ic], 3) + " x, y " + Num(lc.xy.x(), 4) + ", " +
-             Num(lc.xy.y(), 4) + ", " +
-             (std::isfinite(lc.cct.kelvin) ? Num(lc.cct.kelvin, 4) + " K" : "no CCT");
+      if (c.table_gamma.size() == 1) c.table_c.push_back(cs[ic]);
+      const size_t k = ic * gammas.size() + ig;
+      const LightColour& lc = ff.colour[k];
+      c.cells.push_back(ff.seen[k] ? ReportColour::Cell{lc.xy.x(), lc.xy.y(), lc.cct.kelvin}
+                                   : ReportColour::Cell{kNan, kNan, kNan});
     }
-    c.rows.push_back(row);
   }
   LogInfo("report: colour of the total light x ", Num(c.x, 4), " y ", Num(c.y, 4), ", CCT ",
           Num(c.cct_k, 4), " K (", c.source, ")");

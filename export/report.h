@@ -54,7 +54,14 @@ struct ReportColour {
   bool present = false;
   double x = 0, y = 0, cct_k = 0;  // the total light's chromaticity and CCT
   std::string source;              // the calibration file, relative to the dataset
-  std::vector<std::string> rows;   // Duv, the CCT's range over directions, per-direction values
+  std::vector<std::string> rows;   // Duv, the CCT's range over directions
+  // Per direction: x, y and CCT (NaN where not seen or without a chromaticity) at
+  // table_gamma x table_c, cells[ig * table_c.size() + ic].
+  std::vector<double> table_c, table_gamma;
+  struct Cell {
+    double x = 0, y = 0, cct_k = 0;
+  };
+  std::vector<Cell> cells;
 };
 
 struct ReportData {

@@ -464,7 +464,27 @@ void Colour(Page& p) {
     << " K</td></tr>\n";
   for (const std::string& row : c.rows)
     h << "<tr><td class=l colspan=2>" << HtmlEscape(row) << "</td></tr>\n";
-  h << "</table><p class=note>From " << HtmlEscape(c.source) << ".</p></section>\n";
+  h << "</table>\n";
+  if (!c.cells.empty()) {
+    h << "<table><tr><th>&gamma; \\ C</th>";
+    for (double cd : c.table_c) h << "<th>" << Num(cd, 4) << "&deg;</th>";
+    h << "</tr>\n";
+    for (size_t ig = 0; ig < c.table_gamma.size(); ++ig) {
+      h << "<tr><th>" << Num(c.table_gamma[ig], 4) << "&deg;</th>";
+      for (size_t ic = 0; ic < c.table_c.size(); ++ic) {
+        const ReportColour::Cell& cell = c.cells[ig * c.table_c.size() + ic];
+        if (std::isfinite(cell.cct_k))
+          h << "<td>" << Fmt(cell.cct_k, 4) << " K<br><small>" << Fmt(cell.x, 4) << ", "
+            << Fmt(cell.y, 4) << "</small></td>";
+        else
+          h << "<td>&mdash;</td>";
+      }
+      h << "</tr>\n";
+    }
+    h << "</table><p class=note>CCT and chromaticity x, y per direction (&mdash;: not seen or "
+         "no chromaticity).</p>\n";
+  }
+  h << "<p class=note>From " << HtmlEscape(c.source) << ".</p></section>\n";
 }
 
 void Metadata(Page& p) {

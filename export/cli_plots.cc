@@ -90,8 +90,8 @@ int RunIrradiance(IrradianceOptions o, int threads) {
     WriteExr(o.out, image.irradiance, {"R", "G", "B"});
   } else {
     const Rgb8Image picture = FalseColourPicture(
-        image.irradiance, request, IrradianceUnitLabel(info.units), setup.extent / o.size,
-        "plane at " + FormatTick(setup.plane_z, 1) + " mm");
+        image.irradiance, info.channel_weights, request, IrradianceUnitLabel(info.units),
+        setup.extent / o.size, "plane at " + FormatTick(setup.plane_z, 1) + " mm");
     WriteRgb8File(o.out, picture.width, picture.height, picture.rgb);
   }
   LogInfo("irradiance on the plane at ", setup.plane_z, " mm, ", setup.extent, " mm wide, ", o.size,

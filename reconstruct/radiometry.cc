@@ -23,11 +23,15 @@ ReconstructRadiometry LoadReconstructRadiometry(const Dataset& dataset) {
     r.scale = s.scale;
     r.units = s.units;
     r.scale_source = scale_file;
+    r.channel_weights = s.channel_weights;
+    r.channel_weights_from_colour = s.from_colour;
     LogInfo("scale: ", s.scale, " ", s.units, " per unit from ", scale_file,
             dataset.radiometric_scale
                 ? " (dataset.json radiometry.scale_w_m2 " +
                       std::to_string(*dataset.radiometric_scale) + " not used)"
-                : std::string());
+                : std::string(),
+            "; luminance weights ", s.channel_weights.x(), " ", s.channel_weights.y(), " ",
+            s.channel_weights.z(), s.from_colour ? " (colour calibration)" : " (Rec. 709)");
   } else if (dataset.radiometric_scale) {
     r.scale = dataset.radiometric_scale;
     r.units = "W/m^2";

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "core/log.h"
+#include "lib/photometry/colour.h"
 
 namespace lumislab {
 
@@ -32,6 +33,13 @@ ReconstructRadiometry LoadReconstructRadiometry(const Dataset& dataset) {
                 : std::string(),
             "; luminance weights ", s.channel_weights.x(), " ", s.channel_weights.y(), " ",
             s.channel_weights.z(), s.from_colour ? " (colour calibration)" : " (Rec. 709)");
+    // A colour calibration made after the scale: the reading was matched to other weights.
+    if (const auto colour = ColourCalibration::LoadFor(dataset.dir))
+      if ((colour->LuminanceWeights() - s.channel_weights).norm() > 1e-9)
+        LogWarning(scale_file, ": channel_weights ", s.from_colour ? "differ from" : "are not",
+                   " the luminance weights of ", colour->file,
+                   " (calibrated after the scale?): the slab keeps the scale's; run "
+                   "lumislab-calibrate scale --force, then reconstruct --force");
   } else if (dataset.radiometric_scale) {
     r.scale = dataset.radiometric_scale;
     r.units = "W/m^2";

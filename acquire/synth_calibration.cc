@@ -10,6 +10,7 @@
 #include "core/json.h"
 #include "core/log.h"
 #include "core/parallel.h"
+#include "core/slab.h"  // Rec709Weights
 #include "lib/synthetic/calibration_captures.h"
 #include "lib/synthetic/camera_views.h"
 #include "lib/synthetic/spectral.h"
@@ -60,8 +61,44 @@ ImageF ColourChartRender(const SynthScene& scene) {
 }
 
 nlohmann::json Rgb(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-double Luminance(const Eigen::Vector3d& v) {
-  return 0.2126 * v.x() + 0.7152 * v.y() + 0.0722 * v.z();  // Rec. 709, as LinearGray
+
+// What the truth meter reads at the reference point with slide T+ / T- in (ambient light
+// included): a lux meter 683 integral of V E_lambda, a radiometer the Rec. 709 mix of the RGB
+// irradiance. With a spectrum on every emitter (cct_k) the lux reading is exact: an emitter's
+// camera RGB is its radiant irradiance (380 - 780 nm) times its RGB per watt (BlackbodyRgbPerWatt),
+// so each emitter, rendered alone, gives its W/m^2, times its LuminousEfficacy; the ambient light
+// is an equal-energy spectrum (camera RGB = its W/m^2 in every channel, DefaultLuminousEfficacy).
+// Without, lux = K x the Rec. 709 mix (SynthScene::LuminousEfficacy, the synthetic convention).
+struct Readings {
+  double plus = 0, minus = 0;
+  Eigen::Vector3d rgb_plus = Eigen::Vector3d::Zero(), rgb_minus = Eigen::Vector3d::Zero();
+};
+Readings MeterReadings(const SynthScene& scene, double radiometric_scale, bool lux) {
+  Readings r;
+  ReferenceIrradiance(scene, radiometric_scale, &r.rgb_plus, &r.rgb_minus);
+  bool spectral = !scene.luminaire.emitters.empty() && scene.luminaire.ray_sources.empty();
+  for (const Emitter& e : scene.luminaire.emitters) spectral = spectral && e.cct_k > 0;
+  if (!lux || !spectral) {
+    const double k = lux ? scene.LuminousEfficacy() : 1.0;  // lux = K x W/m^2
+    r.plus = k * Rec709Weights().dot(r.rgb_plus);
+    r.minus = k * Rec709Weights().dot(r.rgb_minus);
+    return r;
+  }
+  SynthScene alone = scene;
+  alone.luminaire.emitters.clear();
+  Eigen::Vector3d ambient_p, ambient_n;  // the same on both: the ambient light alone
+  ReferenceIrradiance(alone, radiometric_scale, &ambient_p, &ambient_n);
+  r.plus = DefaultLuminousEfficacy() * ambient_p.x();
+  r.minus = DefaultLuminousEfficacy() * ambient_n.x();
+  for (const Emitter& e : scene.luminaire.emitters) {
+    alone.luminaire.emitters = {e};
+    Eigen::Vector3d p, n;
+    ReferenceIrradiance(alone, radiometric_scale, &p, &n);
+    const double rgb_per_watt = e.intensity_w_sr.sum() / e.radiant_w_sr;
+    r.plus += e.LuminousEfficacy() * (p - ambient_p).sum() / rgb_per_watt;
+    r.minus += e.LuminousEfficacy() * (n - ambient_n).sum() / rgb_per_watt;
+  }
+  return r;
 }
 
 void WriteTruth(const SynthScene& scene, const Dataset& dataset, const std::string& dir) {
@@ -91,30 +128,29 @@ void WriteReferenceReading(const SynthScene& scene, const Dataset& dataset, cons
         at.reference_i = i;
         at.reference_j = j;
         read.captures = at;
-        Eigen::Vector3d plus, minus;
-        ReferenceIrradiance(read, *dataset.radiometric_scale, &plus, &minus);
-        const double signal = Luminance(plus) - Luminance(minus);
+        const Readings r = MeterReadings(read, *dataset.radiometric_scale, lux);
+        const double signal = r.plus - r.minus;
         if (signal > best) best = signal, c = at;
       }
     read.captures = c;
   }
   const CalibrationCaptures& c = *read.captures;
-  Eigen::Vector3d plus, minus;
-  ReferenceIrradiance(read, *dataset.radiometric_scale, &plus, &minus);
-  const double k = lux ? scene.LuminousEfficacy() : 1.0;  // lux = K x W/m^2
+  const Readings r = MeterReadings(read, *dataset.radiometric_scale, lux);
+  const double k = lux ? scene.LuminousEfficacy() : 1.0;  // truth lm = K x W
   nlohmann::json j;
   j["schema_version"] = 1;
   j["position"] = {c.reference_i, c.reference_j};
   j["point_mm"] = {c.point_mm.x(), c.point_mm.y()};
   j["unit"] = lux ? "lux" : "W/m2";
-  j["reading_p"] = k * Luminance(plus);
-  j["reading_n"] = k * Luminance(minus);
-  j["irradiance_p_w_m2"] = Rgb(plus);
-  j["irradiance_n_w_m2"] = Rgb(minus);
+  j["reading_p"] = r.plus;
+  j["reading_n"] = r.minus;
+  j["irradiance_p_w_m2"] = Rgb(r.rgb_plus);
+  j["irradiance_n_w_m2"] = Rgb(r.rgb_minus);
   if (lux) j["luminous_efficacy_lm_w"] = k;
-  j["note"] = std::string(lux ? "lux meter readings (K x the Rec. 709 luminance of the RGB "
-                                "irradiance, K = luminous_efficacy_lm_w)"
-                              : "radiometer readings (Rec. 709 luminance of the RGB irradiance)") +
+  j["note"] = std::string(lux ? "lux meter readings (683 x the integral of V E_lambda for "
+                                "emitters with a spectrum, cct_k; otherwise K x the Rec. 709 "
+                                "mix of the RGB irradiance, K = luminous_efficacy_lm_w)"
+                              : "radiometer readings (Rec. 709 mix of the RGB irradiance)") +
               " at point_mm (lab, screen) with slide p and n in at position [i, j], ambient "
               "light included";
   WriteJsonAtomically(dir + "/truth/reference.json", j);

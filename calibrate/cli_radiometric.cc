@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/screen_calibration.h"
+#include "lib/photometry/colour.h"
 
 namespace lumislab {
 namespace {
@@ -201,10 +202,26 @@ int RunScale(const RadiometricCommand& c, const Dataset& dataset) {
   std::string out;
   if (!Prepare(dataset, "scale.json", c.force, &out)) return 0;
   const auto corrections = Corrections(dataset, {}, "scale");
+  // Luminance is the colour calibration's Y when the dataset has one (calib/colour.json), else
+  // the Rec. 709 mix of camera RGB: exact only for a camera whose channels are Rec. 709's.
+  ScaleOptions options = c.scale_options;
+  if (const auto colour = ColourCalibration::LoadFor(dataset.dir)) {
+    options.channel_weights = colour->LuminanceWeights();
+    options.channel_weights_from_colour = true;
+    LogInfo("scale: luminance weights ", options.channel_weights.x(), " ",
+            options.channel_weights.y(), " ", options.channel_weights.z(), " (R G B) from ",
+            colour->file);
+  } else {
+    LogInfo("scale: luminance weights of Rec. 709 (0.2126 0.7152 0.0722): no calib/colour.json",
+            reference.unit == "lux"
+                ? "; the lux reading is matched to the Rec. 709 mix of camera RGB, not to the "
+                  "camera's luminance (lumislab-calibrate colour gives it)"
+                : "");
+  }
   nlohmann::json report;
   CheckLog checks(dataset.dir, "calibrate scale");
   const RadiometricScale scale =
-      CalibrateScale(dataset, screen, reference, corrections, c.scale_options, &report, &checks);
+      CalibrateScale(dataset, screen, reference, corrections, options, &report, &checks);
   CheckScale(report, scale.scale, &checks);
   MakeCalib(dataset);
   SaveRadiometricScale(out, scale, report);

@@ -47,6 +47,16 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
   info.layout.res_y = root["resolution"][1].IntIn(1, kMaxSlabResolution);
   info.units = root["units"].OneOf({"W/m^2", "lux", "relative"});
   info.filter = ParseFilterInfo(root["filter"], info.grid);
+  // Optional (Rec. 709's when absent: slabs written before it, and captures without a colour
+  // calibration).
+  if (root.Has("channel_weights")) {
+    const JsonView weights = root["channel_weights"];
+    const std::vector<double> w = weights["rgb"].Numbers(3);
+    info.channel_weights = {w[0], w[1], w[2]};
+    if (!(std::abs(info.channel_weights.sum() - 1) < 1e-6 && info.channel_weights.maxCoeff() > 0))
+      weights["rgb"].Fail("3 weights summing to 1, one of them > 0");
+    info.channel_weights_from_colour = weights["from"].OneOf({"rec709", "colour"}) == "colour";
+  }
   const JsonView present = root["present"];
   for (size_t k = 0; k < present.Size(); ++k) {
     if (present[k].Size() != 2) present[k].Fail("a position [i, j]");
@@ -58,13 +68,16 @@ SlabInfo SlabInfo::Load(const std::string& slab_dir) {
 
 void SlabInfo::Save(const std::string& slab_dir) const {
   nlohmann::json j;
-  j["schema_version"] = kSlabSchemaVersion;
+  // Version 1 unless the weights are not Rec. 709's (an older reader ignoring them would misread).
+  j["schema_version"] = channel_weights_from_colour ? kSlabSchemaVersion : 1;
   j["distance_mm"] = distance_mm;
   j["grid"] = GridJson(grid);
   j["window_mm"] = {layout.window_w_mm, layout.window_h_mm};
   j["resolution"] = {layout.res_x, layout.res_y};
   j["units"] = units;
   j["filter"] = FilterInfoJson(filter);
+  j["channel_weights"] = {{"rgb", {channel_weights.x(), channel_weights.y(), channel_weights.z()}},
+                          {"from", channel_weights_from_colour ? "colour" : "rec709"}};
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [i, jj] : present) list.push_back({i, jj});
   j["present"] = list;
@@ -87,7 +100,7 @@ void WriteSlabPosition(const std::string& slab_dir, const SlabInfo& info, const 
     out.data[k * 4 + 3] = p.mask.data[k];
   }
   ExrAttributes attr;
-  attr.ints["lumislab.schema_version"] = kSlabSchemaVersion;
+  attr.ints["lumislab.schema_version"] = 1;  // the EXR's own layout: unchanged since version 1
   attr.ints["lumislab.i"] = p.i;
   attr.ints["lumislab.j"] = p.j;
   attr.doubles["lumislab.distance_mm"] = info.distance_mm;

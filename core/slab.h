@@ -4,6 +4,7 @@
 // SlabLayout. Metadata is repeated as EXR attributes so one file stands on its own.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,9 +15,16 @@
 
 namespace lumislab {
 
-constexpr int kSlabSchemaVersion = 1;
+// slab.json is written as version 2 when its channel_weights are not Rec. 709's (an older reader
+// would weigh the channels with Rec. 709's and misread the slab's luminance), else as version 1.
+constexpr int kSlabSchemaVersion = 2;
 // Texels per side of a slab: what ReadExr reads back (kMaxExrPixels = 8192^2).
 constexpr int kMaxSlabResolution = 8192;
+
+// Rec. 709 luminance weights of linear RGB (they sum to 1): the slab's channel weights when no
+// colour calibration gave the camera's own (SlabInfo::channel_weights), and the scalar of
+// pictures that are not photometric (tone mapping, the photos' gray for detection and metering).
+inline Eigen::Vector3d Rec709Weights() { return {0.2126, 0.7152, 0.0722}; }
 
 struct SlabInfo {
   double distance_mm = 0;
@@ -24,6 +32,12 @@ struct SlabInfo {
   SlabLayout layout;
   std::string units = "W/m^2";  // or "lux" (calib/scale.json from a lux meter), "relative"
   FilterInfo filter;
+  // RGB -> the one channel every photometric stage reads (far field, rays, total light,
+  // irradiance pictures): luminance Y with its weights summed to 1. The camera's own from its
+  // colour calibration (calib/colour.json through calib/scale.json) or Rec. 709's (old slabs,
+  // captures without one; `channel_weights_from_colour` false).
+  Eigen::Vector3d channel_weights = Rec709Weights();
+  bool channel_weights_from_colour = false;
   std::vector<std::pair<int, int>> present;  // positions written so far (i, j)
 
   bool IsPresent(int i, int j) const;

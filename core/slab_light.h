@@ -17,11 +17,6 @@
 
 namespace lumislab {
 
-// Rec. 709 luminance: the one channel far-field and ray files carry (lux slabs give cd and lm,
-// W/m^2 slabs W/sr and W, as calib/scale.json's radiometer reading weighs RGB, docs/formats.md
-// §16), and the one channel whose total light the checks measure.
-inline Eigen::Vector3d LuminanceWeights() { return {0.2126, 0.7152, 0.0722}; }
-
 struct SlabLight {
   int positions = 0;    // positions with an image, summed
   double total = 0;     // sum over texels of the net flux sum_ij E_ij dA (W; lm for lux slabs)
@@ -40,13 +35,15 @@ struct SlabLight {
   double NegativeShare() const { return negative / (positive + negative); }
 };
 
-// The one channel (channel_weights . RGB) of every seen texel of the positions with an image,
-// summed one position at a time (a stage that does not hold the slab reads it position by
-// position: one image in memory, not the whole slab).
+// The one channel (channel_weights . RGB; the slab's own, SlabInfo::channel_weights, unless
+// given: luminance, as calib/scale.json's reading weighed RGB, so lux slabs give lm and W/m^2
+// slabs W) of every seen texel of the positions with an image, summed one position at a time (a
+// stage that does not hold the slab reads it position by position: one image in memory, not the
+// whole slab).
 class SlabLightSum {
  public:
-  explicit SlabLightSum(const SlabInfo& info,
-                        const Eigen::Vector3d& channel_weights = LuminanceWeights());
+  explicit SlabLightSum(const SlabInfo& info) : SlabLightSum(info, info.channel_weights) {}
+  SlabLightSum(const SlabInfo& info, const Eigen::Vector3d& channel_weights);
   void Add(const SlabPosition& position);  // one with an image; its i, j name it
   SlabLight Result() const;
 
@@ -60,7 +57,11 @@ class SlabLightSum {
 };
 // The same over a whole slab (positions without an image are skipped).
 SlabLight MeasureSlabLight(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                           const Eigen::Vector3d& channel_weights = LuminanceWeights());
+                           const Eigen::Vector3d& channel_weights);
+inline SlabLight MeasureSlabLight(const SlabInfo& info,
+                                  const std::vector<SlabPosition>& positions) {
+  return MeasureSlabLight(info, positions, info.channel_weights);
+}
 
 // Whether the sign of a slab's total light says anything: on a grid of one row or column the
 // positions are all at its edge, where the dual coefficients of a legitimate slab may sum below 0

@@ -60,12 +60,22 @@ CheckLog SlabChecks(const std::string& path, const std::string& stage) {
   return CheckLog(DatasetOfSlab(ResolveSlabDir(path)), stage);
 }
 
-// cd / lm for a slab scaled with a lux meter, W/sr / W otherwise (relative: a warning).
+// cd / lm for a slab scaled with a lux meter, W/sr / W otherwise (relative: a warning). A lux
+// slab whose luminance is the Rec. 709 mix of camera RGB (no colour calibration) is a warning,
+// not a refusal: the lux reading fixes the absolute level at the meter's position, so the
+// mismatch of the camera's channels with V(lambda) matters only where the light's spectrum
+// differs from the spectrum there (docs/method.md §3.7).
 bool Photometric(const SlabInfo& info) {
   if (info.units == "relative")
     LogWarning(
         "the slab is in relative units (no radiometric scale): the values written are "
         "relative, labelled W/sr (W)");
+  if (info.units == "lux" && !info.channel_weights_from_colour)
+    LogWarning(
+        "the luminance is the Rec. 709 mix of the camera's RGB, scaled to the lux meter's reading "
+        "(calib/scale.json had no colour calibration): exact only when the light's spectrum is "
+        "the same in every direction; lumislab-calibrate colour (a ColorChecker photo) gives the "
+        "camera's own luminance, then calibrate scale and reconstruct again");
   return info.units == "lux";
 }
 

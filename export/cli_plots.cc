@@ -79,8 +79,8 @@ int RunIrradiance(IrradianceOptions o, int threads) {
     WriteExr(o.out, irradiance_image, {"R", "G", "B"});
   } else {
     const Rgb8Image picture = FalseColourPicture(
-        irradiance_image, request, IrradianceUnitLabel(info.units), plane.extent_mm / o.size,
-        "plane at " + FormatTick(plane.plane_z_mm, 1) + " mm");
+        irradiance_image, info.channel_weights, request, IrradianceUnitLabel(info.units),
+        plane.extent_mm / o.size, "plane at " + FormatTick(plane.plane_z_mm, 1) + " mm");
     WriteRgb8File(o.out, picture.width, picture.height, picture.rgb);
   }
   LogInfo("irradiance on the plane at ", plane.plane_z_mm, " mm, ", plane.extent_mm, " mm wide, ",

@@ -63,9 +63,14 @@ Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const 
       for (size_t ic = 0; ic < d.c_deg.size(); ++ic)
         for (size_t ig = 0; ig < ng; ++ig) {
           const Eigen::Vector3d w = TypeCDirection(d.c_deg[ic], d.gamma_deg[ig]);
-          Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-          for (const Emitter& e : luminaire.emitters) sum += e.Intensity(w);
-          model.values[ic * ng + ig] = k * LuminanceWeights().dot(sum);
+          // cd: 683 integral of V I_lambda for an emitter with a spectrum, K x the Rec. 709
+          // mix (the synthetic convention) without; W/sr: the slab's one channel.
+          double value = 0;
+          for (const Emitter& e : luminaire.emitters)
+            value += !lux          ? info.channel_weights.dot(e.Intensity(w))
+                     : e.cct_k > 0 ? e.LuminousIntensity(w)
+                                   : k * Rec709Weights().dot(e.Intensity(w));
+          model.values[ic * ng + ig] = value;
         }
       c.model = "the analytic luminaire of the synthetic dataset (truth/luminaire.json)";
     }

@@ -154,8 +154,8 @@ Rgb8Image FalseColourView(const PreviewConfig& config, const SceneSetup& setup,
   const double mm_per_pixel = setup.plane ? setup.extent / irradiance.width : 0;
   const std::string title =
       setup.plane ? "plane at " + FormatTick(setup.plane_z, 1) + " mm" : std::string();
-  return FalseColourPicture(irradiance, config.false_colour_scale, IrradianceUnitLabel(info.units),
-                            mm_per_pixel, title);
+  return FalseColourPicture(irradiance, info.channel_weights, config.false_colour_scale,
+                            IrradianceUnitLabel(info.units), mm_per_pixel, title);
 }
 
 }  // namespace lumislab

@@ -222,7 +222,7 @@ void CheckSaturationLevel(const Dataset& dataset, const std::vector<DecodedPhoto
 bool FillSlab(const Dataset& dataset, const ScreenCalibration& calibration, const std::string& dir,
               const RunConfig& config, CheckLog& log) {
   SlabWriter writer(dataset, config.options.resolution, config.force, dir,
-                    config.options.radiometry->units);
+                    config.options.radiometry.get());
   const std::vector<Position> todo = Missing(dataset, writer);
   const int skipped = dataset.grid.count() - int(todo.size());
   if (skipped > 0)
@@ -325,7 +325,7 @@ int RunWatch(RunConfig config) {
   config.options.radiometry =
       std::make_shared<ReconstructRadiometry>(LoadReconstructRadiometry(dataset));
   SlabWriter writer(dataset, config.options.resolution, config.force, "",
-                    config.options.radiometry->units);
+                    config.options.radiometry.get());
   Progress progress("reconstruct --watch", dataset.grid.count());
   CheckLog log(dataset.dir, "reconstruct");  // checks.json's stage (docs/verifies.md)
   CaptureChecks checks(dataset, &log);

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "core/log.h"
+#include "lib/photometry/colour.h"
 
 namespace lumislab {
 
@@ -23,11 +24,22 @@ ReconstructRadiometry LoadReconstructRadiometry(const Dataset& dataset) {
     r.scale = s.scale;
     r.units = s.units;
     r.scale_source = scale_file;
+    r.channel_weights = s.channel_weights;
+    r.channel_weights_from_colour = s.from_colour;
     LogInfo("scale: ", s.scale, " ", s.units, " per unit from ", scale_file,
             dataset.radiometric_scale
                 ? " (dataset.json radiometry.scale_w_m2 " +
                       std::to_string(*dataset.radiometric_scale) + " not used)"
-                : std::string());
+                : std::string(),
+            "; luminance weights ", s.channel_weights.x(), " ", s.channel_weights.y(), " ",
+            s.channel_weights.z(), s.from_colour ? " (colour calibration)" : " (Rec. 709)");
+    // A colour calibration made after the scale: the reading was matched to other weights.
+    if (const auto colour = ColourCalibration::LoadFor(dataset.dir))
+      if ((colour->LuminanceWeights() - s.channel_weights).norm() > 1e-9)
+        LogWarning(scale_file, ": channel_weights ", s.from_colour ? "differ from" : "are not",
+                   " the luminance weights of ", colour->file,
+                   " (calibrated after the scale?): the slab keeps the scale's; run "
+                   "lumislab-calibrate scale --force, then reconstruct --force");
   } else if (dataset.radiometric_scale) {
     r.scale = dataset.radiometric_scale;
     r.units = "W/m^2";

@@ -17,6 +17,9 @@ struct ReconstructRadiometry {
   std::optional<double> scale;  // units per unit value at exposure 1; none: relative
   std::string units = "relative";
   std::string scale_source;  // the file it came from
+  // calib/scale.json's: the weights its reading was matched to (Rec. 709's without one).
+  Eigen::Vector3d channel_weights = Rec709Weights();
+  bool channel_weights_from_colour = false;
 };
 
 // Reads whichever of calib/dark.json, response.json, flat.json, scale.json exist (BadInput

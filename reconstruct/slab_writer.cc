@@ -9,11 +9,15 @@
 namespace lumislab {
 
 SlabWriter::SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir,
-                       const std::string& units)
+                       const ReconstructRadiometry* radiometry)
     : dir_(dir.empty() ? dataset.Path("slab") : dir),
       info_(SlabInfo::FromDataset(dataset, resolution)) {
   info_.present.clear();
-  if (!units.empty()) info_.units = units;
+  if (radiometry) {
+    info_.units = radiometry->units;
+    info_.channel_weights = radiometry->channel_weights;
+    info_.channel_weights_from_colour = radiometry->channel_weights_from_colour;
+  }
   if (!force && std::filesystem::exists(dir_ + "/slab.json")) {
     const SlabInfo old = SlabInfo::Load(dir_);
     if (old.layout.res_x != info_.layout.res_x || old.layout.res_y != info_.layout.res_y)

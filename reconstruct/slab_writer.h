@@ -8,6 +8,7 @@
 
 #include "core/dataset.h"
 #include "core/slab.h"
+#include "reconstruct/radiometry.h"
 
 namespace lumislab {
 
@@ -15,10 +16,11 @@ class SlabWriter {
  public:
   // Opens `dir` (default: dataset/slab): keeps positions whose EXR already exists (unless
   // `force`), rejects an existing slab of another resolution unless `force`; writes a valid
-  // slab.json right away. `units`: the slab's units when not dataset.json's (calib/scale.json:
-  // "W/m^2" or "lux"; "relative"); "" takes them from the dataset.
+  // slab.json right away. `radiometry`: the slab's units (calib/scale.json: "W/m^2" or "lux";
+  // "relative") and channel weights (calib/scale.json's); null takes the units from the dataset
+  // and Rec. 709's weights.
   SlabWriter(const Dataset& dataset, int resolution, bool force, const std::string& dir = "",
-             const std::string& units = "");
+             const ReconstructRadiometry* radiometry = nullptr);
 
   // Unlocked: read its layout and grid only while positions are written (`present` changes
   // under the lock; ask IsPresent, Complete, PresentCount).

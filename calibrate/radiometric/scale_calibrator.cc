@@ -57,10 +57,6 @@ ScaleReference LoadScaleReference(const std::string& path) {
 
 namespace {
 
-double Luminance(const double rgb[3]) {
-  return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];  // Rec. 709, as LinearGray
-}
-
 struct SlideValue {
   double rgb[3] = {0, 0, 0};
   double exposure_sum = 0;
@@ -103,7 +99,8 @@ std::optional<Eigen::Vector3d> AddPhoto(const Photo& photo, const Eigen::Vector2
 }
 
 // The brightest light in a photo (per unit exposure): the 99.9th percentile of its luminance, so
-// that a few hot or glinting pixels do not count.
+// that a few hot or glinting pixels do not count. Rec. 709's (LinearGray): a level against the
+// sensor's full scale for the exposure checks, not a photometric quantity.
 double PeakLuminance(const Photo& photo) {
   const cv::Mat gray = LinearGray(photo);
   std::vector<float> v(gray.begin<float>(), gray.end<float>());
@@ -120,6 +117,11 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
                                 const ScaleOptions& options, nlohmann::json* report,
                                 CheckLog* checks) {
   reference.Check(dataset);
+  // The one channel the reading is matched to: the slab's (SlabInfo::channel_weights).
+  const Eigen::Vector3d& weights = options.channel_weights;
+  auto luminance = [&](const double rgb[3]) {
+    return weights.x() * rgb[0] + weights.y() * rgb[1] + weights.z() * rgb[2];
+  };
   const Eigen::Vector2d pixel = screen.ImageFromScreen(reference.point_mm);
   const int r = options.radius_px;
   if (!(pixel.x() - r - 2 >= 0 && pixel.y() - r - 2 >= 0 &&
@@ -151,8 +153,8 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
       // The photo as dataset.json names it: a dataset folder's name need not be UTF-8 (JSON
       // must), and the report stays valid when the folder moves.
       bracket_values[s].push_back({{"file", e.file},
-                                   {"value", Luminance(y)},
-                                   {"level", Luminance(y) * photo.spec.exposure}});
+                                   {"value", luminance(y)},
+                                   {"level", luminance(y) * photo.spec.exposure}});
     }
     if (e.positive && (peak_exposure == 0 || photo.spec.exposure < peak_exposure))
       peak_exposure = photo.spec.exposure, peak_p = PeakLuminance(photo);
@@ -167,7 +169,7 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
               " unclipped around the reference point",
           "every one clipped (or no photo)");
     for (double& c : slides[s].rgb) c /= slides[s].exposure_sum;
-    value[s] = Luminance(slides[s].rgb);
+    value[s] = luminance(slides[s].rgb);
   }
   const double difference = value[0] - value[1];
   // The reference reads more light through T+ (ScaleReference::Check); photos that do not are
@@ -186,6 +188,8 @@ RadiometricScale CalibrateScale(const Dataset& dataset, const ScreenCalibration&
   RadiometricScale scale;
   scale.scale = (reference.reading_p - reference.reading_n) / difference;
   scale.units = reference.unit;
+  scale.channel_weights = weights;
+  scale.from_colour = options.channel_weights_from_colour;
   if (!(scale.scale >= 1e-12 && scale.scale <= 1e12))
     throw InputError(reference.source, "reading_p", "readings giving a scale in [1e-12, 1e12]",
                      std::to_string(scale.scale));

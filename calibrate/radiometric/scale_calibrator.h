@@ -35,9 +35,13 @@ struct ScaleOptions {
   // Pixels within this distance of the point give the quadratic fit its value at the point
   // (at least 2: six coefficients).
   int radius_px = 3;
+  // RGB -> the one channel matched to the reading (weights summing to 1): the colour
+  // calibration's luminance (ColourCalibration::LuminanceWeights, `from_colour`) or Rec. 709's.
+  Eigen::Vector3d channel_weights = Rec709Weights();
+  bool channel_weights_from_colour = false;
 };
 
-// scale = (reading_p - reading_n) / (Y+ - Y-), Y the Rec. 709 luminance of the position's
+// scale = (reading_p - reading_n) / (Y+ - Y-), Y options.channel_weights . RGB of the position's
 // corrected linear values (decoded with `corrections`, exposure-weighted over the unclipped
 // photos of each slide) at the point (a quadratic fit to the pixels within radius_px); ambient
 // light cancels in both

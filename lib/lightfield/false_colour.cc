@@ -37,7 +37,8 @@ std::vector<double> LinearTicks(double lo, double hi) {
   return ticks;
 }
 
-// Black or white, whichever stands out on colour c (by its Rec. 709 luma).
+// Black or white, whichever stands out on colour c (by its Rec. 709 luma: a display colour,
+// not a photometric quantity).
 Rgb8 ContrastingColour(Rgb8 c) {
   return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b > 110 ? kBlack : kWhite;
 }
@@ -135,11 +136,12 @@ FalseColourScale AutoScale(const std::vector<float>& values, bool log) {
   return scale;
 }
 
-std::vector<float> PixelLuminance(const ImageF& image) {
+std::vector<float> PixelLuminance(const ImageF& image, const Eigen::Vector3d& channel_weights) {
+  const Eigen::Vector3d& w = channel_weights;
   std::vector<float> out(size_t(image.width) * image.height);
   for (size_t p = 0; p < out.size(); ++p) {
     const float* v = &image.data[p * image.channels];
-    out[p] = image.channels >= 3 ? float(0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) : v[0];
+    out[p] = image.channels >= 3 ? float(w.x() * v[0] + w.y() * v[1] + w.z() * v[2]) : v[0];
   }
   return out;
 }
@@ -252,10 +254,10 @@ void ParseFalseColourRange(const std::string& text, const std::string& option,
   request->max = max;
 }
 
-Rgb8Image FalseColourPicture(const ImageF& irradiance, const FalseColourRequest& request,
-                             const std::string& unit, double mm_per_pixel,
-                             const std::string& title) {
-  const std::vector<float> values = PixelLuminance(irradiance);
+Rgb8Image FalseColourPicture(const ImageF& irradiance, const Eigen::Vector3d& channel_weights,
+                             const FalseColourRequest& request, const std::string& unit,
+                             double mm_per_pixel, const std::string& title) {
+  const std::vector<float> values = PixelLuminance(irradiance, channel_weights);
   FalseColourOptions options;
   options.scale = request.Resolve(values);
   options.unit = unit;

@@ -5,6 +5,7 @@
 // both draw through here.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -39,9 +40,10 @@ struct FalseColourScale {
 // without light gives [0, 1] ([1e-3, 1] log).
 FalseColourScale AutoScale(const std::vector<float>& values, bool log);
 
-// The scalar the picture maps: Rec. 709 luminance of each RGB pixel (the quantity a radiometer
-// or lux meter calibration scales, docs/formats.md §16), row 0 on top.
-std::vector<float> PixelLuminance(const ImageF& image);
+// The scalar the picture maps: channel_weights . RGB of each pixel (the slab's weights,
+// SlabInfo::channel_weights: the luminance a radiometer or lux meter calibration scales,
+// docs/formats.md §16), row 0 on top; a 1-channel image as it is.
+std::vector<float> PixelLuminance(const ImageF& image, const Eigen::Vector3d& channel_weights);
 
 // Which pixels draw the iso-line of each level: a pixel is marked when a level lies between its
 // value and its right or lower neighbour's and its value is the nearer of the two (in the scale's
@@ -77,11 +79,12 @@ struct FalseColourRequest {
 void ParseFalseColourRange(const std::string& text, const std::string& option,
                            FalseColourRequest* request);
 
-// The whole picture of a linear RGB irradiance image: its PixelLuminance through the resolved
-// scale, iso-lines, the bar in `unit`, a scale bar when mm_per_pixel > 0 and the title.
-Rgb8Image FalseColourPicture(const ImageF& irradiance, const FalseColourRequest& request,
-                             const std::string& unit, double mm_per_pixel,
-                             const std::string& title = "");
+// The whole picture of a linear RGB irradiance image: its PixelLuminance (by the slab's
+// channel_weights) through the resolved scale, iso-lines, the bar in `unit`, a scale bar when
+// mm_per_pixel > 0 and the title.
+Rgb8Image FalseColourPicture(const ImageF& irradiance, const Eigen::Vector3d& channel_weights,
+                             const FalseColourRequest& request, const std::string& unit,
+                             double mm_per_pixel, const std::string& title = "");
 
 // "1500", "0.25", "2e+05": a tick value with as many decimals as the ticks' step needs.
 std::string FormatTick(double value, double step);

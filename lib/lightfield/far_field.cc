@@ -239,6 +239,7 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
   BellQuadrature(options.samples, &offsets, &weights);
   const int n = options.samples;
   const double h = info.grid.spacing_mm, d = info.distance_mm;
+  const Eigen::Vector3d channel_weights = options.channel_weights.value_or(info.channel_weights);
   FarField out;
   out.c_deg = c_deg;
   out.gamma_deg = gamma_deg;
@@ -263,7 +264,7 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
             const double t = centre.y() + h * offsets[b] + dt;
             if (!SeenAt(info.layout, p.mask, s, t)) return;  // unseen: left at 0
             sum += weights[a] * weights[b] *
-                   options.channel_weights.dot(SampleLayout(info.layout, p.irradiance, s, t));
+                   channel_weights.dot(SampleLayout(info.layout, p.irradiance, s, t));
           }
         }
       }
@@ -279,8 +280,8 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
 }
 
 SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                        int64_t count, uint64_t seed, int threads,
-                        const Eigen::Vector3d& channel_weights) {
+                        int64_t count, uint64_t seed, int threads) {
+  const Eigen::Vector3d& channel_weights = info.channel_weights;
   LUMISLAB_CHECK(int(positions.size()) == info.grid.count(), "one slab position per grid index");
   LUMISLAB_CHECK(count >= 1 && count <= std::numeric_limits<int32_t>::max(),
                  "between 1 and 2^31 - 1 rays");

@@ -6,17 +6,20 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/slab.h"
-#include "core/slab_light.h"  // LuminanceWeights, ReadSlabPositions
+#include "core/slab_light.h"  // ReadSlabPositions
 
 namespace lumislab {
 
 struct FarFieldOptions {
-  int samples = 4;                                       // N x N bell quadrature per position
-  Eigen::Vector3d channel_weights = LuminanceWeights();  // RGB -> the one channel
+  int samples = 4;  // N x N bell quadrature per position
+  // RGB -> the one channel; none: the slab's (SlabInfo::channel_weights, luminance: cd for lux
+  // slabs).
+  std::optional<Eigen::Vector3d> channel_weights;
   int threads = 1;
 };
 
@@ -70,9 +73,9 @@ struct SlabRays {
 // against their nearest neighbours. Then each ray draws a texel by its flux, a cell of its
 // profile by its flux, (u, v) uniformly in the cell and (s, t) uniformly in the texel. Every
 // ray carries total_flux / N. Deterministic for a seed, whatever the thread count (texels run
-// on `threads` threads, each with its own random stream).
+// on `threads` threads, each with its own random stream). The one channel is the slab's
+// (SlabInfo::channel_weights: luminance, lm for lux slabs).
 SlabRays SampleSlabRays(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                        int64_t count, uint64_t seed, int threads = 1,
-                        const Eigen::Vector3d& channel_weights = LuminanceWeights());
+                        int64_t count, uint64_t seed, int threads = 1);
 
 }  // namespace lumislab

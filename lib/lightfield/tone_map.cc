@@ -10,7 +10,8 @@ namespace lumislab {
 
 namespace {
 
-// Rec. 709 luminance of pixel k of a 3-channel image.
+// Rec. 709 luminance of pixel k of a 3-channel image: the brightness a display tone maps, not
+// a photometric quantity (whose weights are the slab's, SlabInfo::channel_weights).
 double Luminance(const ImageF& image, size_t k) {
   return 0.2126 * image.data[3 * k] + 0.7152 * image.data[3 * k + 1] +
          0.0722 * image.data[3 * k + 2];

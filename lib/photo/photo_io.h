@@ -150,7 +150,8 @@ class LinearReader {
 cv::Mat Codes8(const Photo& photo);
 
 // The whole photo as linear, exposure-normalised Rec. 709 luminance (CV_32FC1); BadInput when a
-// value is not finite.
+// value is not finite. A gray for detection, metering and levels against full scale, not a
+// photometric quantity (that is the slab's, SlabInfo::channel_weights).
 cv::Mat LinearGray(const Photo& photo);
 
 }  // namespace lumislab

@@ -215,19 +215,31 @@ void SaveFlatMap(const std::string& json_path, const FlatMap& map, const nlohman
 
 RadiometricScale LoadRadiometricScale(const std::string& json_path) {
   const JsonDocument doc = JsonDocument::Load(json_path);
-  doc.CheckSchemaVersion(kRadiometricCalibrationSchemaVersion);
+  doc.CheckSchemaVersion(kScaleSchemaVersion);
   RadiometricScale scale;
   scale.file = json_path;
   scale.scale = doc.root()["scale"].NumberIn(1e-12, 1e12);
   scale.units = doc.root()["units"].OneOf({"W/m^2", "lux"});
+  if (doc.root().Has("channel_weights")) {
+    const JsonView weights = doc.root()["channel_weights"];
+    const std::vector<double> w = weights["rgb"].Numbers(3);
+    scale.channel_weights = {w[0], w[1], w[2]};
+    if (!(std::abs(scale.channel_weights.sum() - 1) < 1e-6 && scale.channel_weights.maxCoeff() > 0))
+      weights["rgb"].Fail("3 weights summing to 1, one of them > 0");
+    scale.from_colour = weights["from"].OneOf({"rec709", "colour"}) == "colour";
+  }
   return scale;
 }
 
 void SaveRadiometricScale(const std::string& json_path, const RadiometricScale& scale,
                           const nlohmann::json& report) {
   nlohmann::json j = Header("scale", 0, 0);
+  if (scale.from_colour) j["schema_version"] = kScaleSchemaVersion;
   j["scale"] = scale.scale;
   j["units"] = scale.units;
+  const Eigen::Vector3d& w = scale.channel_weights;
+  j["channel_weights"] = {{"rgb", {w.x(), w.y(), w.z()}},
+                          {"from", scale.from_colour ? "colour" : "rec709"}};
   j["meaning"] = "irradiance (units) per unit of corrected linear pixel value at exposure 1";
   j["report"] = report;
   WriteJsonAtomically(json_path, j);

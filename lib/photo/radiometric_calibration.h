@@ -12,6 +12,7 @@
 // division by the exposure: (curve(code) - black_level) / (white_level - black_level).
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/slab.h"  // Rec709Weights
 
 namespace lumislab {
 
@@ -55,7 +57,16 @@ struct RadiometricScale {
   std::string file;
   double scale = 1;             // units per unit of corrected linear value at exposure 1
   std::string units = "W/m^2";  // "W/m^2" or "lux"
+  // The weights that reduced the photos' RGB to the one channel the reading was matched to
+  // (luminance; they sum to 1): the camera's Y row from calib/colour.json, or Rec. 709's when
+  // the dataset had none (`from_colour` false; also when the file predates the member).
+  // Reconstruct gives them to the slab (SlabInfo::channel_weights).
+  Eigen::Vector3d channel_weights = Rec709Weights();
+  bool from_colour = false;
 };
+// calib/scale.json is written as version 2 when its channel_weights come from a colour
+// calibration (a version-1 reader would build a slab weighed with Rec. 709's), else as 1.
+constexpr int kScaleSchemaVersion = 2;
 
 // The corrections the decoder applies to every photo (each optional).
 struct PhotoCorrections {

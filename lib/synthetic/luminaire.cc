@@ -6,6 +6,9 @@
 
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/slab.h"  // Rec709Weights
+#include "lib/photometry/colour.h"
+#include "lib/synthetic/scene.h"  // DefaultLuminousEfficacy
 
 namespace lumislab {
 namespace {
@@ -40,6 +43,15 @@ double MeasuredLobe::Shape(const Eigen::Vector3d& w) const {
   // The file's (C, gamma) of w: type C in the file's frame (TypeCAngles, docs/formats.md §17).
   const Eigen::Vector2d c_gamma = TypeCAngles(luminaire_from_file.transpose() * w);
   return distribution->Intensity(c_gamma.x(), c_gamma.y()) / peak;
+}
+
+double Emitter::LuminousEfficacy() const {
+  return cct_k > 0 ? lumislab::LuminousEfficacy(Blackbody(cct_k)) : DefaultLuminousEfficacy();
+}
+
+double Emitter::LuminousIntensity(const Eigen::Vector3d& w) const {
+  return cct_k > 0 ? LuminousEfficacy() * radiant_w_sr * Shape(w)
+                   : LuminousEfficacy() * Rec709Weights().dot(Intensity(w));
 }
 
 double Emitter::Shape(const Eigen::Vector3d& w) const {

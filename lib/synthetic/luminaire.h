@@ -49,6 +49,13 @@ struct Emitter {
   double Shape(const Eigen::Vector3d& w) const;
   // I0 Shape(w) (W/sr).
   Eigen::Vector3d Intensity(const Eigen::Vector3d& w) const { return Shape(w) * intensity_w_sr; }
+  // The luminous efficacy of its light, lm/W: 683 sum(V s) / sum(s) of its blackbody for an
+  // emitter with a spectrum; DefaultLuminousEfficacy (an equal-energy spectrum) without.
+  double LuminousEfficacy() const;
+  // Its luminous intensity towards w, cd = 683 integral of V I_lambda: LuminousEfficacy x
+  // radiant_w_sr x Shape(w) with a spectrum; without one (RGB is then no spectrum), the
+  // synthetic convention LuminousEfficacy x the Rec. 709 mix of Intensity(w).
+  double LuminousIntensity(const Eigen::Vector3d& w) const;
 };
 
 struct Luminaire {

@@ -336,7 +336,7 @@ double SynthScene::LuminousEfficacy() const {
         solid_angle += e.Shape(w) * std::sin(theta) * (0.5 * kPi / kSteps) * (kPi / kSteps);
       }
     const double flux = e.radiant_w_sr * solid_angle;
-    lumens += flux * lumislab::LuminousEfficacy(Blackbody(e.cct_k));
+    lumens += flux * e.LuminousEfficacy();
     watts += flux;
   }
   return watts > 0 ? lumens / watts : DefaultLuminousEfficacy();

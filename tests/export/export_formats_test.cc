@@ -53,7 +53,7 @@ struct Fixture {
     const Eigen::Vector3d w = TypeCDirection(c_deg, gamma_deg);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Emitter& e : luminaire.emitters) sum += e.Intensity(w);
-    return k * LuminanceWeights().dot(sum);
+    return k * Rec709Weights().dot(sum);
   }
 };
 const Fixture& Data() {
@@ -153,9 +153,9 @@ TEST(ExportFormats, Tm25RaysCarryTheSlabsFlux) {
   double flux = 0;
   for (const SlabPosition& p : positions)
     for (size_t t = 0; t < p.mask.data.size(); ++t)
-      flux += LuminanceWeights().dot(Eigen::Vector3d(p.irradiance.data[3 * t],
-                                                     p.irradiance.data[3 * t + 1],
-                                                     p.irradiance.data[3 * t + 2])) *
+      flux += Rec709Weights().dot(Eigen::Vector3d(p.irradiance.data[3 * t],
+                                                  p.irradiance.data[3 * t + 1],
+                                                  p.irradiance.data[3 * t + 2])) *
               f.info.layout.TexelW() * f.info.layout.TexelH() * 1e-6;
   EXPECT_NEAR(set.FluxSum() / flux, 1, 1e-5);
   r = RunTool("lumislab-export", "info --json " + ShellQuote(ray));

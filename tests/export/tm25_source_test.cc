@@ -135,7 +135,7 @@ TEST(Tm25Source, RoundTripsThroughACapture) {
                                 p.irradiance.at(col, row, 2));
         // Rows run from +t down; the bins from -y up.
         const size_t bin = size_t(nb - 1 - row / texels_per_bin) * nb + col / texels_per_bin;
-        slab_bins.flux[bin] += LuminanceWeights().dot(e) * texel_m2;
+        slab_bins.flux[bin] += Rec709Weights().dot(e) * texel_m2;
       }
 
   // The planner's prediction for this capture (the disc's box and depth from the scene's rays).

@@ -34,7 +34,7 @@ struct Fixture {
     const Eigen::Vector3d w = TypeCDirection(c_deg, gamma_deg);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Emitter& e : scene.luminaire.emitters) sum += e.Intensity(w);
-    return LuminanceWeights().dot(sum);
+    return Rec709Weights().dot(sum);
   }
 };
 const Fixture& Data() {
@@ -112,9 +112,9 @@ TEST(FarField, RaysCarryTheSlabsFluxAndAngularDistribution) {
         for (int col = 0; col < layout.res_x; ++col)
           if (p.mask.at(col, row, 0) >= 0.5f)
             slab[size_t(row / block) * nbx + col / block] +=
-                texel_m2 * LuminanceWeights().dot(Eigen::Vector3d(p.irradiance.at(col, row, 0),
-                                                                  p.irradiance.at(col, row, 1),
-                                                                  p.irradiance.at(col, row, 2)));
+                texel_m2 * Rec709Weights().dot(Eigen::Vector3d(p.irradiance.at(col, row, 0),
+                                                               p.irradiance.at(col, row, 1),
+                                                               p.irradiance.at(col, row, 2)));
     for (const SlabRay& r : rays.rays) {
       const Eigen::Vector3d at = r.origin_mm + r.direction * (f.info.distance_mm / r.direction.z());
       const Eigen::Vector2d texel = layout.ToTexel(at.x(), at.y());

@@ -34,6 +34,18 @@ SlabComparison CompareSlabs(const std::string& slab_dir, const std::string& refe
                    ")");
   if (info.grid.nu != ref_info.grid.nu || info.grid.nv != ref_info.grid.nv)
     throw BadInput(slab_dir + "/slab.json: grid differs from the reference " + reference_dir);
+  // Lux slabs are compared in luminance (each slab's channel_weights): a lux slab's photometric
+  // quantity is its luminance, its RGB is the camera's, and a synthetic truth of spectral
+  // emitters holds grey luminance (lib/synthetic/truth.h WriteTruthSlab). Others channel by
+  // channel.
+  const bool luminance = info.units == "lux" && ref_info.units == "lux";
+  const int channels = luminance ? 1 : 3;
+  auto value = [&](const SlabInfo& si, const SlabPosition& sp, size_t k, int c) -> double {
+    const float* rgb = &sp.irradiance.data[k * 3];
+    if (!luminance) return rgb[c];
+    return si.channel_weights[0] * rgb[0] + si.channel_weights[1] * rgb[1] +
+           si.channel_weights[2] * rgb[2];
+  };
   SlabComparison out;
   double total_err2 = 0, total_ref2 = 0;
   for (const auto& [i, j] : info.present) {
@@ -56,10 +68,11 @@ SlabComparison CompareSlabs(const std::string& slab_dir, const std::string& refe
         ++e.unseen_lit_texels;
         continue;
       }
-      for (int c = 0; c < 3; ++c) {
-        const double d = double(p.irradiance.data[k * 3 + c]) - r.irradiance.data[k * 3 + c];
+      for (int c = 0; c < channels; ++c) {
+        const double ref = value(ref_info, r, k, c);
+        const double d = value(info, p, k, c) - ref;
         err2 += d * d;
-        ref2 += double(r.irradiance.data[k * 3 + c]) * r.irradiance.data[k * 3 + c];
+        ref2 += ref * ref;
         e.max_abs = std::max(e.max_abs, std::abs(d));
       }
     }

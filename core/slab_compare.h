@@ -12,6 +12,7 @@ struct PositionError {
   int i = 0;
   int j = 0;
   double relative_l2 = 0;     // ||E - E_ref|| / ||E_ref|| over lit, seen texels, RGB together
+                              // (lux slabs: their luminance, each slab's channel_weights)
   double max_abs = 0;         // max |E - E_ref| over those texels (slab units)
   int lit_texels = 0;         // texels where |E_ref| >= lit_fraction * max |E_ref| of the position
   int unseen_lit_texels = 0;  // lit in the reference but masked out in the slab

@@ -195,7 +195,7 @@ ReportPlane MakePlane(const ReportData& r, const std::vector<ImageF>& irradiance
   plane.distance_mm = p.plane_z_mm;
   plane.extent_mm = p.extent_mm;
   plane.size = o.plane_size;
-  const Eigen::Vector3d w = LuminanceWeights();
+  const Eigen::Vector3d w = r.info.channel_weights;  // the slab's luminance (formats.md §6)
   for (int y = 0; y < plane.size; ++y)
     for (int x = 0; x < plane.size; ++x)
       plane.luminance.push_back(float(w[0] * p.irradiance.at(x, y, 0) +

@@ -56,10 +56,29 @@ void WriteTruthSlab(const Luminaire& luminaire, SlabInfo info, const std::string
                     double luminous_efficacy) {
   MakeDirectories(dir);
   info.present.clear();
-  const float scale = info.units == "lux" ? float(luminous_efficacy) : 1.f;
+  float scale = info.units == "lux" ? float(luminous_efficacy) : 1.f;
+  // A lux truth of emitters with a spectrum is their luminous intensity (683 integral of V
+  // I_lambda, Emitter::LuminousIntensity) as grey light: the camera's RGB of such light is not
+  // luminance under any fixed weights, and CompareSlabs compares lux slabs in luminance.
+  Luminaire grey = luminaire;
+  bool spectral = false;
+  for (const Emitter& e : luminaire.emitters) spectral = spectral || e.cct_k > 0;
+  if (info.units == "lux" && spectral) {
+    for (Emitter& e : grey.emitters) {
+      // LuminousIntensity(w) / Shape(w), the same for every w: the lobe's I0 in cd.
+      const double i0_cd = e.cct_k > 0
+                               ? e.LuminousEfficacy() * e.radiant_w_sr
+                               : e.LuminousEfficacy() * Rec709Weights().dot(e.intensity_w_sr);
+      e.cct_k = 0;
+      e.intensity_w_sr = Eigen::Vector3d::Constant(i0_cd);
+    }
+    scale = 1.f;
+    info.channel_weights = Rec709Weights();  // grey: any weights summing to 1 give the same
+  }
+  const Luminaire& truth = info.units == "lux" && spectral ? grey : luminaire;
   ParallelFor(info.grid.count(), threads, [&](int q) {
     const int i = q % info.grid.nu, j = q / info.grid.nu;
-    SlabPosition p = TruthPosition(luminaire, info, i, j);
+    SlabPosition p = TruthPosition(truth, info, i, j);
     for (float& v : p.irradiance.data) v *= scale;
     WriteSlabPosition(dir, info, p);
   });

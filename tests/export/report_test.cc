@@ -71,7 +71,7 @@ class ExportReport : public testing::Test {
   static std::vector<std::pair<double, double>> Lobes() {
     std::vector<std::pair<double, double>> lobes;
     for (const Emitter& e : luminaire_.emitters)
-      lobes.push_back({LuminanceWeights().dot(e.intensity_w_sr), e.lobe_exponent});
+      lobes.push_back({Rec709Weights().dot(e.intensity_w_sr), e.lobe_exponent});
     return lobes;
   }
   static double TruthIntensity(double gamma_deg) {
@@ -128,7 +128,7 @@ TEST_F(ExportReport, NumbersMatchTheSyntheticTruth) {
   ASSERT_EQ(r.planes.size(), 3u);
   EXPECT_NEAR(r.planes[0].distance_mm, 750, 1e-9);
   EXPECT_NEAR(r.planes[2].distance_mm, 3000, 1e-9);
-  const double e_truth = LuminanceWeights().dot(luminaire_.PlaneIrradiance(0, 0, 750));
+  const double e_truth = Rec709Weights().dot(luminaire_.PlaneIrradiance(0, 0, 750));
   EXPECT_NEAR(r.planes[0].centre_slab / e_truth, 1, 0.01);
   EXPECT_GT(r.uncertainty.FluxExpanded(), 0);
 }

@@ -53,6 +53,7 @@ int RunColourCommand(ColourCommand* c) {
     spec.corrections = std::make_shared<PhotoCorrections>(
         LoadPhotoCorrections(dataset.Path("calib"), {true, true, false}));
   }
+  RefuseOutputOverInputs(out, to_dataset ? out : "");
   if (std::filesystem::exists(out) && !c->force)
     throw BadInput(out + ": exists; use --force to replace it");
   const Photo photo = DecodePhoto(c->photo, spec);

@@ -76,6 +76,34 @@ void CheckOutputPath(const std::string& path) {
                  "regular files");
 }
 
+void RefuseOutputOverInputs(const std::string& path, const std::string& allowed) {
+  if (path.empty()) return;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(fs::absolute(path), ec);
+  if (ec) return;  // CheckOutputPath and the writer report what is wrong with it
+  if (!allowed.empty() && out == fs::weakly_canonical(fs::absolute(allowed), ec)) return;
+  auto refuse = [&](const std::string& what) {
+    throw BadInput(path + ": is " + what +
+                   ", which lumislab reads: write the output elsewhere (--force replaces an "
+                   "earlier output, never an input)");
+  };
+  if (fs::exists(out.parent_path() / "slab.json", ec))
+    refuse("in the slab folder " + out.parent_path().string());
+  fs::path folder = out.parent_path();
+  for (int up = 0; up < 3 && !folder.empty() && folder != folder.root_path(); ++up) {
+    if (fs::exists(folder / "dataset.json", ec)) {
+      const fs::path inside = out.lexically_relative(folder);
+      const std::string top = inside.begin() == inside.end() ? "" : inside.begin()->string();
+      if (up == 0 && (top == "dataset.json" || top == "checks.json"))
+        refuse("the dataset's " + top);
+      for (const char* sub : {"slab", "calib", "calibration", "photos", "truth"})
+        if (up > 0 && top == sub) refuse("inside the dataset's " + std::string(sub) + "/");
+      return;
+    }
+    folder = folder.parent_path();
+  }
+}
+
 void WriteAtomically(const std::string& final_path,
                      const std::function<void(const std::string& tmp_path)>& write) {
   const std::string tmp = TemporaryPathFor(final_path);

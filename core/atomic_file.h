@@ -22,6 +22,12 @@ int RemoveOrphanedTemporaries(const std::string& dir);
 // call it where they parse --out, so that they refuse before long work; WriteAtomically checks
 // again just before its rename.
 void CheckOutputPath(const std::string& path);
+// BadInput naming `path` when it is a file lumislab reads: inside a slab folder (one holding
+// slab.json), or inside the slab/, calib/, calibration/, photos/ or truth/ folder of a dataset
+// (a folder holding dataset.json, up to three levels up), or the dataset's dataset.json or
+// checks.json; `allowed` (when not empty) is the one such file the caller writes (calibrate
+// colour's calib/colour.json). --force replaces an earlier output, never a run's input.
+void RefuseOutputOverInputs(const std::string& path, const std::string& allowed = "");
 // Calls write(tmp_path), checks final_path (CheckOutputPath), then renames tmp_path onto it. On
 // any exception the temporary file is removed and the exception rethrown; a failed rename is an
 // IoError (exit 3).

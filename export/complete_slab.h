@@ -23,10 +23,13 @@ inline std::string ResolveSlabDir(const std::string& path) {
 }
 
 // Before any work: `out` can be written (CheckOutputPath: no link, special file or folder; its
-// folder exists: exit 3), and an export never replaces a file silently nor keeps an old one
+// folder exists: exit 3), it is none of a dataset's or slab's own files (RefuseOutputOverInputs),
+// and an export never replaces a file silently nor keeps an old one
 // while reporting success: an existing `out` is exit 2 naming it unless `force`.
 inline void CheckExportOutput(const std::string& out, bool force) {
+  if (out.empty()) throw BadInput("--out: expected a file path, got an empty one");
   CheckOutputPath(out);
+  RefuseOutputOverInputs(out);
   const std::filesystem::path folder = std::filesystem::absolute(out).parent_path();
   if (!std::filesystem::is_directory(folder))
     throw IoError(out, "cannot write it: the folder " + folder.string() + " does not exist");

@@ -117,6 +117,12 @@ std::string Coverage::SeenCone() const {
 }
 
 std::string Coverage::Text() const {
+  if (cells_beyond_cone)
+    return "partial: " + SeenCone() +
+           "; every grid direction seen, but the grid's cells reach "
+           "beyond that cone; " +
+           (analytic ? "the analytic luminaire" : "the model") + " puts " +
+           Pct(model_unseen_share) + " of its flux within them there (" + model + ")";
   return "partial: " + SeenCone() + "; " + std::to_string(unseen) + " of " +
          std::to_string(directions) + " grid directions (" + Pct(double(unseen) / directions) +
          ") not seen, written as 0; " + (analytic ? "the analytic luminaire" : "the model") +
@@ -126,9 +132,10 @@ std::string Coverage::Text() const {
 std::string Coverage::Short() const {
   double lo = 1e9;
   for (double g : seen_gamma_max_deg) lo = std::min(lo, g);
-  return "partial: gamma<=" + Num(std::max(lo, 0.0), 4) + " seen, " +
-         Pct(double(unseen) / directions) + " unseen, " + Pct(model_unseen_share) + " of " +
-         (analytic ? "truth" : "Lambert model") + " flux";
+  auto pct = [](double share) { return Num(100 * share, 3) + "%"; };
+  return "partial g<=" + Num(std::max(lo, 0.0), 4) + ": unseen " +
+         pct(double(unseen) / directions) + " dirs, " + pct(model_unseen_share) + " flux (" +
+         (analytic ? "truth" : "Lambert") + ")";
 }
 
 }  // namespace lumislab

@@ -27,13 +27,17 @@ struct Coverage {
   bool analytic = false;  // the synthetic luminaire of truth/ (else a stated Lambertian model)
   std::string model;      // in words
   double model_flux = 0;  // the model's total flux over the grid (slab units: lm or W)
+  // Every grid direction seen, but the cells around them reach directions the capture did not
+  // see (the share and the cone then come from a fine grid; cli_formats.cc CheckCells).
+  bool cells_beyond_cone = false;
 
-  bool Partial() const { return unseen > 0 && model_unseen_share > 0; }
+  bool Partial() const { return (unseen > 0 || cells_beyond_cone) && model_unseen_share > 0; }
   // "gamma 0-37.5 deg seen (37.5 in C 0, 47.5 in C 45, ...)": the seen cone.
   std::string SeenCone() const;
   // The full statement: seen cone, unseen count and share, the model's share of the flux there.
   std::string Text() const;
-  // The same in at most ~60 characters (EULUMDAT's 78-character text fields).
+  // The same in about 50 characters (EULUMDAT's 78-byte text fields, after the report number):
+  // "partial g<=37.5: unseen 54.2% dirs, 22.6% flux (truth)".
   std::string Short() const;
 };
 

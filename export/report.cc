@@ -270,13 +270,7 @@ int RunReport(const ReportOptions& o, int threads) {
   if (!o.pdf.empty() && std::filesystem::path(o.pdf).extension() != ".pdf")
     throw BadInput(o.pdf + ": --pdf must end in .pdf");
   for (const std::string& path : {o.out, o.pdf}) {
-    if (path.empty()) continue;
-    CheckOutputPath(path);
-    const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
-    if (!std::filesystem::is_directory(folder))
-      throw IoError(path, "cannot write it: no folder " + folder.string());
-    if (!o.force && std::filesystem::exists(path))
-      throw BadInput(path + ": exists (--force rewrites it)");
+    if (!path.empty()) CheckExportOutput(path, o.force);
   }
   const ReportData data = MakeReportData(o, threads);
   WriteTextAtomically(o.out, ReportHtml(data));

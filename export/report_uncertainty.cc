@@ -153,6 +153,20 @@ FarFieldUncertainty EstimateFarFieldUncertainty(const SlabInfo& info,
     }
   }
   FarFieldUncertainty u = EstimateFarFieldUncertainty(in);
+  // A capture (no truth/) without the light's depth or the meter's uncertainty: the stated
+  // figure leaves out known terms, which the lab must hear, not find in the small print.
+  if (source != "truth/luminaire.json") {
+    if (options.light_depth_mm < 0)
+      u.missing.push_back(
+          "the parallax terms (the light's depth behind S unknown: --light-depth-mm)");
+    if (options.meter_uncertainty_percent <= 0)
+      u.missing.push_back("the reference meter's uncertainty (--meter-uncertainty)");
+    if (!u.missing.empty()) {
+      std::string list;
+      for (const std::string& m : u.missing) list += (list.empty() ? "" : "; ") + m;
+      LogWarning("the stated uncertainty leaves out ", list);
+    }
+  }
   if (in.light_depth_mm > 0)
     u.notes.push_back("the light's depth behind S, " + Num(in.light_depth_mm, 4) + " mm, from " +
                       source);
@@ -170,6 +184,11 @@ std::string UncertaintyKeyword(const FarFieldUncertainty& u) {
                               : " (peak)") +
             " " + Percent(t.relative) + ",";
   text.back() = ')';
+  if (!u.missing.empty()) {
+    text += "; not included:";
+    for (const std::string& m : u.missing) text += " " + m + ",";
+    text.pop_back();
+  }
   return text;
 }
 

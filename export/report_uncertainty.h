@@ -26,6 +26,9 @@ struct FarFieldUncertainty {
   double peak_relative = 0;        // of the peak intensity
   double coverage_k = 2;           // the coverage factor of the expanded uncertainty
   std::vector<std::string> notes;  // what is not included, and why
+  // Known terms left out because the lab did not give them (a capture without
+  // --light-depth-mm or --meter-uncertainty): the keyword says so, the commands warn.
+  std::vector<std::string> missing;
   double FluxExpanded() const { return coverage_k * flux_relative; }
   double PeakExpanded() const { return coverage_k * peak_relative; }
 };

@@ -79,14 +79,14 @@ nlohmann::json PhotometricFileInfo(const std::string& path) {
     if (!key.empty()) keywords[key] = value;
   j["keywords"] = keywords;
   // Coverage as lumislab states it: IES [_COVERAGE]; EULUMDAT the measurement report field
-  // (line 8, read as TEST) after "; partial: ".
+  // (line 8, read as TEST) from "partial g<=" (export/coverage.h Coverage::Short).
   if (!d.Keyword("_COVERAGE").empty()) {
     std::string text = d.Keyword("_COVERAGE");  // its [MORE] lines are one sentence
     std::replace(text.begin(), text.end(), '\n', ' ');
     j["coverage"] = text;
   } else {
     const std::string test = d.Keyword("TEST");
-    const size_t at = test.find("partial: ");
+    const size_t at = test.find("partial g<=");
     if (at != std::string::npos) j["coverage"] = test.substr(at);
   }
   return j;

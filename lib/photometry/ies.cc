@@ -334,7 +334,14 @@ std::string FormatIes(const IntensityDistribution& d, const IesWriteOptions& opt
                  std::vector<double>(d.values.begin() + ic * d.gamma_deg.size(),
                                      d.values.begin() + (ic + 1) * d.gamma_deg.size()),
                  7);
-  return os.str();
+  // Lines end in CR LF, as LM-63 asks of every line (ParseIes reads LF and CR LF alike).
+  std::string text;
+  for (char ch : os.str()) {
+    if (ch == '\r') continue;  // a keyword value's own CR: the line ends below
+    if (ch == '\n') text += '\r';
+    text += ch;
+  }
+  return text;
 }
 
 void WriteIes(const IntensityDistribution& d, const std::string& path,

@@ -50,8 +50,8 @@ struct IesWriteOptions {
   std::string file_generation_type = "1.00001";
 };
 
-// LM-63-2019 text: the keywords of `d` (the required ones first), TILT=NONE, absolute
-// photometry (lumens per lamp -1), metres, the luminous opening, the angles and values as
+// LM-63-2019 text, lines ending in CR LF: the keywords of `d` (the required ones first), TILT=NONE,
+// absolute photometry (lumens per lamp -1), metres, the luminous opening, the angles and values as
 // stored. A radiometric distribution is written in W/sr with the keyword [_UNITS] saying so
 // (LM-63 has no radiometric mode; ParseIes reads it back as radiometric).
 std::string FormatIes(const IntensityDistribution& d, const IesWriteOptions& options,

@@ -198,12 +198,29 @@ TEST(ExportFormats, BadInputIsExitTwoAndWritesNothing) {
   // A metadata file fills the keywords; an unknown member is named.
   testing::WriteFile(f.dir + "/meta.json",
                      R"({"schema_version": 1, "test": "R-7", "testlab": "Lab", "manufac": "M",
-                         "keywords": {"LUMCAT": "X-1"}})");
+                         "lumcat": "X-1", "keywords": {"_LAB_NOTE": "note"}})");
   auto r = RunTool("lumislab-export", "ies --slab " + ds + " --out " + ShellQuote(out) +
                                           " --allow-partial --metadata " +
                                           ShellQuote(f.dir + "/meta.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(ReadIes(out).Keyword("LUMCAT"), "X-1");
+  EXPECT_EQ(ReadIes(out).Keyword("_LAB_NOTE"), "note");
+  // What lumislab states itself cannot be given (a forged [_COVERAGE] would sit beside the real
+  // one, and info would read either), nor a keyword that has its own member.
+  for (const char* reserved : {"_COVERAGE", "_UNCERTAINTY", "FILEGENINFO", "LUMCAT"}) {
+    testing::WriteFile(f.dir + "/forged.json",
+                       std::string(R"({"schema_version": 1, "keywords": {")") + reserved +
+                           R"(": "complete: trust me"}})");
+    const auto forged = RunTool("lumislab-export", "ies --slab " + ds + " --out " +
+                                                       ShellQuote(f.dir + "/forged.ies") +
+                                                       " --allow-partial --test T --lab L "
+                                                       "--manufacturer M --metadata " +
+                                                       ShellQuote(f.dir + "/forged.json"));
+    EXPECT_EQ(forged.exit_code, 2) << reserved << "\n" << forged.output;
+    EXPECT_NE(forged.output.find(std::string("keywords.") + reserved), std::string::npos)
+        << forged.output;
+    EXPECT_FALSE(std::filesystem::exists(f.dir + "/forged.ies"));
+  }
   testing::WriteFile(f.dir + "/meta2.json", R"({"schema_version": 1, "tset": "R-7"})");
   r = RunTool("lumislab-export", "ies --force --slab " + ds + " --out " + ShellQuote(out) +
                                      " --metadata " + ShellQuote(f.dir + "/meta2.json"));

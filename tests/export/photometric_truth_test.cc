@@ -121,8 +121,11 @@ TEST(PhotometricTruth, PartialCoverageIsRefusedOrStated) {
   r = RunTool("lumislab-export", refusals[1] + " --allow-partial --test R-2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   j = InfoJson(data.dir + "/x.ldt");
-  EXPECT_EQ(j["coverage"].get<std::string>().rfind("partial: gamma<=37.5 seen", 0), 0u) << j;
-  EXPECT_EQ(j["keywords"]["TEST"].get<std::string>().rfind("R-2; partial: ", 0), 0u) << j;
+  EXPECT_EQ(j["coverage"].get<std::string>().rfind(
+                "partial g<=37.5: unseen 54.2% dirs, 22.6% flux (truth)", 0),
+            0u)
+      << j;
+  EXPECT_EQ(j["keywords"]["TEST"].get<std::string>().rfind("R-2; partial g<=", 0), 0u) << j;
   // (TM-25's texts are UTF-32: a name beyond ASCII round-trips; it was cut to 7 bits.)
   r = RunTool("lumislab-export", refusals[2] + " --allow-partial --name 'Leuchte \u00e9\u00e8'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -247,7 +250,7 @@ TEST(PhotometricTruth, KeywordsInputWattsAndInfo) {
   EXPECT_EQ(text.find(data.dir), std::string::npos) << "an absolute path in the file";
   EXPECT_NE(text.find("[FILEGENINFO] lumislab-export ies from the light slab of ds ("),
             std::string::npos);
-  EXPECT_NE(text.find("[MORE] \u00e9tag\u00e8re\n"), std::string::npos) << text.substr(0, 800);
+  EXPECT_NE(text.find("[MORE] \u00e9tag\u00e8re\r\n"), std::string::npos) << text.substr(0, 800);
   const IntensityDistribution d = ReadIes(data.dir + "/k.ies");
   EXPECT_EQ(d.Keyword("LUMINAIRE"), std::string(239, 'a') + "\n\u00e9tag\u00e8re");
   EXPECT_EQ(d.input_watts, 12.5);
@@ -266,6 +269,63 @@ TEST(PhotometricTruth, KeywordsInputWattsAndInfo) {
                                      "--input-watts 12.5");
   ASSERT_EQ(l.exit_code, 0) << l.output;
   EXPECT_EQ(ReadEulumdat(data.dir + "/k.ldt").input_watts, 12.5);
+}
+
+// The red team's traps (issue 29): --force over the run's own inputs, a grid whose cells reach
+// beyond the seen cone or that is too coarse for the light, a grid of which nothing was seen, an
+// EULUMDAT report number that would cut the coverage statement, an impossible efficacy, and the
+// uncertainty of a capture without the light's depth or the meter's uncertainty.
+TEST(PhotometricTruth, TrapsTheRedTeamFound) {
+  const Dataset data("truth_traps");
+  testing::WriteFile(data.dir + "/ds/dataset.json", "{}");  // a dataset: its folders are inputs
+  const std::string ies = "ies --slab " + data.Ds() + kKeywords;
+  for (const std::string& out :
+       {"ds/slab/slab.json", "ds/slab/new.ies", "ds/dataset.json", "ds/truth/luminaire.json"}) {
+    const auto r = RunTool("lumislab-export", ies +
+                                                  " --force --gamma-angles 0,5,10,15,20,25,30 "
+                                                  "--out " +
+                                                  data.Out(out));
+    EXPECT_EQ(r.exit_code, 2) << out << "\n" << r.output;
+    EXPECT_NE(r.output.find("which lumislab reads"), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(SlabInfo::Load(data.dir + "/ds/slab").units, "lux");  // still the slab's own
+  // Cells: gamma 0 and 180 has one cell over 0-90 (692 % of the light); 90 and 180 saw nothing.
+  auto r = RunTool("lumislab-export", ies + " --gamma-angles 0,180 --out " + data.Out("c.ies"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("the grid is too coarse for this light"), std::string::npos) << r.output;
+  r = RunTool("lumislab-export",
+              ies + " --gamma-angles 90,180 --allow-partial --out " + data.Out("c.ies"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("saw none of the grid's"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(data.dir + "/c.ies"));
+  // EULUMDAT: a report number too long for the coverage statement beside it.
+  r = RunTool("lumislab-export",
+              "ldt --slab " + data.Ds() + " --lab L --manufacturer M --allow-partial --out " +
+                  data.Out("l.ldt") + " --test 'Report 2026/123 for customer ACME, batch 7'");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--test: expected at most"), std::string::npos) << r.output;
+  // 1e-3 W for a luminaire of ~200 lm: 2e5 lm/W.
+  r = RunTool("lumislab-export", ies +
+                                     " --gamma-angles 0,5,10,15,20,25,30 --input-watts 0.001 "
+                                     "--out " +
+                                     data.Out("w.ies"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--input-watts: expected"), std::string::npos) << r.output;
+  // A capture (no truth/): the terms it cannot know are named in the keyword and warned.
+  std::filesystem::remove_all(data.dir + "/ds/truth");
+  r = RunTool("lumislab-export",
+              ies + " --gamma-angles 0,5,10,15,20,25,30 --out " + data.Out("u.ies"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the stated uncertainty leaves out"), std::string::npos) << r.output;
+  const std::string keyword = OneLine(ReadIes(data.dir + "/u.ies").Keyword("_UNCERTAINTY"));
+  EXPECT_NE(keyword.find("not included: the parallax terms"), std::string::npos) << keyword;
+  r = RunTool("lumislab-export", ies +
+                                     " --gamma-angles 0,5,10,15,20,25,30 --light-depth-mm 20 "
+                                     "--meter-uncertainty 2 --force --out " +
+                                     data.Out("u.ies"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(OneLine(ReadIes(data.dir + "/u.ies").Keyword("_UNCERTAINTY")).find("not included"),
+            std::string::npos);
 }
 
 }  // namespace

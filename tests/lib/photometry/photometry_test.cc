@@ -149,7 +149,8 @@ TEST(Ies, RoundTripsThroughTheLm63_2019Writer) {
     if (d.Keyword("TESTLAB").empty()) d.keywords.push_back({"TESTLAB", "lab"});
     if (d.Keyword("ISSUEDATE").empty()) d.keywords.push_back({"ISSUEDATE", "2026-12-02"});
     const std::string text = FormatIes(d, {}, "out.ies");
-    EXPECT_EQ(text.rfind("IES:LM-63-2019\n[TEST]", 0), 0u);
+    EXPECT_EQ(text.rfind("IES:LM-63-2019\r\n[TEST]", 0), 0u);  // CR LF lines, as LM-63 asks
+    EXPECT_EQ(text.find("\n"), text.find("\r\n") + 1);
     const IntensityDistribution back = ParseIes(text, "out.ies");
     EXPECT_EQ(back.format, "IES LM-63-2019");
     ExpectSameDistribution(d, back, r.file);

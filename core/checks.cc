@@ -21,15 +21,6 @@ namespace {
 constexpr int kChecksVersion = 1;
 const char kChecksFile[] = "checks.json";
 
-std::string UtcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
 // An advisory lock on the dataset folder for one read-modify-write of checks.json.
 class FolderLock {
  public:
@@ -124,7 +115,7 @@ void CheckLog::Save() const {
                     {"outcome", CheckOutcomeName(r.outcome)},
                     {"message", r.message},
                     {"values", r.values}});
-  stages[stage_] = {{"time", UtcNow()}, {"checks", list}};
+  stages[stage_] = {{"time", NowUtc("%Y-%m-%dT%H:%M:%SZ")}, {"checks", list}};
   WriteJsonAtomically(path, {{"schema_version", kChecksVersion}, {"stages", stages}});
 }
 

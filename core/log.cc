@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <ctime>
 #include <mutex>
 
 namespace lumislab {
@@ -35,6 +36,15 @@ std::string Utf8Head(const std::string& text, size_t max_bytes) {
   size_t n = std::min(text.size(), max_bytes);
   while (n > 0 && n < text.size() && (static_cast<unsigned char>(text[n]) & 0xC0) == 0x80) --n;
   return text.substr(0, n);
+}
+
+std::string NowUtc(const char* format) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[64];
+  std::strftime(text, sizeof text, format, &tm);
+  return text;
 }
 
 void SetLogLevel(LogLevel level) { g_level = static_cast<int>(level); }

@@ -29,6 +29,9 @@ std::string Num(double v, int digits = 4);
 // byte (10xxxxxx), so that a field cut to a width splits no character.
 std::string Utf8Head(const std::string& text, size_t max_bytes);
 
+// The current time in UTC through strftime's `format` ("%Y-%m-%dT%H:%M:%SZ").
+std::string NowUtc(const char* format);
+
 template <typename... Args>
 void Log(LogLevel level, const Args&... args) {
   if (level < GetLogLevel()) return;

@@ -79,16 +79,6 @@ bool Photometric(const SlabInfo& info) {
   return info.units == "lux";
 }
 
-// The current time in UTC, through strftime's `format`.
-std::string NowUtc(const char* format) {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, format, &tm);
-  return text;
-}
-
 // ---- keywords: flags over a metadata file -------------------------------------------------
 
 struct Keywords {

@@ -106,15 +106,6 @@ ReportColour MakeReportColour(const ReportData& r, const std::vector<SlabPositio
   return c;
 }
 
-std::string ReportNowUtc(const char* format) {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[40];
-  std::strftime(text, sizeof text, format, &tm);
-  return text;
-}
-
 std::string FileTimeUtc(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -305,7 +296,7 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   r.info = SlabInfo::Load(r.slab_dir);
   RequireCompleteSlab(r.info, r.slab_dir);
   r.per_klm = o.per_klm;
-  r.generated_utc = ReportNowUtc("%Y-%m-%d %H:%M UTC");
+  r.generated_utc = NowUtc("%Y-%m-%d %H:%M UTC");
   r.software = std::string("lumislab-export ") + LUMISLAB_VERSION;
   r.title = o.title.empty() ? "Photometric report" : o.title;
   CheckLog checks(r.dataset_dir, "export report");

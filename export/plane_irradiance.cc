@@ -68,20 +68,19 @@ std::string CheckPlaneResolved(const PlaneIrradiance& plane, const SlabInfo& inf
                              Num(refuse_mm, 4) + " mm = " + Num(kPlaneNearFieldRefuseSupports, 3) +
                              " (K + 2) h, trusted from " + Num(warn_mm, 4) +
                              " mm = " + Num(kPlaneNearFieldWarnSupports, 3) + " (K + 2) h)";
-  if (D < refuse_mm || plane.negative_pixels > 0)
-    throw InputError(option, "",
-                     "a plane the exact model resolves: illuminance >= 0, at least " +
-                         Num(refuse_mm, 4) + " mm from S" + limits,
-                     Num(D, 6) + " mm (" + plane.NegativeText(unit) + "); nothing written");
-  if (!(D < warn_mm) && plane.below_zero_pixels == 0) return "";
+  if (D < refuse_mm)
+    throw InputError(option, "", "a plane at least " + Num(refuse_mm, 4) + " mm from S" + limits,
+                     Num(D, 6) + " mm; nothing written");
+  if (!(D < warn_mm) && plane.negative_pixels == 0) return "";
   const std::string text =
       "the plane at " + Num(D, 4) + " mm" +
       (D < warn_mm ? " is nearer S than the exact model is trusted" : std::string()) +
-      (plane.below_zero_pixels > 0
-           ? std::string(D < warn_mm ? "; " : " has ") + std::to_string(plane.below_zero_pixels) +
-                 " pixel(s) below 0 (min " + Num(plane.min_luminance, 4) + " " + unit + ")"
+      (plane.negative_pixels > 0
+           ? std::string(D < warn_mm ? "; " : " has ") + plane.NegativeText(unit) +
+                 ": the dual filter's ringing where the model does not resolve the plane "
+                 "(left as computed, not clamped)"
            : std::string()) +
-      limits;
+      (D < warn_mm ? limits : std::string(" (docs/method.md §4.9)"));
   LogWarning(text);
   return text;
 }

@@ -32,9 +32,12 @@ struct PlaneIrradiance {
 // of its maximum at every D <= 25 mm (min -17278 lx of 401407 at 20 mm, -1.0e7 of 5.0e7 at
 // 1 mm) and none from 30 mm = 2 (K + 2) h; its axial illuminance follows the far field from an
 // effective depth of 27 +- 1 mm behind S for D = 50 ... 200 mm (24 mm at 750) but drifts to 25,
-// 23 and 21 mm at 40, 35 and 30 mm. Hence, in supports' extents (K + 2) h:
-//   D < 2 (K + 2) h, or pixels below -1 % of the maximum: refused (exit 2), nothing written;
-//   D < 3 (K + 2) h, or any pixel below 0: a warning (stderr, and a note at the report's plane).
+// 23 and 21 mm at 40, 35 and 30 mm. Far planes ring too, at their edges beyond the grid's cover
+// (at 4d = 3000 mm over the window: 85 of 14641 pixels, min -1.8 % of the maximum). Hence, in
+// supports' extents (K + 2) h:
+//   D < 2 (K + 2) h: refused (exit 2), nothing written;
+//   D < 3 (K + 2) h, or pixels below -1 % of the maximum: a warning (stderr, and a note at the
+//   report's plane) saying so; the values are left as computed (the EXR is the model's output).
 constexpr double kPlaneNegativeTolerance = 0.01;
 constexpr double kPlaneNearFieldRefuseSupports = 2;
 constexpr double kPlaneNearFieldWarnSupports = 3;

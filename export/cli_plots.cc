@@ -74,6 +74,11 @@ int RunIrradiance(IrradianceOptions o, int threads) {
   const PlaneIrradiance plane = RenderPlaneIrradiance(info, irradiance, o.distance_mm, o.extent_mm,
                                                       o.size, o.samples, threads);
   if (!plane.complete) throw Failure("stopped by a signal; " + o.out + " not written");
+  const std::string unit = IrradianceUnitLabel(info.units);
+  LogInfo("plane at ", plane.plane_z_mm, " mm: luminance min ", Num(plane.min_luminance, 6),
+          " max ", Num(plane.max_luminance, 6), " ", unit, ", ", plane.negative_pixels,
+          " pixel(s) below -", Num(100 * kPlaneNegativeTolerance, 2), " % of the maximum");
+  CheckPlaneResolved(plane, info, unit, "--distance-mm");
   const ImageF& irradiance_image = plane.irradiance;
   if (ext == ".exr") {
     WriteExr(o.out, irradiance_image, {"R", "G", "B"});

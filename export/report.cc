@@ -38,6 +38,7 @@ namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kChromiumTimeoutS = 120;
+constexpr double kMaxEfficacy = 683;  // lm/W: K_m, monochromatic 555 nm (SI candela definition)
 
 // The colour section: the chromaticity and CCT of the slab's total light and of the far field
 // per direction through the dataset's camera colour calibration (calib/colour.json,
@@ -56,6 +57,7 @@ ReportColour MakeReportColour(const ReportData& r, const std::vector<SlabPositio
   c.x = total.xy.x();
   c.y = total.xy.y();
   c.cct_k = total.cct.kelvin;
+  c.duv = total.cct.duv;
   c.rows.push_back("Duv (total light): " + Num(total.cct.duv, 3));
   c.rows.push_back("camera RGB -> CIE XYZ: " + calibration->chart + " under " +
                    calibration->illuminant + ", fit Delta E*ab mean " +
@@ -183,6 +185,7 @@ ReportPlane MakePlane(const ReportData& r, const std::vector<ImageF>& irradiance
       RenderPlaneIrradiance(r.info, irradiance, D, 0, o.plane_size, o.plane_samples, threads);
   if (!p.complete) throw Failure("stopped by a signal; " + o.out + " not written");
   ReportPlane plane;
+  plane.note = CheckPlaneResolved(p, r.info, r.IlluminanceUnit(), "--distances-mm");
   plane.distance_mm = p.plane_z_mm;
   plane.extent_mm = p.extent_mm;
   plane.size = o.plane_size;
@@ -298,7 +301,6 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   r.per_klm = o.per_klm;
   r.generated_utc = NowUtc("%Y-%m-%d %H:%M UTC");
   r.software = std::string("lumislab-export ") + LUMISLAB_VERSION;
-  r.title = o.title.empty() ? "Photometric report" : o.title;
   CheckLog checks(r.dataset_dir, "export report");
   std::vector<SlabPosition> positions = ReadSlabPositions(r.slab_dir, r.info, threads);
   CheckSlabLight(r.info, positions, r.slab_dir, checks);
@@ -316,12 +318,25 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   d.values = ff.values;
   for (double& v : d.values) v = std::max(v, 0.0);  // the fit's ringing: no negative intensity
   d.photometric = r.info.units == "lux";
+  // A W/m^2 (or relative) slab gives W/sr and W: not a photometric report (issue 29 red team).
+  r.title = !o.title.empty() ? o.title
+            : d.photometric  ? "Photometric report"
+                             : "Radiometric report";
   if (o.per_klm && !d.photometric)
     LogWarning("--per-klm: the slab is in ", r.info.units,
                " units, not lux: the diagrams stay in W/sr (cd/klm needs lm)");
   d.input_watts = o.input_watts;
   r.seen = ff.seen;
   r.summary = SummarisePhotometry(d, r.seen);
+  // The seen flux alone already bounds the efficacy from below: above the luminous efficacy of
+  // monochromatic 555 nm light (683 lm/W, the most any source can have) the power is wrong.
+  if (d.photometric && o.input_watts > 0 && !(r.summary.total_flux / o.input_watts <= kMaxEfficacy))
+    throw InputError(
+        "--input-watts", "",
+        "the luminaire's input power: at most " + Num(kMaxEfficacy, 4) +
+            " lm/W (555 nm light) for the " + Num(r.summary.total_flux, 6) +
+            " lm seen, i.e. >= " + Num(r.summary.total_flux / kMaxEfficacy, 6) + " W",
+        Num(o.input_watts, 8) + " W (" + Num(r.summary.total_flux / o.input_watts, 6) + " lm/W)");
   r.seen_cone_deg = SeenConeDeg(d, r.seen);
   r.flux_in_cone = d.FluxWithin(r.seen_cone_deg);
   IntensityDistribution seen_sr = d;  // the zonal sum of 0/1: the seen solid angle

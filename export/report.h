@@ -46,13 +46,15 @@ struct ReportPlane {
   int size = 0;
   std::vector<double> profile_x_mm, profile_slab, profile_far;  // far: NaN where not seen
   double centre_slab = 0, centre_far = 0;
+  std::string note;  // CheckPlaneResolved's warning: nearer S than the model is trusted (or "")
 };
 
 // The colour section's content (calib/colour.json through lib/lightfield/light_colour.h);
 // present = false when the dataset has no colour calibration.
 struct ReportColour {
   bool present = false;
-  double x = 0, y = 0, cct_k = 0;  // the total light's chromaticity and CCT
+  double x = 0, y = 0, cct_k = 0;  // the total light's chromaticity and CCT (NaN: none)
+  double duv = 0;                  // the total light's Duv (CCT is NaN beyond |Duv| 0.05)
   std::string source;              // the calibration file, relative to the dataset
   std::vector<std::string> rows;   // Duv, the CCT's range over directions
   // Per direction: x, y and CCT (NaN where not seen or without a chromaticity) at

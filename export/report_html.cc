@@ -94,7 +94,12 @@ void Summary(Page& p) {
                      Deg(r.seen_cone_deg)
                : std::string()) +
           ")</span>");
-  if (s.efficacy > 0)
+  if (s.efficacy > 0 && r.seen_fraction < 1 - 1e-9)  // the unseen flux is not in it
+    row("Luminous efficacy (seen flux)",
+        "&ge; " + Fmt(s.efficacy, 4) + " lm/W at " + Fmt(s.input_watts, 4) +
+            " W <span class=note>(a lower bound: the flux of the seen directions only, " +
+            Num(100 * r.seen_fraction, 3) + " % of the hemisphere)</span>");
+  else if (s.efficacy > 0)
     row("Luminous efficacy", Fmt(s.efficacy, 4) + " lm/W at " + Fmt(s.input_watts, 4) + " W");
   else
     row("Luminous efficacy", s.input_watts > 0 ? "\u2014 (not photometric units)"
@@ -103,7 +108,8 @@ void Summary(Page& p) {
   if (!r.distribution.photometric)
     h << "<p class=\"note warn\">The slab is in " << HtmlEscape(r.info.units)
       << " units: intensities are W/sr and fluxes W (radiometric). Calibrate the scale with a lux "
-         "meter (lumislab-calibrate scale --unit lux) for cd and lm.</p>\n";
+         "meter (lumislab-calibrate scale --unit lux) for cd and lm." +
+             std::string(r.per_klm ? " --per-klm is ignored: cd/klm needs lm." : "") + "</p>\n";
   h << "</section>\n";
 }
 
@@ -346,7 +352,9 @@ void Planes(Page& p) {
     h << "</svg><figcaption>D = " << Num(plane.distance_mm, 5) << " mm, " << r.IlluminanceUnit()
       << ", 0 (dark) to " << Fmt(top, 4) << " (yellow), viridis. Red cross: the luminaire's axis "
       << "(x = y = 0); white line 50 %, orange 10 % of the plane's maximum. +x right, +y up: "
-      << "the view from beyond the plane towards the luminaire.</figcaption></figure>\n";
+      << "the view from beyond the plane towards the luminaire.";
+    if (!plane.note.empty()) h << " <b class=warn>Warning: " << HtmlEscape(plane.note) << ".</b>";
+    h << "</figcaption></figure>\n";
   }
   h << "</div></section>\n";
 }
@@ -370,7 +378,9 @@ void NearField(Page& p) {
     h << "<tr><td>" << Num(plane.distance_mm, 5) << "</td><td>" << Fmt(plane.centre_slab, 5)
       << "</td><td>" << Fmt(plane.centre_far, 5) << "</td><td>"
       << Fmt(100 * (plane.centre_far / plane.centre_slab - 1), 3) << " %</td><td>"
-      << Fmt(top > 0 ? 100 * worst / top : NAN, 3) << " %</td></tr>\n";
+      << Fmt(top > 0 ? 100 * worst / top : NAN, 3) << " %"
+      << (plane.note.empty() ? "" : " <b class=warn>(too near S: see its picture)</b>")
+      << "</td></tr>\n";
   }
   h << "</table><div class=figs>\n";
   for (const ReportPlane& plane : r.planes) {
@@ -460,8 +470,12 @@ void Colour(Page& p) {
     return;
   }
   h << "<table><tr><th class=l>chromaticity x, y (total light)</th><td>" << Fmt(c.x, 4) << ", "
-    << Fmt(c.y, 4) << "</td></tr><tr><th class=l>CCT</th><td>" << Fmt(c.cct_k, 4)
-    << " K</td></tr>\n";
+    << Fmt(c.y, 4) << "</td></tr><tr><th class=l>CCT</th><td>"
+    << (std::isfinite(c.cct_k) ? Fmt(c.cct_k, 4) + " K"
+                               : "no CCT (Duv " + Fmt(c.duv, 3) +
+                                     ": CCT is defined within |Duv| &le; 0.05 of the Planckian "
+                                     "locus, CIE 15 / ANSI C78.377)")
+    << "</td></tr>\n";
   for (const std::string& row : c.rows)
     h << "<tr><td class=l colspan=2>" << HtmlEscape(row) << "</td></tr>\n";
   h << "</table>\n";
@@ -476,13 +490,16 @@ void Colour(Page& p) {
         if (std::isfinite(cell.cct_k))
           h << "<td>" << Fmt(cell.cct_k, 4) << " K<br><small>" << Fmt(cell.x, 4) << ", "
             << Fmt(cell.y, 4) << "</small></td>";
+        else if (std::isfinite(cell.x) && std::isfinite(cell.y))
+          h << "<td>no CCT<br><small>" << Fmt(cell.x, 4) << ", " << Fmt(cell.y, 4)
+            << "</small></td>";
         else
           h << "<td>&mdash;</td>";
       }
       h << "</tr>\n";
     }
     h << "</table><p class=note>CCT and chromaticity x, y per direction (&mdash;: not seen or "
-         "no chromaticity).</p>\n";
+         "no chromaticity; no CCT: |Duv| &gt; 0.05).</p>\n";
   }
   h << "<p class=note>From " << HtmlEscape(c.source) << ".</p></section>\n";
 }

@@ -122,6 +122,7 @@ Cct CctFromXy(const Eigen::Vector2d& xy) {
   const Eigen::Vector2d on_locus = PlanckianUv(mired);
   cct.duv = std::copysign((uv - on_locus).norm(), uv.y() - on_locus.y());
   if (mired <= kMinMired + 1e-6 || mired >= kMaxMired - 1e-6) cct.kelvin = kNaN;
+  if (!(std::abs(cct.duv) <= kCctMaxAbsDuv)) cct.kelvin = kNaN;  // no CCT this far off the locus
   return cct;
 }
 

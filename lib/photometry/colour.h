@@ -44,13 +44,20 @@ Eigen::Vector2d XyToUv1960(const Eigen::Vector2d& xy);
 // Chromaticity of the blackbody at `kelvin` (computed from Blackbody and Cmf1931).
 Eigen::Vector2d PlanckianXy(double kelvin);
 
+// CCT is defined only near the Planckian locus: CIE 15:2018 §9.5 and ANSI C78.377 use it within
+// |Duv| <= 0.05 of the locus; farther away no temperature "correlates" and `kelvin` is NaN.
+constexpr double kCctMaxAbsDuv = 0.05;
+
 struct Cct {
-  double kelvin = 0;  // correlated colour temperature; NaN outside [1000, 25000] K
-  double duv = 0;     // signed distance to the Planckian locus in CIE 1960 (u, v), + above it
+  // Correlated colour temperature; NaN outside [1000, 25000] K or for |duv| > kCctMaxAbsDuv.
+  double kelvin = 0;
+  double duv = 0;  // signed distance to the Planckian locus in CIE 1960 (u, v), + above it; kept
+                   // (finite) for any finite xy, also where kelvin is NaN
 };
 // The CCT of (x, y) by its definition (CIE 15): the temperature of the Planckian point nearest in
 // CIE 1960 (u, v), found on a 1-mired table of the locus and refined by golden-section search.
-// Exact to well below 1 K against PlanckianXy (the locus computed from the 5 nm tables).
+// Exact to well below 1 K against PlanckianXy (the locus computed from the 5 nm tables). Off the
+// locus by more than kCctMaxAbsDuv: kelvin NaN, duv the distance (say "no CCT (Duv ...)").
 Cct CctFromXy(const Eigen::Vector2d& xy);
 
 // CIE 1976 L*a*b* of xyz against the white `white_xyz` (same units), and Delta E*ab.

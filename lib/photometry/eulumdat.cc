@@ -373,7 +373,10 @@ std::string FormatEulumdat(const IntensityDistribution& d, const std::string& na
                      Num(sets[s].watts, 8));
   }
   const double lamp_flux = sets[0].flux_lm;  // the intensities are per 1000 lm of it
-  const bool round = d.opening.width_mm < 0 || d.opening.length_mm < 0;
+  // One shape in IES and LDT alike: what EULUMDAT cannot hold (an ellipse, mixed signs) is
+  // refused, not turned into a circle (issue 29 red team: -40,-30,0 became a 30 mm circle).
+  CheckPortableOpening(d.opening, name, "luminous opening");
+  const bool round = d.opening.width_mm < 0;  // then length = width: the diameter
   const double length = std::abs(d.opening.length_mm);
   const double width = round ? 0.0 : std::abs(d.opening.width_mm);
   const double height = std::abs(d.opening.height_mm);

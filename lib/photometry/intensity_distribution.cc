@@ -155,6 +155,25 @@ void IntensityDistribution::Check(const std::string& file) const {
                          Num(*std::max_element(values.begin(), values.end()), 8) + ")");
 }
 
+void CheckPortableOpening(const LuminousOpening& o, const std::string& where,
+                          const std::string& field) {
+  const double w = o.width_mm, l = o.length_mm, h = o.height_mm;
+  const bool finite = std::isfinite(w) && std::isfinite(l) && std::isfinite(h);
+  const bool point = w == 0 && l == 0 && h >= 0;  // EULUMDAT: a round area of diameter 0
+  const bool box = w > 0 && l > 0 && h >= 0;
+  const bool round = w < 0 && l == w && h >= 0;
+  if (finite && (point || box || round)) return;
+  throw InputError(
+      where, field,
+      "an opening IES and EULUMDAT both hold (width,length,height mm): 0,0,height "
+      ">= 0 (a point), both sides > 0 and height >= 0 (a rectangle or box), or -D,-D,height "
+      ">= 0 (a circle or vertical cylinder of diameter D)",
+      Num(w, 8) + "," + Num(l, 8) + "," + Num(h, 8) +
+          (finite && w < 0 && l < 0 && w != l ? " (an ellipse: EULUMDAT has none)"
+           : finite && h < 0                  ? " (a negative height: EULUMDAT has none)"
+                                              : ""));
+}
+
 double IntensityDistribution::Intensity(double c_in, double gamma) const {
   size_t ig;
   double fg;

@@ -31,6 +31,17 @@ struct LuminousOpening {
   double height_mm = 0;
 };
 
+// The openings both IES and EULUMDAT hold alike (LM-63-2019 §5.10 / Annex D's shapes; EULUMDAT's
+// luminous area: length or diameter, width 0 = round, heights): a point (0, 0, height >= 0), a
+// rectangle or box (width > 0, length > 0, height >= 0), a circle or vertical cylinder (width =
+// length < 0, the diameter, height >= 0). Ellipses, mixed signs, a zero side beside a non-zero one
+// (EULUMDAT reads width 0 as round) and a negative height (LM-63's spheres and horizontal
+// cylinders) are refused: InputError(where, field, ...), exit 2. The EULUMDAT writer checks its
+// opening, and `lumislab-export` checks --opening-mm with it, so an IES and an LDT file describe
+// one shape.
+void CheckPortableOpening(const LuminousOpening& o, const std::string& where,
+                          const std::string& field);
+
 struct IntensityDistribution {
   std::string format;             // "IES LM-63-2002", "EULUMDAT", ... (what it was read as)
   std::vector<double> c_deg;      // strictly increasing, one of CSymmetry's ranges

@@ -65,6 +65,29 @@ TEST_F(ExportPlots, IrradianceOnThePlaneAtD) {
   EXPECT_EQ(picture.cols, 64 + BarPanelWidth(64));
 }
 
+// Issue 29 red team: planes near S had negative lux written (min -1.6e6 lx at 2 mm, -16341 at
+// 20 mm). Below 2 (K + 2) h = 30 mm (h 5, K 1): exit 2 naming --distance-mm, nothing written;
+// below 3 (K + 2) h = 45 mm: written with a warning (docs/method.md §4.9 "Planes near S").
+TEST_F(ExportPlots, PlanesNearSAreRefusedOrWarned) {
+  for (const char* d : {"2", "20", "29"}) {
+    const std::string out = Out(std::string("near") + d + ".exr");
+    EXPECT_EQ(RunExportWith({"irradiance", "--slab", Slab(), "--distance-mm", d, "--extent-mm",
+                             "60", "--size", "16", "--samples", "1", "--out", out}),
+              2)
+        << d;
+    EXPECT_FALSE(std::filesystem::exists(out)) << d;
+  }
+  const std::string out = Out("near40.exr");
+  testing::internal::CaptureStderr();
+  const int code =
+      RunExportWith({"irradiance", "--slab", Slab(), "--distance-mm", "40", "--extent-mm", "60",
+                     "--size", "16", "--samples", "1", "--out", out});
+  const std::string err = testing::internal::GetCapturedStderr();
+  ASSERT_EQ(code, 0) << err;
+  EXPECT_NE(err.find("nearer S than the exact model is trusted"), std::string::npos) << err;
+  EXPECT_EQ(ReadExr(out, {"R", "G", "B"}).width, 16);
+}
+
 TEST_F(ExportPlots, PolarPlotSvgAndPng) {
   const std::string svg = Out("p.svg"), png = Out("p.png");
   ASSERT_EQ(RunExportWith({"polar", "--slab", Slab(), "--gamma-step", "5", "--out", svg}), 0);

@@ -21,6 +21,7 @@
 #include "core/geometry.h"
 #include "core/log.h"
 #include "core/slab_light.h"
+#include "export/report_svg.h"
 #include "export/report_uncertainty.h"
 #include "lib/photo/photo_write.h"
 #include "lib/synthetic/spectral.h"
@@ -154,6 +155,31 @@ TEST_F(ExportReport, HtmlStatesCoverageAndIsSelfContained) {
     EXPECT_EQ(text.find(external), std::string::npos) << external;
   EXPECT_EQ(RunExportWith({"report", "--slab", (dir_ / "ds").string(), "--out", html}), 2);
   EXPECT_EQ(RunExportWith({"report", "--slab", (dir_ / "ds").string(), "--out", Out("x.pdf")}), 2);
+}
+
+// Issue 29 red team, planes near S and a W/m^2 slab: --distances-mm 20 (below 2 (K + 2) h = 30
+// mm) is exit 2 naming it, nothing written; 40 mm (below 3 (K + 2) h) is drawn with a warning at
+// that plane. The title says radiometric, and --per-klm's being ignored is in the HTML.
+TEST_F(ExportReport, NearPlanesRadiometricTitleAndPerKlmNote) {
+  const std::string html = Out("near.html");
+  EXPECT_EQ(RunExportWith({"report", "--slab", (dir_ / "ds").string(), "--out", html,
+                           "--plane-size", "16", "--distances-mm", "20,750"}),
+            2);
+  EXPECT_FALSE(fs::exists(html));
+  ReportOptions o = Options();
+  o.plane_size = 16;
+  o.distances_mm = {40, 750};
+  o.per_klm = true;
+  const ReportData r = MakeReportData(o, 2);
+  ASSERT_EQ(r.planes.size(), 2u);
+  EXPECT_NE(r.planes[0].note.find("nearer S than the exact model is trusted"), std::string::npos)
+      << r.planes[0].note;
+  EXPECT_EQ(r.planes[1].note, "");
+  const std::string text = ReportHtml(r);
+  EXPECT_NE(text.find("Warning: the plane at 40 mm"), std::string::npos);
+  EXPECT_NE(text.find("Radiometric report"), std::string::npos);
+  EXPECT_EQ(text.find("Photometric report"), std::string::npos);
+  EXPECT_NE(text.find("--per-klm is ignored"), std::string::npos);
 }
 
 // --pdf without a Chromium to run: exit 1 naming what to install, the HTML written.
@@ -300,6 +326,20 @@ TEST(ExportReportLux, PhotometricUnitsEfficacyAndPerKlm) {
   const double per_klm = r.summary.PerKlm(r.distribution.At(0, 0));
   EXPECT_NE(html.find("<th>0&deg;</th><td>" + Num(per_klm, 4) + "</td>"), std::string::npos)
       << Num(per_klm, 4);
+  // Issue 29 red team: the efficacy of a partial cone is over the seen flux only, a lower bound;
+  // an input power above 683 lm/W (K_m) is exit 2 naming --input-watts.
+  ASSERT_LT(r.seen_fraction, 1);
+  EXPECT_NE(html.find("Luminous efficacy (seen flux)"), std::string::npos);
+  EXPECT_NE(html.find("a lower bound"), std::string::npos);
+  EXPECT_EQ(html.find("Photometric report"), html.find("<title>") + 7) << "lux: photometric";
+  o.input_watts = 1e-300;
+  try {
+    MakeReportData(o, 2);
+    ADD_FAILURE() << "1e-300 W accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.exit_code(), 2);
+    EXPECT_EQ(std::string(e.what()).rfind("--input-watts", 0), 0u) << e.what();
+  }
   fs::remove_all(dir);
 }
 
@@ -354,6 +394,22 @@ TEST(ExportReportColour, CctOfTheTotalLightAndPerDirection) {
       EXPECT_EQ(html.find("No colour calibration"), std::string::npos);
     }
   }
+  // Issue 29 red team: a calibration that puts the light far off the Planckian locus (X, Z swapped
+  // gave "CCT 1.684e+04 K" at Duv 0.0965; here X and Z a third of Y's row, a green far above the
+  // locus): no CCT, the Duv said.
+  ColourCalibration swapped = calibration;
+  swapped.rgb_to_xyz << 0.3, 0, 0, 0, 1, 0, 0, 0, 0.3;
+  SaveColourCalibration((dir / "ds/calib/colour.json").string(), swapped, fit_report);
+  ReportOptions o;
+  o.slab = (dir / "ds").string();
+  o.out = (dir / "r.html").string();
+  o.plane_size = 16;
+  o.distances_mm = {750};
+  const ReportData r = MakeReportData(o, 2);
+  std::printf("off the locus: x %.4f y %.4f, Duv %.4f\n", r.colour.x, r.colour.y, r.colour.duv);
+  EXPECT_TRUE(std::isnan(r.colour.cct_k)) << r.colour.cct_k;
+  EXPECT_GT(std::abs(r.colour.duv), 0.05);
+  EXPECT_NE(ReportHtml(r).find("no CCT (Duv " + Fmt(r.colour.duv, 3)), std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -49,6 +49,27 @@ TEST(Colour, CctOfThePlanckianLocusIsItsTemperature) {
   EXPECT_NEAR(cct.duv, 0.01, 1e-5);
 }
 
+// Issue 29 red team: a colour.json swapping X and Z gave "CCT 1.684e+04 K" at Duv 0.0965. CCT is
+// defined within |Duv| <= 0.05 (CIE 15, ANSI C78.377): beyond, kelvin NaN and Duv kept.
+TEST(Colour, NoCctFarOffTheLocus) {
+  const Eigen::Vector2d uv = XyToUv1960(PlanckianXy(4000));
+  const Eigen::Vector2d uv2 = XyToUv1960(PlanckianXy(4001));
+  const Eigen::Vector2d tangent = (uv2 - uv).normalized();
+  Eigen::Vector2d normal(-tangent.y(), tangent.x());
+  if (normal.y() < 0) normal = -normal;
+  auto at = [&](double duv) {
+    const Eigen::Vector2d off = uv + duv * normal;
+    const double d = 2 * off.x() - 8 * off.y() + 4;
+    return CctFromXy({3 * off.x() / d, 2 * off.y() / d});
+  };
+  EXPECT_NEAR(at(0.049).kelvin, 4000, 3);
+  for (double duv : {0.051, -0.051, 0.0965}) {
+    const Cct c = at(duv);
+    EXPECT_TRUE(std::isnan(c.kelvin)) << duv << ": " << c.kelvin;
+    EXPECT_NEAR(c.duv, duv, 1e-4);
+  }
+}
+
 TEST(Colour, CctOfDaylightIsThePublishedOne) {
   // D65: CCT 6504 K, Duv +0.0032 (CIE 15; ANSI C78.377 sign, above the locus).
   const Cct d65 = CctFromXy(XyzToXy(SpectrumToXyz(IlluminantD65())));

@@ -223,6 +223,38 @@ TEST(Eulumdat, ReadsTheIsymLayoutsAndDecimalCommas) {
       << message;
 }
 
+// Issue 29 red team: --opening-mm -40,-30,0 gave an ellipse in IES and a 30 mm circle in LDT,
+// and mixed signs passed. One check (CheckPortableOpening) keeps the shapes both formats hold;
+// the EULUMDAT writer refuses the others instead of turning them into a circle.
+TEST(Opening, OnlyShapesIesAndLdtBothHold) {
+  for (const LuminousOpening& ok : std::vector<LuminousOpening>{
+           {0, 0, 0}, {20, 30, 0}, {20, 30, 5}, {-30, -30, 0}, {-30, -30, 10}})
+    EXPECT_NO_THROW(CheckPortableOpening(ok, "--opening-mm", ""))
+        << ok.width_mm << "," << ok.length_mm << "," << ok.height_mm;
+  for (const LuminousOpening& bad : std::vector<LuminousOpening>{{-40, -30, 0},
+                                                                 {-50, 40, 0},
+                                                                 {50, -40, 0},
+                                                                 {0, 30, 0},
+                                                                 {20, 0, 0},
+                                                                 {-30, -30, -30},
+                                                                 {20, 30, -5},
+                                                                 {std::nan(""), 1, 1}}) {
+    const auto [code, message] = Thrown([&] { CheckPortableOpening(bad, "--opening-mm", ""); });
+    EXPECT_EQ(code, 2);
+    EXPECT_EQ(message.rfind("--opening-mm", 0), 0u) << message;
+  }
+  IntensityDistribution d = Analytic({0}, [](double) { return 1.0; });
+  d.opening = {-40, -30, 0};
+  const auto [code, message] = Thrown([&] { FormatEulumdat(d, "e.ldt", {}); });
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(message.find("ellipse"), std::string::npos) << message;
+  // A circle: IES's -D,-D and EULUMDAT's diameter D with width 0 read back as the same shape.
+  d.opening = {-30, -30, 0};
+  const IntensityDistribution back = ParseEulumdat(FormatEulumdat(d, "e.ldt", {}), "e.ldt");
+  EXPECT_DOUBLE_EQ(back.opening.width_mm, -30);
+  EXPECT_DOUBLE_EQ(back.opening.length_mm, -30);
+}
+
 std::string ReadText(const std::string& path) { return ReadTextFile(path); }
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {

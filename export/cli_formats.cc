@@ -539,7 +539,9 @@ int RunFarField(const FarFieldCommand& c, int threads) {
           " accredited=", c.accredited ? "yes" : "no",
           " lumen_scaled=", c.lumen_scaled ? "yes" : "no", " input_watts=", c.input_watts);
   CheckExportOutput(c.out, c.force);
-  DirectionGrid(c);  // refuses a bad grid before the slab is read, and bad keywords
+  DirectionGrid(c);              // refuses a bad grid before the slab is read, and bad keywords
+  if (c.opening_mm.size() == 3)  // one shape IES and EULUMDAT both hold
+    CheckPortableOpening({c.opening_mm[0], c.opening_mm[1], c.opening_mm[2]}, "--opening-mm", "");
   const auto keywords = ResolveKeywords(c.keywords);
   if (c.format == "ies") CheckIesRequiredKeywords(keywords, c.out);
   RequireLuxSlab(c.slab, c.format == "ies" ? "IES" : "EULUMDAT");

@@ -311,6 +311,17 @@ TEST(PhotometricTruth, TrapsTheRedTeamFound) {
                                      data.Out("w.ies"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--input-watts: expected"), std::string::npos) << r.output;
+  // An elliptical opening: IES has one, EULUMDAT not (it wrote a circle); refused for both.
+  for (const char* format : {"ies", "ldt"}) {
+    r = RunTool("lumislab-export", std::string(format) + " --slab " + data.Ds() + kKeywords +
+                                       " --gamma-angles 0,5,10,15,20,25,30 --opening-mm "
+                                       "-40,-30,0 --out " +
+                                       data.Out(std::string("o.") + format));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--opening-mm: expected an opening IES and EULUMDAT both hold"),
+              std::string::npos)
+        << r.output;
+  }
   // A capture (no truth/): the terms it cannot know are named in the keyword and warned.
   std::filesystem::remove_all(data.dir + "/ds/truth");
   r = RunTool("lumislab-export",

@@ -20,8 +20,7 @@ nlohmann::json SlabLightValues(const SlabLight& light) {
 }
 
 SlabLightSum::SlabLightSum(const SlabInfo& info, const Eigen::Vector3d& channel_weights)
-    : info_(info),
-      weights_(channel_weights),
+    : weights_(channel_weights),
       area_m2_(info.layout.TexelW() * info.layout.TexelH() * 1e-6),
       texel_flux_(size_t(info.layout.res_x) * info.layout.res_y, 0.0) {}
 

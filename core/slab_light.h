@@ -48,7 +48,6 @@ class SlabLightSum {
   SlabLight Result() const;
 
  private:
-  const SlabInfo& info_;
   Eigen::Vector3d weights_;
   double area_m2_;
   std::vector<double> texel_flux_;

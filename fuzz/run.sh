@@ -6,7 +6,7 @@
 # Usage: fuzz/run.sh [seconds per target] [fuzz build folder]
 #   defaults: 25 s, build-fuzz (configure it as scripts/test.sh does, or see fuzz/README.md);
 #   0 s replays the seed corpus once without mutating it (deterministic). CI does not replay:
-#   scripts/test.sh mutates each target for LUMISLAB_FUZZ_SECONDS (15) from -seed=1
+#   scripts/test.sh mutates each target for LUMISLAB_FUZZ_SECONDS (10) from -seed=1
 # Environment:
 #   LUMISLAB_FUZZ_TARGETS  space-separated targets to run (default: all of fuzz/corpus/)
 #   LUMISLAB_FUZZ_JOBS     targets run side by side (default: nproc)

@@ -7,7 +7,7 @@
 #                  build-asan/, and ctest over the tiers where memory errors live (below; fuzz/
 #                  sanitizers/ holds the run-time options and the third-party suppressions)
 #   4. fuzz:       the libFuzzer targets of fuzz/ built into build-fuzz/, each run for
-#                  LUMISLAB_FUZZ_SECONDS (default 15) on its seed corpus, mutating from a fixed
+#                  LUMISLAB_FUZZ_SECONDS (default 10) on its seed corpus, mutating from a fixed
 #                  seed (-seed=1; LUMISLAB_FUZZ_ARGS overrides) so that a finding in CI replays
 #                  on another machine (fuzz/run.sh; 0 s replays every seed once)
 # Every stage runs even when an earlier one failed; each prints a summary line, and the script
@@ -30,7 +30,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
-fuzz_seconds=${LUMISLAB_FUZZ_SECONDS:-15}
+fuzz_seconds=${LUMISLAB_FUZZ_SECONDS:-10}
 # The sanitizer and fuzz builds: -O2 with line tables (readable stack traces). Not -O1: Eigen
 # needs its inlining: at -O1 under ASan the calibrate tests run many times slower than Release.
 # Unity builds and lld, as scripts/setup.sh's.

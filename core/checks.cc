@@ -75,7 +75,12 @@ const char* CheckOutcomeName(CheckOutcome outcome) {
 }
 
 CheckLog::CheckLog(std::string dataset_dir, std::string stage)
-    : dir_(std::move(dataset_dir)), stage_(std::move(stage)) {}
+    : dir_(std::move(dataset_dir)), stage_(std::move(stage)) {
+  // A stage killed while saving leaves its checks.json temporary in the dataset folder; a rerun
+  // that has nothing to redo would not write checks.json again, so the orphan goes here (only
+  // those of processes that no longer run).
+  if (!dir_.empty() && std::filesystem::is_directory(dir_)) RemoveOrphanedTemporaries(dir_);
+}
 
 void CheckLog::Pass(const std::string& check, const std::string& message, nlohmann::json values) {
   LogDebug(check, ": ", message);

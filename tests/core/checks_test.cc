@@ -75,5 +75,20 @@ TEST(Checks, AForeignRecordIsReplacedAndNoFolderMeansNoRecord) {
   EXPECT_EQ(FormatCheckReport(FreshFolder("none")), "");
 }
 
+// A stage killed while saving leaves .checks.tmp<pid>_<n>.json; the next stage on the dataset
+// removes it even when it has nothing to save (e2e.FaultInjection.CalibrateScreen found one left
+// after a rerun that skipped its finished work). A live process's temporary stays.
+TEST(Checks, AKilledSavesTemporaryIsRemovedByTheNextStage) {
+  const std::string dir = FreshFolder("orphan");
+  // pid 2^22 + 1 is above Linux's pid_max limit: no process has it.
+  const std::string orphan = dir + "/.checks.tmp4194305_1.json";
+  const std::string live = dir + "/.checks.tmp" + std::to_string(getpid()) + "_1.json";
+  std::ofstream(orphan) << "{";
+  std::ofstream(live) << "{";
+  CheckLog rerun(dir, "calibrate screen");
+  EXPECT_FALSE(std::filesystem::exists(orphan));
+  EXPECT_TRUE(std::filesystem::exists(live));
+}
+
 }  // namespace
 }  // namespace lumislab

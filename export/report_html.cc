@@ -106,7 +106,7 @@ void Summary(Page& p) {
                                                : "\u2014 (input power not given: --input-watts)");
   h << "</table>\n";
   if (!r.distribution.photometric)
-    h << "<p class=\"note warn\">The slab is in " << HtmlEscape(r.info.units)
+    h << "<p class=\"note warn\">The slab is in " << XmlEscape(r.info.units)
       << " units: intensities are W/sr and fluxes W (radiometric). Calibrate the scale with a lux "
          "meter (lumislab-calibrate scale --unit lux) for cd and lm." +
              std::string(r.per_klm ? " --per-klm is ignored: cd/klm needs lm." : "") + "</p>\n";
@@ -353,7 +353,7 @@ void Planes(Page& p) {
       << ", 0 (dark) to " << Fmt(top, 4) << " (yellow), viridis. Red cross: the luminaire's axis "
       << "(x = y = 0); white line 50 %, orange 10 % of the plane's maximum. +x right, +y up: "
       << "the view from beyond the plane towards the luminaire.";
-    if (!plane.note.empty()) h << " <b class=warn>Warning: " << HtmlEscape(plane.note) << ".</b>";
+    if (!plane.note.empty()) h << " <b class=warn>Warning: " << XmlEscape(plane.note) << ".</b>";
     h << "</figcaption></figure>\n";
   }
   h << "</div></section>\n";
@@ -444,18 +444,18 @@ void Uncertainty(Page& p) {
   h << "<section><h2>Uncertainty</h2><table><tr><th class=l>term</th><th>relative standard "
        "uncertainty</th><th class=l>for</th><th class=l>basis</th></tr>\n";
   for (const UncertaintyTerm& t : u.terms)
-    h << "<tr><td class=l>" << HtmlEscape(t.name) << "</td><td>" << Num(100 * t.relative, 2)
+    h << "<tr><td class=l>" << XmlEscape(t.name) << "</td><td>" << Num(100 * t.relative, 2)
       << " %</td><td class=l>"
       << (t.flux && t.peak ? "both"
           : t.flux         ? "flux"
                            : "peak")
-      << "</td><td class=l>" << HtmlEscape(t.basis) << "</td></tr>\n";
+      << "</td><td class=l>" << XmlEscape(t.basis) << "</td></tr>\n";
   h << "<tr><th class=l>expanded (k = " << Num(u.coverage_k, 2) << ")</th><th>flux "
     << Num(100 * u.FluxExpanded(), 2) << " %, peak " << Num(100 * u.PeakExpanded(), 2)
     << " %</th><td></td><td class=l>root sum of squares &times; k</td></tr></table>\n"
        "<ul class=note>";
-  for (const std::string& n : u.notes) h << "<li>" << HtmlEscape(n) << "</li>";
-  h << "<li>IES keyword: [_UNCERTAINTY] " << HtmlEscape(UncertaintyKeyword(u)) << "</li>";
+  for (const std::string& n : u.notes) h << "<li>" << XmlEscape(n) << "</li>";
+  h << "<li>IES keyword: [_UNCERTAINTY] " << XmlEscape(UncertaintyKeyword(u)) << "</li>";
   h << "</ul></section>\n";
 }
 
@@ -477,7 +477,7 @@ void Colour(Page& p) {
                                      "locus, CIE 15 / ANSI C78.377)")
     << "</td></tr>\n";
   for (const std::string& row : c.rows)
-    h << "<tr><td class=l colspan=2>" << HtmlEscape(row) << "</td></tr>\n";
+    h << "<tr><td class=l colspan=2>" << XmlEscape(row) << "</td></tr>\n";
   h << "</table>\n";
   if (!c.cells.empty()) {
     h << "<table><tr><th>&gamma; \\ C</th>";
@@ -501,17 +501,17 @@ void Colour(Page& p) {
     h << "</table><p class=note>CCT and chromaticity x, y per direction (&mdash;: not seen or "
          "no chromaticity; no CCT: |Duv| &gt; 0.05).</p>\n";
   }
-  h << "<p class=note>From " << HtmlEscape(c.source) << ".</p></section>\n";
+  h << "<p class=note>From " << XmlEscape(c.source) << ".</p></section>\n";
 }
 
 void Metadata(Page& p) {
   auto& h = p.html;
   h << "<section><h2>Capture and software</h2><table>\n";
   for (const auto& [k, v] : p.r.metadata)
-    h << "<tr><th class=l>" << HtmlEscape(k) << "</th><td class=l>" << HtmlEscape(v)
+    h << "<tr><th class=l>" << XmlEscape(k) << "</th><td class=l>" << XmlEscape(v)
       << "</td></tr>\n";
   h << "<tr><th class=l>report generated</th><td class=l>" << p.r.generated_utc << " by "
-    << HtmlEscape(p.r.software) << "</td></tr>\n";
+    << XmlEscape(p.r.software) << "</td></tr>\n";
   h << "<tr><th class=l>far field</th><td class=l>C 0&ndash;360&deg; by "
     << Num(p.r.distribution.c_deg[1] - p.r.distribution.c_deg[0], 4)
     << "&deg;, &gamma; 0&ndash;90&deg; by "
@@ -527,9 +527,9 @@ std::string ReportHtml(const ReportData& data) {
   Page p{data, {}};
   auto& h = p.html;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
-    << HtmlEscape(data.title) << "</title><style>" << kCss << "</style></head><body>\n";
-  h << "<h1>" << HtmlEscape(data.title) << "</h1><p class=note>" << HtmlEscape(data.slab_dir)
-    << " &middot; " << data.generated_utc << " &middot; " << HtmlEscape(data.software) << "</p>\n";
+    << XmlEscape(data.title) << "</title><style>" << kCss << "</style></head><body>\n";
+  h << "<h1>" << XmlEscape(data.title) << "</h1><p class=note>" << XmlEscape(data.slab_dir)
+    << " &middot; " << data.generated_utc << " &middot; " << XmlEscape(data.software) << "</p>\n";
   Summary(p);
   SpreadTable(p);
   Zonal(p);

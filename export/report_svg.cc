@@ -15,23 +15,6 @@
 
 namespace lumislab {
 
-std::string HtmlEscape(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    if (ch == '&')
-      out += "&amp;";
-    else if (ch == '<')
-      out += "&lt;";
-    else if (ch == '>')
-      out += "&gt;";
-    else if (ch == '"')
-      out += "&quot;";
-    else
-      out += ch;
-  }
-  return out;
-}
-
 std::string Fmt(double v, int digits) { return std::isfinite(v) ? Num(v, digits) : "\u2014"; }
 
 std::string Deg(double v, int decimals) {
@@ -74,9 +57,9 @@ std::string SvgAxes::Open(const std::string& x_title, const std::string& y_title
        << "\" text-anchor=\"end\">" << FormatTick(t, step) << "</text>\n";
   }
   os << "<text x=\"" << (left + width - right) / 2 << "\" y=\"" << height - 6
-     << "\" text-anchor=\"middle\">" << HtmlEscape(x_title) << "</text>\n";
+     << "\" text-anchor=\"middle\">" << XmlEscape(x_title) << "</text>\n";
   os << "<text transform=\"translate(11," << (top + height - bottom) / 2
-     << ") rotate(-90)\" text-anchor=\"middle\">" << HtmlEscape(y_title) << "</text>\n";
+     << ") rotate(-90)\" text-anchor=\"middle\">" << XmlEscape(y_title) << "</text>\n";
   return os.str();
 }
 

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "lib/lightfield/polar_plot.h"  // XmlEscape
 #include "lib/lightfield/raster.h"
 
 namespace lumislab {
@@ -41,7 +42,6 @@ std::string ContourPath(const std::vector<double>& v, int nx, int ny, double lev
 // PNG encoder, into a temporary file, read back and removed).
 std::string PngDataUri(const Rgb8Image& image);
 
-std::string HtmlEscape(const std::string& s);
 // A number with `digits` significant digits; "—" for NaN.
 std::string Fmt(double v, int digits = 4);
 // "12.3°"; "—" for NaN.

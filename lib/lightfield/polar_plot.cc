@@ -21,21 +21,6 @@ std::string Hex(Rgb8 c) {
   return text;
 }
 
-std::string XmlEscape(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    if (ch == '&')
-      out += "&amp;";
-    else if (ch == '<')
-      out += "&lt;";
-    else if (ch == '>')
-      out += "&gt;";
-    else
-      out += ch;
-  }
-  return out;
-}
-
 // The curve of one plane: the left half-plane's values from its largest gamma to 0, then the
 // right one's from 0 outwards; `side` +1 right, -1 left.
 std::vector<double> CurvePoints(const PolarPlotData& data, const std::vector<double>& left,
@@ -156,6 +141,23 @@ PolarPlot MakePolarPlot(const PolarPlotData& data, int size) {
   if (!data.title.empty()) plot.texts.push_back({12, 12, data.title, 13, -1, kLabel});
   if (half) plot.height = std::ceil(cy + radius + 48);  // no empty upper half
   return plot;
+}
+
+std::string XmlEscape(const std::string& s) {
+  std::string out;
+  for (const char ch : s) {
+    if (ch == '&')
+      out += "&amp;";
+    else if (ch == '<')
+      out += "&lt;";
+    else if (ch == '>')
+      out += "&gt;";
+    else if (ch == '"')
+      out += "&quot;";
+    else
+      out += ch;
+  }
+  return out;
 }
 
 std::string PolarPlotSvg(const PolarPlot& plot) {

@@ -56,6 +56,10 @@ struct PolarPlot {
 
 PolarPlot MakePolarPlot(const PolarPlotData& data, int size = 600);
 std::string PolarPlotSvg(const PolarPlot& plot);
+
+// Text for SVG and HTML, element content or a quoted attribute: & < > " escaped. The polar
+// plot's labels and the lab report (export/report_html.cc) use it.
+std::string XmlEscape(const std::string& s);
 Rgb8Image PolarPlotImage(const PolarPlot& plot);
 
 }  // namespace lumislab

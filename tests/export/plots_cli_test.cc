@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/exr_io.h"
+#include "export/cli.h"
 #include "export/cli_plots.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/synthetic/truth.h"
@@ -17,19 +18,12 @@
 namespace lumislab {
 namespace {
 
+// lumislab-export in this process, as its main runs it (export/cli.h).
 int RunExportWith(std::vector<std::string> args) {
   args.insert(args.begin(), "lumislab-export");
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
-  return RunMain("export", [&] {
-    CLI::App app{"lumislab-export"};
-    app.require_subcommand(1);
-    CommonOptions common;
-    AddCommonOptions(&app, &common);
-    const ParsedCommand plots = AddPlotCommands(app, &common);
-    if (const auto code = ParseCommandLine(app, int(argv.size()), argv.data())) return *code;
-    return plots(StartTool("export", common)).value_or(2);
-  });
+  return RunMain("export", [&] { return RunExport(int(argv.size()), argv.data()); });
 }
 
 class ExportPlots : public testing::Test {

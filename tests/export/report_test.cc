@@ -21,6 +21,7 @@
 #include "core/geometry.h"
 #include "core/log.h"
 #include "core/slab_light.h"
+#include "export/cli.h"
 #include "export/report_svg.h"
 #include "export/report_uncertainty.h"
 #include "lib/photo/photo_write.h"
@@ -32,19 +33,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// lumislab-export in this process, as its main runs it (export/cli.h).
 int RunExportWith(std::vector<std::string> args) {
   args.insert(args.begin(), "lumislab-export");
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
-  return RunMain("export", [&] {
-    CLI::App app{"lumislab-export"};
-    app.require_subcommand(1);
-    CommonOptions common;
-    AddCommonOptions(&app, &common);
-    const ParsedCommand report = AddReportCommand(app, &common);
-    if (const auto code = ParseCommandLine(app, int(argv.size()), argv.data())) return *code;
-    return report(StartTool("export", common)).value_or(2);
-  });
+  return RunMain("export", [&] { return RunExport(int(argv.size()), argv.data()); });
 }
 
 // The default scene's emitters 1 and 1.5 mm behind S (as tests/export/export_formats_test.cc:

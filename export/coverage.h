@@ -50,6 +50,11 @@ struct Coverage {
 Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const SlabInfo& info,
                       const std::string& slab_dir);
 
+// The same with the analytic luminaire looked for in `truth_dir` (luminaire.json, reference.json
+// with the lux meter's K): a luminaire folder's <folder>/truth, in the luminaire frame.
+Coverage GridCoverageWithTruth(const IntensityDistribution& d, const FarField& ff,
+                               const SlabInfo& info, const std::string& truth_dir);
+
 // True when `slab_dir` belongs to a synthetic dataset (truth/luminaire.json beside it).
 bool SyntheticSlab(const std::string& slab_dir);
 

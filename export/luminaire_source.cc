@@ -1,0 +1,93 @@
+#include "export/luminaire_source.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "core/checks.h"
+#include "core/dataset.h"
+#include "core/log.h"
+#include "core/slab_light.h"
+#include "export/complete_slab.h"
+
+namespace lumislab {
+
+std::string RegisterCommand(const std::string& folder) {
+  return "lumislab-calibrate orientations --luminaire " + folder;
+}
+
+LuminaireSource LoadLuminaireSource(const std::string& folder, int threads,
+                                    const std::string& stage) {
+  LuminaireSource source;
+  source.set = LoadLuminaireSet(folder);
+  for (size_t k = 0; k < source.set.orientations.size(); ++k) {
+    const Orientation& o = source.set.orientations[k];
+    PosedSlab slab;
+    slab.name = o.name;
+    const std::string dataset = source.set.DatasetFolder(k);
+    slab.slab_dir = ResolveSlabDir(dataset);
+    slab.info = SlabInfo::Load(slab.slab_dir);
+    RequireCompleteSlab(slab.info, slab.slab_dir);
+    slab.positions = ReadSlabPositions(slab.slab_dir, slab.info, threads);
+    CheckLog checks(DatasetOfSlab(slab.slab_dir), stage);
+    CheckSlabLight(slab.info, slab.positions, slab.slab_dir, checks);
+    checks.Save();
+    slab.capture_from_luminaire = o.rotation;
+    slab.centre_mm = o.centre_mm;
+    slab.cone = ConeOfDataset(Dataset::Load(dataset));
+    LogInfo("orientation ", o.name, ": ", slab.slab_dir, ", rotation (", o.rotation_deg.x(), ", ",
+            o.rotation_deg.y(), ", ", o.rotation_deg.z(), ") deg",
+            o.registered ? " registered" : " nominal", ", units ", slab.info.units);
+    source.slabs.push_back(std::move(slab));
+  }
+  if (source.slabs.empty())
+    throw InputError(LuminaireJsonPath(folder), "orientations", "at least one orientation", "none");
+  source.units = CommonUnits(source.slabs);
+  if (!source.set.orientations.front().registered && source.slabs.size() > 1)
+    LogWarning(folder,
+               ": not registered (no registration.json): the merge uses the nominal poses of "
+               "luminaire.json, whose error (a degree or two for a hand remount) blurs the "
+               "overlaps and turns the lobes; register it first: ",
+               RegisterCommand(folder));
+  return source;
+}
+
+std::string LuminaireSource::Orientations() const {
+  std::string s = std::to_string(slabs.size()) + " orientation" + (slabs.size() == 1 ? "" : "s");
+  s += " (" + slabs.front().name +
+       (slabs.size() > 2    ? ", ..., "
+        : slabs.size() == 2 ? ", "
+                            : "") +
+       (slabs.size() > 1 ? slabs.back().name : "") + "), ";
+  const bool registered = set.orientations.front().registered;
+  if (!registered) return s + "nominal poses (not registered)";
+  double worst = 0, sigma = 0;
+  std::string worst_name = set.orientations.front().name;
+  for (const Orientation& o : set.orientations) {
+    if (o.correction_deg.norm() > worst) worst = o.correction_deg.norm(), worst_name = o.name;
+    sigma = std::max(sigma, o.sigma_deg.maxCoeff());
+  }
+  return s + "registered: corrections up to " + Num(worst, 3) + " deg (" + worst_name +
+         "), 1-sigma up to " + Num(sigma, 2) + " deg";
+}
+
+std::vector<std::string> LuminaireSource::RegistrationRows() const {
+  std::vector<std::string> rows;
+  for (const Orientation& o : set.orientations) {
+    std::string row = o.name + ": " + o.dataset + ", nominal rotation (" +
+                      Num(o.rotation_deg.x(), 4) + ", " + Num(o.rotation_deg.y(), 4) + ", " +
+                      Num(o.rotation_deg.z(), 4) + ") deg";
+    if (o.registered)
+      row += ", correction (" + Num(o.correction_deg.x(), 3) + ", " + Num(o.correction_deg.y(), 3) +
+             ", " + Num(o.correction_deg.z(), 3) + ") deg +- (" + Num(o.sigma_deg.x(), 2) + ", " +
+             Num(o.sigma_deg.y(), 2) + ", " + Num(o.sigma_deg.z(), 2) + ") deg (1 sigma)";
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string LuminaireSource::TruthDir() const {
+  return (std::filesystem::path(set.folder) / "truth").string();
+}
+
+}  // namespace lumislab

@@ -87,17 +87,9 @@ Coverage SlabCoverage(const IntensityDistribution& d, const FarField& ff, const 
 // (by the flux term).
 FarFieldUncertainty SlabUncertainty(const Slab& slab, int samples,
                                     const UncertaintyOptions& options) {
-  if (!slab.luminaire)
-    return EstimateFarFieldUncertainty(slab.info, DatasetOfSlab(slab.dir), samples, options);
-  FarFieldUncertainty worst;
-  bool first = true;
-  for (const PosedSlab& s : slab.luminaire->slabs) {
-    FarFieldUncertainty u =
-        EstimateFarFieldUncertainty(s.info, DatasetOfSlab(s.slab_dir), samples, options);
-    if (first || u.FluxExpanded() > worst.FluxExpanded()) worst = std::move(u);
-    first = false;
-  }
-  return worst;
+  return slab.luminaire
+             ? LuminaireUncertainty(*slab.luminaire, samples, options)
+             : EstimateFarFieldUncertainty(slab.info, DatasetOfSlab(slab.dir), samples, options);
 }
 
 bool Synthetic(const Slab& slab) {

@@ -54,9 +54,7 @@ std::string Extension(const std::string& path) {
 // light; a plane the pose tilts, or a centre off its axis, is warned about.
 void PlaneOfLuminaireFolder(IrradianceOptions* o) {
   const LuminaireSet set = LoadLuminaireSet(o->slab_dir);
-  size_t best = 0;
-  for (size_t k = 1; k < set.orientations.size(); ++k)
-    if (set.orientations[k].rotation(2, 2) > set.orientations[best].rotation(2, 2)) best = k;
+  const size_t best = FrontOrientation(set);
   const Orientation& front = set.orientations[best];
   const double tilt_deg = std::acos(std::clamp(front.rotation(2, 2), -1.0, 1.0)) * 180 / kPi;
   LogInfo("luminaire ", o->slab_dir, ": the plane z = ", o->distance_mm,

@@ -86,6 +86,26 @@ std::vector<std::string> LuminaireSource::RegistrationRows() const {
   return rows;
 }
 
+size_t FrontOrientation(const LuminaireSet& set) {
+  size_t best = 0;
+  for (size_t k = 1; k < set.orientations.size(); ++k)
+    if (set.orientations[k].rotation(2, 2) > set.orientations[best].rotation(2, 2)) best = k;
+  return best;
+}
+
+FarFieldUncertainty LuminaireUncertainty(const LuminaireSource& source, int samples,
+                                         const UncertaintyOptions& options) {
+  FarFieldUncertainty worst;
+  bool first = true;
+  for (const PosedSlab& s : source.slabs) {
+    FarFieldUncertainty u =
+        EstimateFarFieldUncertainty(s.info, DatasetOfSlab(s.slab_dir), samples, options);
+    if (first || u.FluxExpanded() > worst.FluxExpanded()) worst = std::move(u);
+    first = false;
+  }
+  return worst;
+}
+
 std::string LuminaireSource::TruthDir() const {
   return (std::filesystem::path(set.folder) / "truth").string();
 }

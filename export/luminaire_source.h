@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/luminaire_set.h"
+#include "export/report_uncertainty.h"
 #include "lib/lightfield/merged_far_field.h"
 
 namespace lumislab {
@@ -33,6 +34,16 @@ struct LuminaireSource {
 // good to a degree or two, which the merge then carries.
 LuminaireSource LoadLuminaireSource(const std::string& folder, int threads,
                                     const std::string& stage);
+
+// The orientation that looks along the luminaire's gamma = 0 axis (its capture +z nearest the
+// luminaire's +z: the largest R_k(2, 2)): the planes of `irradiance` and the report are its.
+size_t FrontOrientation(const LuminaireSet& set);
+
+// The stated uncertainty of a merged far field: the largest (by the flux term) of the
+// orientations' (EstimateFarFieldUncertainty of each slab); the registration's and the blend's
+// terms are not in it.
+FarFieldUncertainty LuminaireUncertainty(const LuminaireSource& source, int samples,
+                                         const UncertaintyOptions& options);
 
 // The command that registers `folder` (its registration.json).
 std::string RegisterCommand(const std::string& folder);

@@ -886,14 +886,20 @@ struct InfoCommand {
 };
 
 int RunInfo(const InfoCommand& c) {
+  if (IsLuminaireFolder(c.file)) {
+    std::fputs(LuminaireFolderInfo(c.file, c.json).c_str(), stdout);
+    return 0;
+  }
   std::fputs(FormatPhotometricFileInfo(PhotometricFileInfo(c.file), c.json).c_str(), stdout);
   return 0;
 }
 
 CLI::App* AddInfoCommand(CLI::App& app, InfoCommand* c, CommonOptions* common) {
   CLI::App* cmd = app.add_subcommand(
-      "info", "what an IES, EULUMDAT or TM-25 file holds: format, angle grid or rays, flux");
-  cmd->add_option("file", c->file, "the file")->required();
+      "info",
+      "what an IES, EULUMDAT or TM-25 file holds: format, angle grid or rays, flux; of a "
+      "luminaire folder: its orientations, registration and coverage");
+  cmd->add_option("file", c->file, "the file, or a luminaire folder")->required();
   cmd->add_flag("--json", c->json, "print it as JSON (with a flux field)");
   AddCommonOptions(cmd, common);
   return cmd;

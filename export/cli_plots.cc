@@ -126,10 +126,37 @@ int RunIrradiance(IrradianceOptions o, int threads) {
   return 0;
 }
 
+int RunPolar(PolarOptions o, int threads) {
+  if (!IsLuminaireFolder(o.slab_dir)) o.slab_dir = ResolveSlabDir(o.slab_dir);
+  LogInfo("parameters: slab=", o.slab_dir, " gamma_step=", o.gamma_step_deg, " samples=", o.samples,
+          " size=", o.size, " out=", o.out);
+  const std::string ext = Extension(o.out);
+  if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
+  CheckExportOutput(o.out, o.force);
+  PolarPlotData data = PolarData(o.slab_dir, o.gamma_step_deg, o.samples, threads);
+  if (!o.title.empty()) data.title = o.title;
+  const PolarPlot plot = MakePolarPlot(data, o.size);
+  if (ext == ".svg") {
+    WriteTextAtomically(o.out, PolarPlotSvg(plot));
+  } else {
+    const Rgb8Image image = PolarPlotImage(plot);
+    WriteRgb8File(o.out, image.width, image.height, image.rgb);
+  }
+  LogInfo("polar plot -> ", o.out);
+  return 0;
+}
+
+}  // namespace
+
 // The far field in the four half-planes, up to the largest gamma every one of them saw: of the
 // slab (gamma 0-90), or of a luminaire folder the merged far field (gamma 0-180).
-PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
-  const bool merged = IsLuminaireFolder(o.slab_dir);
+PolarPlotData PolarData(const std::string& slab_dir, double gamma_step_deg, int samples,
+                        int threads) {
+  const bool merged = IsLuminaireFolder(slab_dir);
+  PolarOptions o;
+  o.slab_dir = merged ? slab_dir : ResolveSlabDir(slab_dir);
+  o.gamma_step_deg = gamma_step_deg;
+  o.samples = samples;
   std::vector<double> gamma;
   const double span = merged ? 180 : 90;
   for (int k = 0; k * o.gamma_step_deg <= span + 1e-9; ++k) gamma.push_back(k * o.gamma_step_deg);
@@ -174,33 +201,11 @@ PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
     }
   if (negative > 0) LogWarning(negative, " negative intensities drawn as 0");
   data.unit = IntensityUnitLabel(info.units);
-  data.title = o.title.empty() ? std::string(merged ? "Merged far field (the orientations saw"
-                                                    : "Far field (the slab saw") +
-                                     " \u03B3 = 0 to " +
-                                     FormatTick(data.gamma_deg.back(), o.gamma_step_deg) + "\u00B0)"
-                               : o.title;
+  data.title =
+      std::string(merged ? "Merged far field (the orientations saw" : "Far field (the slab saw") +
+      " \u03B3 = 0 to " + FormatTick(data.gamma_deg.back(), o.gamma_step_deg) + "\u00B0)";
   return data;
 }
-
-int RunPolar(PolarOptions o, int threads) {
-  if (!IsLuminaireFolder(o.slab_dir)) o.slab_dir = ResolveSlabDir(o.slab_dir);
-  LogInfo("parameters: slab=", o.slab_dir, " gamma_step=", o.gamma_step_deg, " samples=", o.samples,
-          " size=", o.size, " out=", o.out);
-  const std::string ext = Extension(o.out);
-  if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
-  CheckExportOutput(o.out, o.force);
-  const PolarPlot plot = MakePolarPlot(PolarDataFromSlab(o, threads), o.size);
-  if (ext == ".svg") {
-    WriteTextAtomically(o.out, PolarPlotSvg(plot));
-  } else {
-    const Rgb8Image image = PolarPlotImage(plot);
-    WriteRgb8File(o.out, image.width, image.height, image.rgb);
-  }
-  LogInfo("polar plot -> ", o.out);
-  return 0;
-}
-
-}  // namespace
 
 ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
   auto irradiance = std::make_shared<IrradianceOptions>();

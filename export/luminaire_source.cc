@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "core/checks.h"
 #include "core/dataset.h"
@@ -84,6 +85,68 @@ std::vector<std::string> LuminaireSource::RegistrationRows() const {
     rows.push_back(row);
   }
   return rows;
+}
+
+std::string LuminaireFolderInfo(const std::string& folder, bool json) {
+  const LuminaireSet set = LoadLuminaireSet(folder);
+  nlohmann::json j;
+  j["format"] = "lumislab luminaire folder";
+  j["coverage_asked"] = set.coverage;
+  j["registered"] = !set.orientations.empty() && set.orientations.front().registered;
+  std::vector<Eigen::Matrix3d> rotations;
+  std::vector<OrientationCone> cones;
+  std::string text = folder + ": luminaire folder, " + std::to_string(set.orientations.size()) +
+                     " orientations, coverage asked: " + set.coverage +
+                     (j["registered"] ? ", registered" : ", not registered (nominal poses)") + "\n";
+  for (size_t k = 0; k < set.orientations.size(); ++k) {
+    const Orientation& o = set.orientations[k];
+    nlohmann::json e;
+    e["name"] = o.name;
+    e["dataset"] = o.dataset;
+    e["rotation_deg"] = {o.rotation_deg.x(), o.rotation_deg.y(), o.rotation_deg.z()};
+    std::string line = "  " + o.name + ": " + o.dataset + ", rotation (" +
+                       Num(o.rotation_deg.x(), 4) + ", " + Num(o.rotation_deg.y(), 4) + ", " +
+                       Num(o.rotation_deg.z(), 4) + ") deg";
+    if (o.registered) {
+      e["correction_deg"] = {o.correction_deg.x(), o.correction_deg.y(), o.correction_deg.z()};
+      e["sigma_deg"] = {o.sigma_deg.x(), o.sigma_deg.y(), o.sigma_deg.z()};
+      line += ", correction " + Num(o.correction_deg.norm(), 3) + " deg (1-sigma up to " +
+              Num(o.sigma_deg.maxCoeff(), 2) + ")";
+    }
+    const std::string dataset = set.DatasetFolder(k);
+    const Dataset ds = Dataset::Load(dataset);
+    cones.push_back(ConeOfDataset(ds));
+    rotations.push_back(o.rotation);
+    const std::string slab_dir = dataset + "/slab";
+    if (std::filesystem::is_regular_file(slab_dir + "/slab.json")) {
+      const SlabInfo info = SlabInfo::Load(slab_dir);
+      e["slab"] = info.Complete() ? "complete" : "partial";
+      e["units"] = info.units;
+      line += "; slab " + std::string(info.Complete() ? "complete" : "partial") + ", units " +
+              info.units;
+    } else {
+      e["slab"] = "none";
+      line += "; no slab yet";
+    }
+    j["orientations"].push_back(e);
+    text += line + "\n";
+  }
+  const CoverageReport c = AnalyseCoverage(rotations, cones, set.coverage == "hemisphere");
+  j["covered_fraction"] = c.covered_fraction;
+  j["unseen_sr"] = c.unseen_sr;
+  j["overlap_problem"] = c.overlap_problem;
+  text += "  cones at these poses cover " + Num(100 * c.covered_fraction, 4) + " % of the " +
+          set.coverage + " (" + Num(c.unseen_sr, 3) + " sr unseen); ";
+  for (const PairOverlap& p : c.pairs) {
+    j["pairs"].push_back({{"a", set.orientations[size_t(p.a)].name},
+                          {"b", set.orientations[size_t(p.b)].name},
+                          {"overlap_sr", p.overlap_sr}});
+  }
+  text +=
+      std::to_string(c.pairs.size()) + " overlapping pairs; " +
+      (c.overlap_problem.empty() ? "every orientation connected to the first" : c.overlap_problem) +
+      "\n";
+  return json ? j.dump(2) + "\n" : text;
 }
 
 size_t FrontOrientation(const LuminaireSet& set) {

@@ -45,6 +45,13 @@ size_t FrontOrientation(const LuminaireSet& set);
 FarFieldUncertainty LuminaireUncertainty(const LuminaireSource& source, int samples,
                                          const UncertaintyOptions& options);
 
+// `info` of a luminaire folder, from its files alone (no slab positions read): the coverage
+// asked, each orientation (dataset, nominal rotation, registration's correction and 1-sigma, its
+// slab's state and unit) and the planner's coverage of the set (AnalyseCoverage of the cones at
+// the current poses: the fraction seen, the pairs' overlaps, why it cannot be registered). As
+// text, or JSON with `json`.
+std::string LuminaireFolderInfo(const std::string& folder, bool json);
+
 // The command that registers `folder` (its registration.json).
 std::string RegisterCommand(const std::string& folder);
 

@@ -12,28 +12,6 @@
 namespace lumislab {
 namespace {
 
-// Orientation k's far field at capture-frame directions (ComputeFarFieldAt): value and seen.
-struct Lookup {
-  std::vector<double> values;
-  std::vector<uint8_t> seen;
-};
-Lookup FarFieldAt(const PosedSlab& slab, const std::vector<Eigen::Vector3d>& directions,
-                  const FarFieldOptions& options) {
-  Lookup out;
-  out.values.assign(directions.size(), 0.0);
-  out.seen.assign(directions.size(), 0);
-  FarFieldOptions one = options;
-  one.threads = 1;
-  ParallelFor(int(directions.size()), options.threads, [&](int k) {
-    if (!(directions[size_t(k)].z() > 1e-9)) return;
-    const Eigen::Vector2d a = TypeCAngles(directions[size_t(k)]);
-    const FarField ff = ComputeFarField(slab.info, slab.positions, {a.x()}, {a.y()}, one);
-    out.values[size_t(k)] = ff.values[0];
-    out.seen[size_t(k)] = ff.seen[0];
-  });
-  return out;
-}
-
 std::vector<OrientationCone> Cones(const std::vector<PosedSlab>& slabs) {
   std::vector<OrientationCone> cones;
   for (const PosedSlab& s : slabs) cones.push_back(s.cone);
@@ -135,11 +113,11 @@ MergedFarField ComputeMergedFarField(const std::vector<PosedSlab>& slabs,
   for (size_t k = 0; k < count; ++k) grid[k] = TypeCDirection(c_deg[k / ng], gamma_deg[k % ng]);
   const std::vector<OrientationCone> cones = Cones(slabs);
   const std::vector<Eigen::Matrix3d> rotations = Rotations(slabs);
-  std::vector<Lookup> at(n);
+  std::vector<FarFieldAt> at(n);
   for (size_t o = 0; o < n; ++o) {
     std::vector<Eigen::Vector3d> turned(count);
     for (size_t k = 0; k < count; ++k) turned[k] = rotations[o] * grid[k];
-    at[o] = FarFieldAt(slabs[o], turned, options);
+    at[o] = ComputeFarFieldAt(slabs[o].info, slabs[o].positions, turned, options);
   }
   MergedFarField out;
   out.ff.c_deg = c_deg;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../e2e/test_util.h"
+#include "core/atomic_file.h"
 #include "core/dataset.h"
 #include "core/error.h"
 #include "core/geometry.h"
@@ -270,8 +271,10 @@ TEST_F(MergedExport, LobesAtTheRightCGammaInEveryExport) {
   const std::string lum = ShellQuote(Lum());
   for (const std::string format : {"ies", "ldt"}) {
     const std::string out = Out("merged." + format);
+    // EULUMDAT at 2 x 2 quadrature points (the time of the test), IES at the default 4 x 4.
     const auto r = RunTool("lumislab-export", format + " --slab " + lum + " --out " +
-                                                  ShellQuote(out) + " --threads 2" + kKeywords);
+                                                  ShellQuote(out) + " --threads 2" + kKeywords +
+                                                  (format == "ldt" ? " --samples 2" : ""));
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const IntensityDistribution d = format == "ies" ? ReadIes(out) : ReadEulumdat(out);
     EXPECT_EQ(d.gamma_deg.back(), 180) << format;
@@ -294,7 +297,7 @@ TEST_F(MergedExport, LobesAtTheRightCGammaInEveryExport) {
   // truth's is.
   const std::string ray = Out("merged.ray");
   auto r = RunTool("lumislab-export", "tm25 --slab " + lum + " --out " + ShellQuote(ray) +
-                                          " --rays 200000 --threads 2");
+                                          " --rays 100000 --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Tm25RaySet rays = ReadTm25(ray);
   double total = 0;
@@ -406,6 +409,19 @@ TEST_F(MergedExport, RegisteredPosesAreUsed) {
   EXPECT_GT(unregistered, exact * 1.2);
   EXPECT_LT(registered, exact * 1.05 + 1e-4);
   EXPECT_NE(registered_source.Orientations().find("registered"), std::string::npos);
+  // The report states the orientations, the registration and the merged coverage.
+  const std::string html = Out("report.html");
+  const auto r = RunTool("lumislab-export",
+                         "report --slab " + ShellQuote(mis) + " --out " + ShellQuote(html) +
+                             " --distances-mm 750 --plane-size 32 --c-step 15 --gamma-step 5 "
+                             "--threads 2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string text = ReadTextFile(html);
+  for (const char* want :
+       {"6 orientations (o00, ..., o05), registered: corrections up to 1.5 deg (o03)",
+        "correction (0, 1.5, 0) deg", "100 % of the sphere seen by at least one orientation",
+        "&gamma; 0&ndash;180&deg;"})
+    EXPECT_NE(text.find(want), std::string::npos) << want;
 }
 
 // The blend weights alone: they sum to 1 where some orientation saw a direction, 0 where none

@@ -8,6 +8,7 @@
 // (a Fibonacci sphere; K = 6: the cube's faces) face the screen. Ks ascend, so VmHWM after K is
 // the peak of that K (its slabs and the merge's working set; the earlier Ks used less).
 // Usage: merge_bench [threads (0: all cores)] [resolution] [K list, comma separated]
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

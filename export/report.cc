@@ -421,7 +421,9 @@ ParsedCommand AddReportCommand(CLI::App& app, CommonOptions* common) {
       ->check(FiniteIn(kMinDistanceMm, kMaxDistanceMm));
   cmd->add_option("--c-step", o->c_step, "degrees between C planes of the far field")
       ->capture_default_str();
-  cmd->add_option("--gamma-step", o->gamma_step, "degrees between gamma angles (0-90)")
+  cmd->add_option("--gamma-step", o->gamma_step,
+                  "degrees between gamma angles (0-90; 0-180 for a luminaire folder measured "
+                  "over the sphere)")
       ->capture_default_str();
   cmd->add_option("--samples", o->samples, "N x N quadrature points per position (far field)")
       ->check(CLI::Range(1, 16))

@@ -6,6 +6,7 @@
 // flux, the lobes at the right C / gamma in IES, EULUMDAT, TM-25 and the polar plot, a hemisphere
 // folder asked for the sphere, the registered poses, and the blend weights and units alone.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -140,7 +141,8 @@ class MergedExport : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     scene_ = new SynthScene(LoadScene("full-sphere"));
-    dir_ = testing::FreshDir("merged_export");
+    // One folder per process: ctest runs each test of the suite in its own, side by side.
+    dir_ = testing::FreshDir("merged_export_" + std::to_string(getpid()));
     std::vector<Eigen::Vector3d> faces(std::begin(kCubeFaces), std::end(kCubeFaces));
     WriteFolder(*scene_, Lum(), "sphere", faces);
     for (size_t k = 0; k < faces.size(); ++k)
@@ -269,7 +271,8 @@ TEST_F(MergedExport, LobesAtTheRightCGammaInEveryExport) {
                 CGamma(want.back()).c_str());
   }
   const std::string lum = ShellQuote(Lum());
-  for (const std::string format : {"ies", "ldt"}) {
+  for (const char* name : {"ies", "ldt"}) {
+    const std::string format = name;
     const std::string out = Out("merged." + format);
     // EULUMDAT at 2 x 2 quadrature points (the time of the test), IES at the default 4 x 4.
     const auto r = RunTool("lumislab-export", format + " --slab " + lum + " --out " +

@@ -258,6 +258,7 @@ std::string CGamma(const Eigen::Vector3d& w) {
 // luminaire has them (IES, EULUMDAT: the grid's peak; TM-25: the flux-weighted mean direction of
 // the rays within 20 degrees of it; the polar plot: its planes' peaks), full-sphere by default.
 TEST_F(MergedExport, LobesAtTheRightCGammaInEveryExport) {
+  if (testing::kSanitized) GTEST_SKIP() << "accuracy run (four exports): the Release build's";
   IntensityDistribution truth = SphereGrid(5, 2.5);
   const size_t ng = truth.gamma_deg.size();
   for (size_t k = 0; k < truth.values.size(); ++k)

@@ -369,6 +369,19 @@ TEST_F(MergedExport, HemisphereFolderIsPartialForTheSphere) {
   r = RunTool("lumislab-export", "info " + ShellQuote(half));
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("coverage asked: hemisphere"), std::string::npos) << r.output;
+  r = RunTool("lumislab-export", "info --json " + ShellQuote(half));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json info = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  EXPECT_EQ(info["orientations"].size(), 1u);
+  EXPECT_EQ(info["orientations"][0]["slab"], "complete");
+  EXPECT_LT(info["covered_fraction"].get<double>(), 1);
+  // The plane z = D of the luminaire frame: the front orientation's plane at D + centre_z.
+  r = RunTool("lumislab-export", "irradiance --slab " + ShellQuote(half) +
+                                     " --distance-mm 750 --size 32 --samples 1 --out " +
+                                     ShellQuote(Out("half.exr")));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("as orientation o00 sees it"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("at 745 mm from its S"), std::string::npos) << r.output;
 }
 
 // A mounting error of 1.5 degrees: o03 (looking along the luminaire's +x, at the narrow lobe

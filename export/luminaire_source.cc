@@ -12,6 +12,14 @@
 #include "export/complete_slab.h"
 
 namespace lumislab {
+namespace {
+
+// A 1-sigma of registration.json: infinite where the overlaps do not constrain the component.
+std::string Sigma(double sigma_deg) {
+  return std::isfinite(sigma_deg) ? Num(sigma_deg, 2) : std::string("unconstrained");
+}
+
+}  // namespace
 
 std::string RegisterCommand(const std::string& folder) {
   return "lumislab-calibrate orientations --luminaire " + folder;
@@ -69,7 +77,7 @@ std::string LuminaireSource::Orientations() const {
     sigma = std::max(sigma, o.sigma_deg.maxCoeff());
   }
   return s + "registered: corrections up to " + Num(worst, 3) + " deg (" + worst_name +
-         "), 1-sigma up to " + Num(sigma, 2) + " deg";
+         "), 1-sigma up to " + Sigma(sigma) + " deg";
 }
 
 std::vector<std::string> LuminaireSource::RegistrationRows() const {
@@ -80,8 +88,8 @@ std::vector<std::string> LuminaireSource::RegistrationRows() const {
                       Num(o.rotation_deg.z(), 4) + ") deg";
     if (o.registered)
       row += ", correction (" + Num(o.correction_deg.x(), 3) + ", " + Num(o.correction_deg.y(), 3) +
-             ", " + Num(o.correction_deg.z(), 3) + ") deg +- (" + Num(o.sigma_deg.x(), 2) + ", " +
-             Num(o.sigma_deg.y(), 2) + ", " + Num(o.sigma_deg.z(), 2) + ") deg (1 sigma)";
+             ", " + Num(o.correction_deg.z(), 3) + ") deg +- (" + Sigma(o.sigma_deg.x()) + ", " +
+             Sigma(o.sigma_deg.y()) + ", " + Sigma(o.sigma_deg.z()) + ") deg (1 sigma)";
     rows.push_back(row);
   }
   return rows;
@@ -109,9 +117,11 @@ std::string LuminaireFolderInfo(const std::string& folder, bool json) {
                        Num(o.rotation_deg.z(), 4) + ") deg";
     if (o.registered) {
       e["correction_deg"] = {o.correction_deg.x(), o.correction_deg.y(), o.correction_deg.z()};
-      e["sigma_deg"] = {o.sigma_deg.x(), o.sigma_deg.y(), o.sigma_deg.z()};
+      for (int i = 0; i < 3; ++i)  // null: unconstrained, as registration.json writes it
+        e["sigma_deg"].push_back(std::isfinite(o.sigma_deg[i]) ? nlohmann::json(o.sigma_deg[i])
+                                                               : nlohmann::json());
       line += ", correction " + Num(o.correction_deg.norm(), 3) + " deg (1-sigma up to " +
-              Num(o.sigma_deg.maxCoeff(), 2) + ")";
+              Sigma(o.sigma_deg.maxCoeff()) + ")";
     }
     const std::string dataset = set.DatasetFolder(k);
     const Dataset ds = Dataset::Load(dataset);

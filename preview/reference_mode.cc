@@ -30,6 +30,7 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
   options.samples = config.samples;
   options.threads = config.threads;
   options.visibility = config.shadows;
+  options.whole_frame = config.luminaire_folder;  // the luminaire's own frame, every direction
   // Inputs first: a bad luminaire or slab is refused before the scene is built.
   const bool analytic = !config.analytic.empty();
   const Luminaire luminaire = analytic ? LoadLuminaire(config.analytic) : Luminaire{};

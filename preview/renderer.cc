@@ -75,6 +75,13 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glGenVertexArrays(1, &gl_->quad_vao);
   glGenBuffers(1, &gl_->vbo);
 
+  // Every orientation's positions are layers of one texture array.
+  GLint max_layers = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  if (lights + merge_layers > max_layers)
+    throw BadInput(std::to_string(lights) + " positions (" + std::to_string(OrientationCount()) +
+                   " orientations) exceed the driver's " + std::to_string(max_layers) +
+                   " texture-array layers");
   glGenTextures(1, &gl_->intensity);
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
   glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, info_.layout.res_x, info_.layout.res_y,

@@ -243,7 +243,8 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   if (config.luminaire_folder) {
     for (const auto& [set, option] : {std::pair{config.reference, "--reference"},
                                       {config.shadow_share > 0, "--shadow-share"},
-                                      {config.merge_group > 1, "--merge-group"}})
+                                      {config.merge_group > 1, "--merge-group"},
+                                      {extras.write_test_slab, "--write-test-slab"}})
       if (set)
         throw BadInput(std::string(option) + " serves one slab, not a luminaire folder (" +
                        config.slab_dir + ")");

@@ -3,6 +3,8 @@
 // light only towards +z of the luminaire frame and only through the screen window; Lambertian
 // materials; float (RGBA32F, additive blending) or sRGBE-packed accumulation (paper §4.2).
 // Needs a current GL 4.5 core context (OffscreenContext or WindowContext).
+// A luminaire folder (docs/method.md §4.12): every orientation's positions are lights, each pass
+// one orientation's, shaded in its capture frame and weighted by the blend (LightOrientation).
 //
 // Deferred shading: a G-buffer (luminaire-frame position, normal, albedo per pixel) is drawn when
 // the view changes, and each light pass is one full-screen pass over it; the shaders have the
@@ -17,7 +19,8 @@
 // The methods are in files by phase: renderer.cc (set-up, uploads, Render(), read-back),
 // renderer_shadows.cc (shadow maps and their sharing), renderer_merge.cc (merged lights),
 // renderer_tiles.cc (light culling by tiles), renderer_light.cc (light passes, coarse shading),
-// renderer_reproject.cc (reprojection); the shaders in preview/shaders/.
+// renderer_reproject.cc (reprojection), renderer_orientations.cc (a luminaire folder's
+// orientations); the shaders in preview/shaders/.
 #pragma once
 
 #include <Eigen/Core>

@@ -269,8 +269,10 @@ TEST(PreviewLuminaire, WatchAddsAnOrientationThatAppears) {
 TEST(PreviewLuminaire, RefusalsNameTheirCause) {
   const std::string lum = LuminaireFolder("refusals", {0, 1});
   const std::string out = Scratch("refused.exr");
-  for (const std::vector<std::string>& extra :
-       {std::vector<std::string>{"--merge-group", "2"}, {"--shadow-share", "1"}, {"--reference"}}) {
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--merge-group", "2"},
+                                                {"--shadow-share", "1"},
+                                                {"--reference"},
+                                                {"--write-test-slab"}}) {
     std::vector<std::string> args = {"--slab", lum, "--scene", "plane", "--out", out};
     args.insert(args.end(), extra.begin(), extra.end());
     EXPECT_EQ(RunPreviewWith(args), 2) << extra[0];

@@ -59,10 +59,11 @@ Slab LoadLuminaireSlab(const std::string& folder, int threads, const std::string
 
 // The far field of the slab or, for a luminaire folder, the merged far field (luminaire frame);
 // a single slab's light is checked into `checks` (a merged one's orientations were, each in its
-// dataset, when loaded).
+// dataset, when loaded). `state_scales`: log the orientations' flux ratios over their overlaps
+// (the grid's far field; not again for the cell check's fine one).
 FarField SlabFarField(const Slab& slab, const std::vector<double>& c_deg,
                       const std::vector<double>& gamma_deg, const FarFieldOptions& options,
-                      CheckLog& checks) {
+                      CheckLog& checks, bool state_scales = true) {
   if (!slab.luminaire) {
     FarField ff = ComputeFarField(slab.info, slab.positions, c_deg, gamma_deg, options);
     CheckFarFieldLight(ff, slab.info, slab.dir, checks);
@@ -70,9 +71,10 @@ FarField SlabFarField(const Slab& slab, const std::vector<double>& c_deg,
   }
   MergedFarField merged = ComputeMergedFarField(slab.luminaire->slabs, c_deg, gamma_deg, options);
   for (const MergedFarField::PairScale& p : merged.pair_scales)
-    LogInfo("scale across orientations: ", slab.luminaire->slabs[size_t(p.b)].name, " / ",
-            slab.luminaire->slabs[size_t(p.a)].name, " = ", Num(p.ratio, 4), " over the ",
-            p.directions, " grid directions both weigh");
+    if (state_scales)
+      LogInfo("scale across orientations: ", slab.luminaire->slabs[size_t(p.b)].name, " / ",
+              slab.luminaire->slabs[size_t(p.a)].name, " = ", Num(p.ratio, 4), " over the ",
+              p.directions, " grid directions both weigh");
   return std::move(merged.ff);
 }
 
@@ -446,7 +448,7 @@ CellCheck CheckCells(const IntensityDistribution& d, const Slab& slab,
   for (int k = 0; k <= n; ++k) fine.gamma_deg.push_back(k == n ? hi : lo + k * out.fine_step_deg);
   const FarField ff =
       slab.luminaire
-          ? SlabFarField(slab, fine.c_deg, fine.gamma_deg, options, unrecorded)
+          ? SlabFarField(slab, fine.c_deg, fine.gamma_deg, options, unrecorded, false)
           : ComputeFarField(slab.info, slab.positions, fine.c_deg, fine.gamma_deg, options);
   fine.values = ff.values;
   for (double& v : fine.values) v = std::max(v, 0.0);

@@ -91,6 +91,13 @@ std::vector<double> BlendWeights(const std::vector<OrientationCone>& cones,
 std::string CommonUnits(const std::vector<PosedSlab>& slabs) {
   LUMISLAB_CHECK(!slabs.empty(), "at least one slab");
   const std::string& units = slabs.front().info.units;
+  if (units == "relative" && slabs.size() > 1)
+    throw InputError(slabs.front().slab_dir + "/slab.json", "units",
+                     "lux or W/m^2 (a slab without a radiometric scale has the level of its own "
+                     "capture's exposure, unlike another orientation's: calibrate the scale of "
+                     "every orientation's dataset, lumislab-calibrate scale, then reconstruct "
+                     "it again)",
+                     units);
   for (const PosedSlab& s : slabs)
     if (s.info.units != units)
       throw InputError(s.slab_dir + "/slab.json", "units",

@@ -47,8 +47,9 @@ std::vector<double> BlendWeights(const std::vector<OrientationCone>& cones,
 // The slabs' common unit (SlabInfo::units): every orientation carries its own radiometric scale
 // (its calib/scale.json), so the merged intensity is in one unit only when every slab's is the
 // same: "lux" (cd, lm) or "W/m^2" (W/sr, W) throughout. BadInput naming the slab.json of the
-// first slab unlike the first otherwise. "relative" slabs (no scale) merge only among themselves
-// and only if the caller accepts it (their relative levels are the cameras' exposures).
+// first slab unlike the first otherwise. "relative" slabs (no scale) are refused when there are
+// several: each one's level is its own capture's exposure, so their sum would not be one
+// luminaire's light (one relative slab alone is what it is, as export states).
 std::string CommonUnits(const std::vector<PosedSlab>& slabs);
 
 // The merged far field on a C / gamma grid of the luminaire frame (gamma 0-180: the full sphere).

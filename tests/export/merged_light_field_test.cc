@@ -470,7 +470,8 @@ TEST(MergedLightField, BlendWeights) {
   EXPECT_DOUBLE_EQ(w[0], 1);
 }
 
-// Every orientation carries its own scale: slabs in lux and in W/m^2 do not merge.
+// Every orientation carries its own scale: slabs in lux and in W/m^2 do not merge, nor several
+// without a scale.
 TEST(MergedLightField, UnitsMustAgree) {
   std::vector<PosedSlab> slabs(2);
   slabs[0].slab_dir = "a/slab";
@@ -485,6 +486,11 @@ TEST(MergedLightField, UnitsMustAgree) {
   }
   slabs[1].info.units = "lux";
   EXPECT_EQ(CommonUnits(slabs), "lux");
+  // Without a scale, each slab's level is its capture's exposure: not merged.
+  slabs[0].info.units = slabs[1].info.units = "relative";
+  EXPECT_THROW(CommonUnits(slabs), Error);
+  slabs.pop_back();
+  EXPECT_EQ(CommonUnits(slabs), "relative");
 }
 
 }  // namespace

@@ -2,8 +2,9 @@
 // measured from several orientations (core/luminaire_set.h), each orientation's complete slab
 // with its pose, looked at as one luminaire in its own frame. The far field of every orientation
 // is read at the directions it sees and blended where several see one; the rays of every slab
-// are turned into the luminaire frame and thinned by the same blend. GL-free; the preview's
-// shader carries a copy of the blend weights (tests/preview pins the two equal).
+// are turned into the luminaire frame and thinned by the same blend. GL-free. (The preview blends
+// with the taper alone, its shader's copy of ConeTaper pinned by tests/preview: it reads no seen
+// masks.)
 //
 // Frames: R_k (capture_from_luminaire) maps luminaire-frame directions into orientation k's
 // capture frame, w_capture = R_k w; points x_capture = R_k x + centre_k (docs/formats.md §19).
@@ -37,8 +38,8 @@ struct PosedSlab {
 // whether orientation k's far field saw R_k w (its mask). Where no orientation's taper is above 0
 // but some saw w (the cone is drawn with a margin the seen mask need not keep), the orientations
 // that saw it share it equally; where none saw it every weight is 0. The weights sum to 1 or 0.
-// The one CPU implementation of the blend: the merged far field, the merged rays and the test
-// of the preview's shader all call it.
+// The one implementation of the blend with seen masks: the merged far field and the merged rays
+// call it.
 std::vector<double> BlendWeights(const std::vector<OrientationCone>& cones,
                                  const std::vector<Eigen::Matrix3d>& capture_from_luminaire,
                                  const std::vector<uint8_t>& seen, const Eigen::Vector3d& w,

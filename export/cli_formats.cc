@@ -78,10 +78,10 @@ FarField SlabFarField(const Slab& slab, const std::vector<double>& c_deg,
   return std::move(merged.ff);
 }
 
-// The coverage against the slab's model: a luminaire folder's truth/ (luminaire frame) or the
-// dataset's (GridCoverage).
+// The coverage against the slab's model: a luminaire folder's truth/ (luminaire frame; without
+// one, an isotropic emitter) or the dataset's (GridCoverage).
 Coverage SlabCoverage(const IntensityDistribution& d, const FarField& ff, const Slab& slab) {
-  return slab.luminaire ? GridCoverageWithTruth(d, ff, slab.info, slab.luminaire->TruthDir())
+  return slab.luminaire ? GridCoverageWithTruth(d, ff, slab.info, slab.luminaire->TruthDir(), true)
                         : GridCoverage(d, ff, slab.info, slab.dir);
 }
 

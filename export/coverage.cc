@@ -44,7 +44,8 @@ Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const 
 }
 
 Coverage GridCoverageWithTruth(const IntensityDistribution& d, const FarField& ff,
-                               const SlabInfo& info, const std::string& truth_dir) {
+                               const SlabInfo& info, const std::string& truth_dir,
+                               bool isotropic_model) {
   Coverage c;
   const size_t ng = d.gamma_deg.size();
   c.c_deg = d.c_deg;
@@ -78,7 +79,12 @@ Coverage GridCoverageWithTruth(const IntensityDistribution& d, const FarField& f
       c.model = "the analytic luminaire of the synthetic dataset (truth/luminaire.json)";
     }
   }
-  if (!c.analytic) {
+  if (!c.analytic && isotropic_model) {
+    for (double& v : model.values) v = 1;
+    c.model =
+        "a model, not a measurement: an isotropic emitter (I0 in every direction) matched to the "
+        "seen flux";
+  } else if (!c.analytic) {
     for (size_t ic = 0; ic < d.c_deg.size(); ++ic)
       for (size_t ig = 0; ig < ng; ++ig)
         model.values[ic * ng + ig] = std::max(0.0, std::cos(d.gamma_deg[ig] * kPi / 180));

@@ -382,6 +382,12 @@ TEST_F(MergedExport, HemisphereFolderIsPartialForTheSphere) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("as orientation o00 sees it"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("at 745 mm from its S"), std::string::npos) << r.output;
+  // Without the analytic luminaire (a real capture), the model of a luminaire folder is an
+  // isotropic emitter: the back hemisphere no orientation saw is still missing light.
+  fs::remove_all(half + "/truth");
+  r = RunTool("lumislab-export", args + " --force");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("an isotropic emitter"), std::string::npos) << r.output;
 }
 
 // A mounting error of 1.5 degrees: o03 (looking along the luminaire's +x, at the narrow lobe

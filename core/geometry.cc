@@ -39,6 +39,20 @@ Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees) {
       .toRotationMatrix();
 }
 
+Eigen::Vector3d ZyxDegreesOf(const Eigen::Matrix3d& r) {
+  // R = Rz Ry Rx: R(2,0) = -sin y, R(2,1) / R(2,2) = tan x, R(1,0) / R(0,0) = tan z.
+  const double sin_y = std::clamp(-r(2, 0), -1.0, 1.0);
+  const double y = std::asin(sin_y);
+  double x = 0, z = 0;
+  if (std::abs(sin_y) < 1 - 1e-12) {
+    x = std::atan2(r(2, 1), r(2, 2));
+    z = std::atan2(r(1, 0), r(0, 0));
+  } else {  // cos y = 0: only z -+ x is defined; x = 0
+    z = std::atan2(-r(0, 1), r(1, 1));
+  }
+  return Eigen::Vector3d(x, y, z) * 180 / kPi;
+}
+
 Eigen::Vector3d TypeCDirection(double c_deg, double gamma_deg) {
   const double c = c_deg * kPi / 180, g = gamma_deg * kPi / 180;
   return {std::sin(g) * std::cos(c), -std::sin(g) * std::sin(c), std::cos(g)};

@@ -130,6 +130,8 @@ std::string Percent(double fraction) {
   return buf;
 }
 
+void DropRedundant(std::vector<const Candidate*>* chosen, int needed, int min_common);
+
 // Greedy set cover over one lattice's candidates. `stall` is set to the candidate that would
 // add most while overlapping no chosen one enough, when the cover stops short.
 std::vector<const Candidate*> GreedyCover(const std::vector<Candidate>& candidates, int needed,
@@ -171,7 +173,39 @@ std::vector<const Candidate*> GreedyCover(const std::vector<Candidate>& candidat
     Or(&covered, best->seen);
     tilts.push_back(best->pose.mount_tilt_deg);
   }
-  // Drop, latest first, what the others now cover without breaking the connection.
+  DropRedundant(&chosen, needed, min_common);
+  // Two for one: where one candidate sees all that two chosen ones alone saw and keeps the set
+  // connected, it replaces them (the greedy's early choices are often improved so).
+  for (bool improved = true; improved && chosen.size() > 2;) {
+    improved = false;
+    for (size_t i = 1; i < chosen.size() && !improved; ++i)
+      for (size_t j = i + 1; j < chosen.size() && !improved; ++j) {
+        std::vector<const Candidate*> rest;
+        for (size_t k = 0; k < chosen.size(); ++k)
+          if (k != i && k != j) rest.push_back(chosen[k]);
+        Bits unseen = covered;
+        for (const Candidate* c : rest)
+          for (size_t w = 0; w < unseen.size(); ++w) unseen[w] &= ~c->seen[w];
+        for (const Candidate& c : candidates) {
+          if (CountAndNot(unseen, c.seen) > 0) continue;
+          rest.push_back(&c);
+          if (Connected(rest, min_common)) {
+            chosen = rest;
+            improved = true;
+            break;
+          }
+          rest.pop_back();
+        }
+      }
+  }
+  return chosen;
+}
+
+// Drops, latest first, what the others cover without breaking the connection.
+void DropRedundant(std::vector<const Candidate*>* chosen_set, int needed, int min_common) {
+  std::vector<const Candidate*>& chosen = *chosen_set;
+  Bits covered(chosen[0]->seen.size(), 0);
+  for (const Candidate* c : chosen) Or(&covered, c->seen);
   for (size_t k = chosen.size(); k-- > 1;) {
     std::vector<const Candidate*> rest = chosen;
     rest.erase(rest.begin() + long(k));
@@ -180,7 +214,6 @@ std::vector<const Candidate*> GreedyCover(const std::vector<Candidate>& candidat
     if (Count(cover) >= std::min(needed, Count(covered)) && Connected(rest, min_common))
       chosen = rest;
   }
-  return chosen;
 }
 
 // Mount indices in order of first use (the first orientation's mount is 0), then the

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <filesystem>
 
+#include "acquire/cli.h"
 #include "acquire_test_util.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/json.h"
@@ -189,6 +191,34 @@ TEST(SynthOrientations, RefusesAnEmitterInFrontOfS) {
         << message;
   }
   EXPECT_FALSE(fs::exists(dir + "/lum"));
+}
+
+int RunTool(std::vector<std::string> args) {
+  args.insert(args.begin(), {"lumislab-acquire", "synth"});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  return RunMain("acquire", [&] { return RunAcquire(int(argv.size()), argv.data()); });
+}
+
+// The command line: --orientations makes the luminaire folder; a mounting error without it, and
+// a missing orientations file, are bad input (exit 2).
+TEST(SynthOrientations, CommandLine) {
+  const std::string dir = FreshDir("orientations_cli");
+  const std::string scene = dir + "/scene.json";
+  WriteTextAtomically(scene, acquire_test::SmallSceneJson());
+  WriteLuminaireSet(ThreeOrientations(dir + "/plan"));
+  EXPECT_EQ(RunTool({"--scene", scene, "--out", dir + "/x", "--mount-error-deg", "1"}), 2);
+  EXPECT_EQ(RunTool({"--scene", scene, "--out", dir + "/x", "--orientations", dir + "/none.json"}),
+            2);
+  EXPECT_FALSE(fs::exists(dir + "/x"));
+  EXPECT_EQ(RunTool({"--scene", scene, "--out", dir + "/lum", "--orientations",
+                     LuminaireJsonPath(dir + "/plan"), "--mount-error-deg", "1.5", "--seed", "3",
+                     "--truth-resolution", "10", "--threads", "2"}),
+            0);
+  EXPECT_TRUE(LuminaireFolderComplete(dir + "/lum"));
+  const JsonDocument truth = JsonDocument::Load(dir + "/lum/truth/orientations.json");
+  EXPECT_EQ(truth.root()["seed"].Int(), 3);
+  EXPECT_GE(truth.root()["orientations"][2]["error_deg"].Number(), 0.75);
 }
 
 }  // namespace

@@ -128,6 +128,12 @@ TEST(PlanOrientationsCli, PlanLoadsAsALuminaireSet) {
     EXPECT_EQ(hand.orientations[k].mount, int(k));
     EXPECT_FALSE(hand.orientations[k].axis_deg);
   }
+  // The setup from a dataset.json (its photos not read), for the hemisphere.
+  ASSERT_EQ(
+      Plan({"--dataset-setup", std::string(LUMISLAB_SOURCE_DIR) + "/tests/data/v1/dataset.json",
+            "--hemisphere", "--out", (dir / "luminaire.json").string()}),
+      0);
+  EXPECT_EQ(LoadLuminaireSet(dir.string()).coverage, "hemisphere");
 }
 
 std::string Refusal(const std::vector<std::string>& args) {
@@ -156,6 +162,8 @@ TEST(PlanOrientationsCli, RefusesWhatCannotCoverOrConnect) {
       Refusal({"--distance-mm", "750", "--screen-mm", "2000", "2000", "--grid", "3", "3", "10",
                "--luminaire-radius-mm", "100", "--centre-depth-mm", "90"});
   EXPECT_NE(centre.find("--centre-depth-mm: expected more than"), std::string::npos) << centre;
+  const std::string both = Refusal({"--dataset-setup", "dataset.json", "--distance-mm", "750"});
+  EXPECT_NE(both.find("--dataset-setup: give the setup by a file"), std::string::npos) << both;
 }
 
 }  // namespace

@@ -320,7 +320,8 @@ LuminaireSet OrientationPlanSet(const OrientationPlanInput& in, const Orientatio
     std::snprintf(name, sizeof name, "o%02zu", k);
     o.name = name;
     o.dataset = name;
-    o.rotation_deg = ZyxDegreesOf(p.rotation);
+    // The lattice's angles, without the last bits of the decomposition nor a -0.
+    o.rotation_deg = (ZyxDegreesOf(p.rotation) * 1e9).array().round() / 1e9 + 0.0;
     o.centre_mm = in.centre_mm;
     o.mount = p.mount;
     if (in.rotation_axis) o.axis_deg = p.axis_deg;

@@ -57,7 +57,7 @@ void WriteTrueOrientations(const LuminaireSet& set, const std::vector<TruePose>&
         {{"name", p.name},
          {"dataset", set.orientations[k].dataset},
          {"rotation", MatrixJson(p.rotation)},
-         {"rotation_deg", VectorJson(ZyxDegreesOf(p.rotation))},
+         {"rotation_deg", VectorJson(RotationZyxDegreesOf(p.rotation))},
          {"nominal_rotation_deg", VectorJson(set.orientations[k].rotation_deg)},
          {"centre_mm", VectorJson(p.centre_mm)},
          {"error_deg", p.error_deg}});
@@ -83,7 +83,7 @@ void WriteLuminaireFolder(const SynthScene& scene, const SynthOptions& options,
     one.out_dir = set.DatasetFolder(k);
     one.force = true;  // a fresh folder (staging) or a live capture's redo
     LogInfo("orientation ", poses[k].name, " (", k + 1, "/", poses.size(), "): rotation_deg ",
-            ZyxDegreesOf(poses[k].rotation).transpose(), ", mounting error ", poses[k].error_deg,
+            RotationZyxDegreesOf(poses[k].rotation).transpose(), ", mounting error ", poses[k].error_deg,
             " deg");
     report->orientations.push_back(RunSynth(turned, one));
   }

@@ -321,7 +321,7 @@ LuminaireSet OrientationPlanSet(const OrientationPlanInput& in, const Orientatio
     o.name = name;
     o.dataset = name;
     // The lattice's angles, without the last bits of the decomposition nor a -0.
-    o.rotation_deg = (ZyxDegreesOf(p.rotation) * 1e9).array().round() / 1e9 + 0.0;
+    o.rotation_deg = (RotationZyxDegreesOf(p.rotation) * 1e9).array().round() / 1e9 + 0.0;
     o.centre_mm = in.centre_mm;
     o.mount = p.mount;
     if (in.rotation_axis) o.axis_deg = p.axis_deg;

@@ -81,18 +81,6 @@ TEST(GeometryTest, RotationZyxDegreesAppliesXThenYThenZ) {
   EXPECT_TRUE(z.isApprox((Eigen::Matrix3d() << c, -s, 0, s, c, 0, 0, 0, 1).finished(), 1e-12)) << z;
 }
 
-// ZyxDegreesOf inverts RotationZyxDegrees: the angles come back (y inside (-90, 90)), and at
-// gimbal lock (y = +-90) the rotation does.
-TEST(GeometryTest, ZyxDegreesOfInvertsRotationZyxDegrees) {
-  for (const Eigen::Vector3d a : {Eigen::Vector3d(10, -20, 30), Eigen::Vector3d(-170, 89, 179),
-                                  Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(120, -45, -60)})
-    EXPECT_TRUE(ZyxDegreesOf(RotationZyxDegrees(a)).isApprox(a, 1e-9)) << a.transpose();
-  for (const Eigen::Vector3d a : {Eigen::Vector3d(30, 90, 10), Eigen::Vector3d(-50, -90, 70)}) {
-    const Eigen::Matrix3d r = RotationZyxDegrees(a);
-    EXPECT_TRUE(RotationZyxDegrees(ZyxDegreesOf(r)).isApprox(r, 1e-9)) << a.transpose();
-  }
-}
-
 // Type C in the luminaire frame (docs/formats.md §17, "Orientation"): gamma = 0 along +z, C = 0
 // towards +x, C = 90 towards -y, so C turns counter-clockwise seen looking along +z (from +x
 // through -y to -x and +y), as LM-63 counts it looking down along gamma = 0. Radiance's

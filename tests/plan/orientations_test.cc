@@ -115,7 +115,7 @@ TEST(PlanOrientationsCli, PlanLoadsAsALuminaireSet) {
     ASSERT_TRUE(o.mount && o.axis_deg) << k;
     const Eigen::Matrix3d on_axis = RotationZyxDegrees({0, *o.axis_deg, 0});
     // The mount's tilt is about x only: what the pose is after taking the axis angle off.
-    const Eigen::Vector3d tilt = ZyxDegreesOf(on_axis.transpose() * o.NominalRotation());
+    const Eigen::Vector3d tilt = RotationZyxDegreesOf(on_axis.transpose() * o.NominalRotation());
     EXPECT_NEAR(tilt.y(), 0, 1e-9) << k;
     EXPECT_NEAR(tilt.z(), 0, 1e-9) << k;
   }

@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/input_file.h"
 #include "core/json.h"
 #include "core/log.h"
 #include "core/stop_signal.h"
@@ -83,13 +84,44 @@ void WriteLuminaireFolder(const SynthScene& scene, const SynthOptions& options,
     one.out_dir = set.DatasetFolder(k);
     one.force = true;  // a fresh folder (staging) or a live capture's redo
     LogInfo("orientation ", poses[k].name, " (", k + 1, "/", poses.size(), "): rotation_deg ",
-            RotationZyxDegreesOf(poses[k].rotation).transpose(), ", mounting error ", poses[k].error_deg,
-            " deg");
+            RotationZyxDegreesOf(poses[k].rotation).transpose(), ", mounting error ",
+            poses[k].error_deg, " deg");
     report->orientations.push_back(RunSynth(turned, one));
   }
 }
 
 }  // namespace
+
+LuminaireSet LoadOrientationsFile(const std::string& file) {
+  const fs::path path(file);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return LoadLuminaireSet(file);
+  if (path.filename() == "luminaire.json")
+    return LoadLuminaireSet(path.has_parent_path() ? path.parent_path().string() : ".");
+  // Another name: read through LoadLuminaireSet from a private folder, its messages naming the
+  // file given.
+  CheckInputFile(file, "orientations file");
+  const std::string folder = TemporaryPathFor(file + ".d");
+  struct Remove {
+    std::string folder;
+    ~Remove() {
+      std::error_code ignored;
+      fs::remove_all(folder, ignored);
+    }
+  } remove{folder};
+  MakeDirectories(folder);
+  WriteTextAtomically(LuminaireJsonPath(folder), ReadTextFile(file));
+  try {
+    LuminaireSet set = LoadLuminaireSet(folder);
+    set.folder = path.has_parent_path() ? path.parent_path().string() : ".";
+    return set;
+  } catch (const Error& e) {
+    std::string message = e.what();
+    for (size_t at; (at = message.find(LuminaireJsonPath(folder))) != std::string::npos;)
+      message.replace(at, LuminaireJsonPath(folder).size(), file);
+    throw Error(e.code(), message);
+  }
+}
 
 void SynthOrientationsOptions::Check() const {
   if (orientations_file.empty())
@@ -119,17 +151,16 @@ std::vector<TruePose> TruePoses(const LuminaireSet& set, double mount_error_deg,
 
 void CheckBehindS(const Luminaire& luminaire, const LuminaireSet& set,
                   const std::vector<TruePose>& poses, const std::string& file) {
-  for (size_t k = 0; k < poses.size(); ++k)
-    for (size_t e = 0; e < luminaire.emitters.size(); ++e) {
-      const Eigen::Vector3d x =
-          poses[k].rotation * luminaire.emitters[e].position_mm + poses[k].centre_mm;
-      if (x.z() < 0) continue;
+  if (!luminaire.ray_sources.empty()) luminaire.Turned(poses[0].rotation, poses[0].centre_mm);
+  for (size_t k = 0; k < poses.size(); ++k) {
+    try {
+      luminaire.Turned(poses[k].rotation, poses[k].centre_mm);  // its refusal, named here
+    } catch (const Error& e) {
       throw InputError(file, Field(set, k, "centre_mm"),
-                       "a pose that keeps every emitter behind S (z < 0 of the capture frame)",
-                       "emitter " + std::to_string(e) + " at z = " + Num(x.z(), 4) +
-                           " mm (rotation_deg and centre_mm turn it in front of S; move the "
-                           "centre deeper)");
+                       "a pose (rotation_deg, centre_mm) that keeps every emitter behind S",
+                       e.what());
     }
+  }
 }
 
 bool LuminaireFolderComplete(const std::string& dir) {

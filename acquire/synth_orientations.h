@@ -28,6 +28,10 @@ struct SynthOrientationsOptions {
   void Check() const;  // BadInput naming the option
 };
 
+// The orientations of a file in luminaire.json's format (any name), a luminaire.json or a
+// luminaire folder (LoadLuminaireSet's checks; messages name the file given).
+LuminaireSet LoadOrientationsFile(const std::string& file);
+
 // The true pose of one orientation: R_true = E R_nominal, E the mounting error (a turn in the
 // capture frame, what registration.json's correction estimates), about the same centre.
 struct TruePose {
@@ -42,8 +46,9 @@ struct TruePose {
 // orientation exact (it defines the luminaire frame).
 std::vector<TruePose> TruePoses(const LuminaireSet& set, double mount_error_deg, uint64_t seed);
 
-// BadInput "<file>: orientations[k] (name): rotation_deg/centre_mm: ..." when a pose puts an
-// emitter of `luminaire` on or in front of S (z >= 0 of the capture frame).
+// BadInput "<file>: orientations[k] (name): centre_mm: expected ..., got <Luminaire::Turned's
+// reason>" when a pose puts an emitter of `luminaire` on or in front of S (z >= 0 of the capture
+// frame); Turned's own refusal of a luminaire with ray sources.
 void CheckBehindS(const Luminaire& luminaire, const LuminaireSet& set,
                   const std::vector<TruePose>& poses, const std::string& file);
 

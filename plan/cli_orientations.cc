@@ -44,6 +44,27 @@ Dataset SetupOf(const OrientationsCommand& c) {
   return ds;
 }
 
+// luminaire.json's content under any file name: WriteLuminaireSet into a private folder beside
+// it, the file then renamed onto `file` (atomic as WriteLuminaireSet is).
+void WritePlanFile(LuminaireSet set, const std::string& file) {
+  const fs::path path(file);
+  set.folder = path.has_parent_path() ? path.parent_path().string() : ".";
+  if (path.filename() == "luminaire.json") return WriteLuminaireSet(set);
+  const std::string folder = TemporaryPathFor(file + ".d");
+  MakeDirectories(folder);
+  set.folder = folder;
+  std::error_code ec;
+  try {
+    WriteLuminaireSet(set);
+    fs::rename(LuminaireJsonPath(folder), path, ec);
+    if (ec) throw IoError(file, "cannot rename " + LuminaireJsonPath(folder) + " onto it");
+  } catch (...) {
+    fs::remove_all(folder, ec);
+    throw;
+  }
+  fs::remove_all(folder, ec);
+}
+
 }  // namespace
 
 CLI::App* AddOrientationsCommand(CLI::App& app, OrientationsCommand* c, CommonOptions* common) {
@@ -134,7 +155,7 @@ int RunOrientationsCommand(const OrientationsCommand& c, int threads) {
   std::cout << OrientationPlanTable(in, plan);
   if (!plan.problem.empty()) throw BadInput("no plan: " + plan.problem);
   if (!c.out.empty()) {
-    WriteOrientationsFile(OrientationPlanSet(in, plan), c.out);
+    WritePlanFile(OrientationPlanSet(in, plan), c.out);
     std::cout << "plan: " << c.out << '\n';
   }
   return 0;

@@ -20,6 +20,15 @@ constexpr int kSearchSamples = 6000;
 
 using Bits = std::vector<uint64_t>;
 
+// AnalyseCoverage's default sampling, named for the calls that pass names.
+constexpr int kCoverageSamples = 20000;
+
+std::string OrientationName(size_t k) {
+  char name[32];
+  std::snprintf(name, sizeof name, "o%02zu", k);
+  return name;
+}
+
 int Count(const Bits& a) {
   int n = 0;
   for (uint64_t w : a) n += __builtin_popcountll(w);
@@ -238,10 +247,17 @@ std::vector<PlannedOrientation> Ordered(const std::vector<const Candidate*>& cho
   return out;
 }
 
+std::vector<std::string> Names(size_t count) {
+  std::vector<std::string> names;
+  for (size_t k = 0; k < count; ++k) names.push_back(OrientationName(k));
+  return names;
+}
+
 void Analyse(const OrientationPlanInput& in, OrientationPlan* plan) {
   const std::vector<Eigen::Matrix3d> rotations = Rotations(plan->orientations);
   const std::vector<OrientationCone> cones(rotations.size(), in.cone);
-  plan->coverage = AnalyseCoverage(rotations, cones, in.hemisphere);
+  plan->coverage =
+      AnalyseCoverage(rotations, cones, in.hemisphere, kCoverageSamples, Names(rotations.size()));
   plan->cumulative_coverage.clear();
   for (size_t k = 1; k <= rotations.size(); ++k)
     plan->cumulative_coverage.push_back(
@@ -287,7 +303,8 @@ OrientationPlan PlanOrientations(const OrientationPlanInput& in) {
         std::vector<Eigen::Matrix3d> r = Rotations(plan.orientations);
         r.push_back(stall->pose.rotation);
         const CoverageReport next =
-            AnalyseCoverage(r, std::vector<OrientationCone>(r.size(), in.cone), in.hemisphere);
+            AnalyseCoverage(r, std::vector<OrientationCone>(r.size(), in.cone), in.hemisphere,
+                            kCoverageSamples, Names(r.size()));
         why << ": no further turn overlaps the chosen ones enough to register"
             << (next.overlap_problem.empty() ? "" : " (" + next.overlap_problem + ")");
       } else {
@@ -316,10 +333,8 @@ LuminaireSet OrientationPlanSet(const OrientationPlanInput& in, const Orientatio
   for (size_t k = 0; k < plan.orientations.size(); ++k) {
     const PlannedOrientation& p = plan.orientations[k];
     Orientation o;
-    char name[32];
-    std::snprintf(name, sizeof name, "o%02zu", k);
-    o.name = name;
-    o.dataset = name;
+    o.name = OrientationName(k);
+    o.dataset = o.name;
     // The lattice's angles, without the last bits of the decomposition nor a -0.
     o.rotation_deg = (RotationZyxDegreesOf(p.rotation) * 1e9).array().round() / 1e9 + 0.0;
     o.centre_mm = in.centre_mm;

@@ -120,7 +120,8 @@ TEST(SynthOrientations, TruthSlabIsTheAnalyticTurnedLuminaire) {
           const Eigen::Vector2d st = info.layout.TexelCentre(col, row);
           Eigen::Vector3d expected = Eigen::Vector3d::Zero();
           for (const Emitter& e : scene.luminaire.emitters) {
-            const Eigen::Vector3d x = r * e.position_mm + poses[k].centre_mm;
+            const Eigen::Vector3d x =
+                r * (e.position_mm - scene.luminaire.centre_mm) + poses[k].centre_mm;
             const Eigen::Vector3d ray = Eigen::Vector3d(st.x(), st.y(), d) - x;
             const double dist = ray.norm();
             const Eigen::Vector3d w = ray / dist;
@@ -216,6 +217,21 @@ TEST(SynthOrientations, CommandLine) {
                      "--truth-resolution", "10", "--threads", "2"}),
             0);
   EXPECT_TRUE(LuminaireFolderComplete(dir + "/lum"));
+  // A plan under another name reads the same; its errors name it.
+  const std::string plan = dir + "/plan.json";
+  WriteTextAtomically(plan, ReadTextFile(LuminaireJsonPath(dir + "/plan")));
+  EXPECT_EQ(LoadOrientationsFile(plan).orientations.size(), 3u);
+  std::string text = ReadTextFile(plan);
+  text.replace(text.find("\"sphere\""), 8, "\"cube\"");
+  WriteTextAtomically(plan, text);
+  try {
+    LoadOrientationsFile(plan);
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(plan + ": coverage: expected", 0), 0u) << e.what();
+  }
+  for (const auto& entry : fs::directory_iterator(dir))  // no private folder left
+    EXPECT_EQ(entry.path().string().find(".d"), std::string::npos) << entry.path();
   const JsonDocument truth = JsonDocument::Load(dir + "/lum/truth/orientations.json");
   EXPECT_EQ(truth.root()["seed"].Int(), 3);
   EXPECT_GE(truth.root()["orientations"][2]["error_deg"].Number(), 0.75);

@@ -16,6 +16,8 @@ namespace {
 int PrintScene(const std::string& scene) {
   if (scene == "default") {
     std::fputs(DefaultSceneJson().c_str(), stdout);
+  } else if (scene == "full-sphere") {
+    std::fputs(FullSphereSceneJson().c_str(), stdout);
   } else {
     LoadScene(scene);  // validates
     std::fputs(ReadTextFile(scene).c_str(), stdout);
@@ -52,7 +54,10 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
       "synth",
       "render the photos of a synthetic scene through both filter slides, a "
       "calibration photo, dataset.json and the analytic truth/ into a dataset folder");
-  cmd->add_option("--scene", o.scene, "scene file (JSON) or \"default\"")->required();
+  cmd->add_option("--scene", o.scene,
+                  "scene file (JSON), \"default\" or \"full-sphere\" (a luminaire lighting "
+                  "every direction, for --orientations)")
+      ->required();
   cmd->add_option("--out", o.out_dir, "dataset folder to write");
   cmd->add_option("--interval", o.interval_s,
                   "live acquisition: dataset.json and the calibration photo first, then "
@@ -104,7 +109,8 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
   cmd->add_option("--seed", c->orientations.seed, "--orientations: the seed of the mounting errors")
       ->capture_default_str();
   cmd->add_flag("--print-scene", c->print_scene,
-                "print the scene as JSON (the built-in one for --scene default) and exit");
+                "print the scene as JSON (the built-in one for --scene default or full-sphere) "
+                "and exit");
   AddCommonOptions(cmd, common);
   return cmd;
 }

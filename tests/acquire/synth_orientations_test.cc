@@ -90,16 +90,28 @@ TEST(SynthOrientations, WritesTheLuminaireFolderAndTruth) {
         << entry.path();
 }
 
+// The built-in full-sphere scene (lobes along every axis, a side lobe and an asymmetric one) with
+// a 3 x 3 grid and a small camera.
+SynthScene SmallFullSphereScene() {
+  SynthScene scene = LoadScene("full-sphere");
+  scene.grid.nu = scene.grid.nv = 3;
+  scene.camera.width = 160;
+  scene.camera.height = 120;
+  scene.camera.focal_px /= 10;
+  return scene;
+}
+
 // Orientation k's truth slab is the luminaire turned by its true pose, written here from the
-// emitters of the luminaire's own frame: a point x = R p + centre, intensity I0 Shape(R^T w)
-// towards w, through the filter at c_ij where the ray crosses S.
+// emitters of the luminaire's own frame: a point x = R (p - centre) + centre_k, intensity
+// I0 Shape(R^T w) towards w (the lobe about its own axis), through the filter at c_ij where the
+// ray crosses S.
 TEST(SynthOrientations, TruthSlabIsTheAnalyticTurnedLuminaire) {
   const std::string dir = FreshDir("orientations_truth");
   WriteLuminaireSet(ThreeOrientations(dir + "/plan"));
   SynthOrientationsOptions o;
   o.orientations_file = LuminaireJsonPath(dir + "/plan");
   o.mount_error_deg = 2;
-  const SynthScene scene = SmallScene();
+  const SynthScene scene = SmallFullSphereScene();
   const std::string lum = dir + "/lum";
   RunSynthOrientations(scene, SmallSynthOptions(lum), o);
   const LuminaireSet set = LoadLuminaireSet(lum);

@@ -140,6 +140,8 @@ std::string Percent(double fraction) {
 }
 
 void DropRedundant(std::vector<const Candidate*>* chosen, int needed, int min_common);
+void SwapTwoForOne(const std::vector<Candidate>& candidates, const Bits& covered, int min_common,
+                   std::vector<const Candidate*>* chosen);
 
 // Greedy set cover over one lattice's candidates. `stall` is set to the candidate that would
 // add most while overlapping no chosen one enough, when the cover stops short.
@@ -183,8 +185,16 @@ std::vector<const Candidate*> GreedyCover(const std::vector<Candidate>& candidat
     tilts.push_back(best->pose.mount_tilt_deg);
   }
   DropRedundant(&chosen, needed, min_common);
-  // Two for one: where one candidate sees all that two chosen ones alone saw and keeps the set
-  // connected, it replaces them (the greedy's early choices are often improved so).
+  SwapTwoForOne(candidates, covered, min_common, &chosen);
+  return chosen;
+}
+
+// Two for one: where one candidate sees all that two chosen ones alone saw and keeps the set
+// connected, it replaces them (the greedy's early choices are often improved so), until no such
+// swap is left. The first orientation stays.
+void SwapTwoForOne(const std::vector<Candidate>& candidates, const Bits& covered, int min_common,
+                   std::vector<const Candidate*>* chosen_set) {
+  std::vector<const Candidate*>& chosen = *chosen_set;
   for (bool improved = true; improved && chosen.size() > 2;) {
     improved = false;
     for (size_t i = 1; i < chosen.size() && !improved; ++i)
@@ -207,7 +217,6 @@ std::vector<const Candidate*> GreedyCover(const std::vector<Candidate>& candidat
         }
       }
   }
-  return chosen;
 }
 
 // Drops, latest first, what the others cover without breaking the connection.

@@ -287,7 +287,7 @@ OrientationPlan PlanOrientations(const OrientationPlanInput& in) {
   std::optional<OrientationPlan> best;
   OrientationPlan fallback;  // the largest coverage, when no lattice reaches the request
   double fallback_coverage = -1;
-  int best_mounts = 0;
+  double best_cost = 0;
   for (int step : kOrientationStepsDeg) {
     const std::vector<Candidate> candidates = Candidates(in, samples, step, in.threads);
     const Candidate* stall = nullptr;
@@ -322,11 +322,12 @@ OrientationPlan PlanOrientations(const OrientationPlanInput& in) {
       plan.problem = why.str();
     }
     if (plan.problem.empty()) {
-      const int mounts = MountCount(chosen, in.rotation_axis);
-      if (!best || plan.orientations.size() < best->orientations.size() ||
-          (plan.orientations.size() == best->orientations.size() && mounts < best_mounts)) {
+      const double cost = double(plan.orientations.size()) +
+                          (in.rotation_axis ? kRemountCost * (MountCount(chosen, true) - 1) : 0.0);
+      if (!best || cost < best_cost - 1e-9 ||
+          (cost < best_cost + 1e-9 && plan.orientations.size() < best->orientations.size())) {
         best = plan;
-        best_mounts = mounts;
+        best_cost = cost;
       }
     } else if (covered > fallback_coverage) {
       fallback = plan;

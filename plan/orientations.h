@@ -20,6 +20,9 @@ constexpr double kDefaultLuminaireRadiusMm = 50;
 constexpr double kCentreDepthMarginMm = 10;
 // Candidate turns are multiples of one of these steps (degrees), coarsest first.
 constexpr int kOrientationStepsDeg[] = {90, 72, 60, 45, 40, 36, 30, 24, 20, 18, 15};
+// With a rotation axis a plan costs its orientations plus this much per hand remount: the
+// lattice of least cost wins (among equals the fewer orientations, then the coarser lattice).
+constexpr double kRemountCost = 0.5;
 // The search's connection test asks this much more overlap than kMinOverlapSr, so that
 // AnalyseCoverage, sampling the sphere more finely, finds every planned pair connected.
 constexpr double kPlannedOverlapMargin = 1.5;
@@ -56,7 +59,7 @@ struct OrientationPlan {
   std::string problem;
 };
 
-// The fewest orientations (then the fewest mounts) over candidate lattices of
+// The least cost (orientations + kRemountCost x remounts) over candidate lattices of
 // kOrientationStepsDeg: per lattice a greedy set cover that adds the candidate seeing most of
 // what is still unseen among those overlapping a chosen one, then drops what became redundant.
 OrientationPlan PlanOrientations(const OrientationPlanInput& in);

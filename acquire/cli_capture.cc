@@ -32,8 +32,9 @@ CLI::App* AddCaptureCommand(CLI::App& app, CaptureOptions* o, CommonOptions* com
                   "each position) or auto (position with a slide axis, else slide-pass)")
       ->capture_default_str();
   cmd->add_option("--operator", o->operator_program,
-                  "a program that carries out the operator's steps (slides, board) instead of "
-                  "the terminal: called as <program> <action> <argument> <request>");
+                  "a program that carries out the operator's steps (slides, board; with "
+                  "--orientations remounts and turns) instead of the terminal: called as "
+                  "<program> <action> <argument> <request>");
   cmd->add_flag("--dry-run", o->dry_run,
                 "print the plan, the travel, the photo count and the predicted lab time; touch "
                 "no device");

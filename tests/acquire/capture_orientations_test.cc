@@ -226,6 +226,19 @@ TEST(CaptureOrientations, APlanTheAxisCannotReachIsRefused) {
   CheckPlanAgainstLab(plan(R"({"name": "o01", "dataset": "o01", "rotation_deg": [0, 90, 0],
       "centre_mm": [0, 0, 0], "mount": 0, "axis_deg": 90})"),
                       plan_file, lab, "setup.json");
+  // lumislab-plan orientations' poses, R = Ry(axis_deg) Rx(mount tilt): a second orientation on
+  // the tilted mount 1, turned 45 degrees further by the axis.
+  LuminaireSet planned = plan(R"({"name": "o01", "dataset": "o01", "rotation_deg": [0, -60, 0],
+      "centre_mm": [0, 0, 0], "mount": 0, "axis_deg": -60})");
+  Orientation tilted = planned.orientations[2];  // [90, 0, 0] on mount 1 at axis 0
+  tilted.name = tilted.dataset = "o03";
+  tilted.rotation_deg = {90, 45, 0};
+  tilted.axis_deg = 45;
+  planned.orientations.push_back(tilted);
+  CheckPlanAgainstLab(planned, plan_file, lab, "setup.json");
+  planned.orientations.back().rotation_deg = {90, 0, 45};  // turned about z instead
+  ExpectRefused([&] { CheckPlanAgainstLab(planned, plan_file, lab, "setup.json"); },
+                "orientations[3].rotation_deg: expected orientations[2] turned");
   // Turned about x where the lab's axis turns about y.
   const LuminaireSet about_x = plan(R"({"name": "o01", "dataset": "o01",
       "rotation_deg": [90, 0, 0], "centre_mm": [0, 0, 0], "mount": 0, "axis_deg": 90})");

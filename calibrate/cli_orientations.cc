@@ -20,7 +20,8 @@ Eigen::Vector3d ZyxDegreesOf(const Eigen::Matrix3d& r) {
   const double sy = std::clamp(-r(2, 0), -1.0, 1.0);
   if (std::abs(sy) > 1 - 1e-12)
     return Eigen::Vector3d(0, std::asin(sy), std::atan2(-r(0, 1), r(1, 1))) * kDeg;
-  return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), std::asin(sy), std::atan2(r(1, 0), r(0, 0))) *
+  return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), std::asin(sy),
+                         std::atan2(r(1, 0), r(0, 0))) *
          kDeg;
 }
 
@@ -44,15 +45,15 @@ RegistrationInput ReadOrientation(const LuminaireSet& set, size_t k, const Regis
   if (!info.Complete())
     throw InputError(slab_dir + "/slab.json", "present",
                      "every position of the " + std::to_string(info.grid.nu) + " x " +
-                         std::to_string(info.grid.nv) + " grid (finish it with lumislab-reconstruct)",
+                         std::to_string(info.grid.nv) +
+                         " grid (finish it with lumislab-reconstruct)",
                      std::to_string(info.present.size()) + " position(s)");
   RegistrationInput in;
   in.name = orientation.name;
   in.nominal = orientation.NominalRotation();
   in.cone = ConeOfDataset(dataset);
-  in.far_field =
-      SampleFarFieldGrid(info, ReadSlabPositions(slab_dir, info, threads), in.cone,
-                         o.nodes_per_tan, threads);
+  in.far_field = SampleFarFieldGrid(info, ReadSlabPositions(slab_dir, info, threads), in.cone,
+                                    o.nodes_per_tan, threads);
   return in;
 }
 
@@ -76,8 +77,8 @@ void PrintTable(const LuminaireSet& set, const Registration& r) {
     char line[256];
     std::snprintf(line, sizeof line, "%-5s %-5s  %12.4f  %7d  %15.4f  %7.4f  %9.4f\n",
                   set.orientations[size_t(p.a)].name.c_str(),
-                  set.orientations[size_t(p.b)].name.c_str(), p.overlap_sr, p.samples,
-                  p.rms_before, p.rms_after, p.ratio);
+                  set.orientations[size_t(p.b)].name.c_str(), p.overlap_sr, p.samples, p.rms_before,
+                  p.rms_after, p.ratio);
     table << line;
   }
   std::printf("%s", table.str().c_str());
@@ -152,8 +153,8 @@ int RunOrientationsCommand(OrientationsCommand* c, int threads) {
   const LuminaireSet set = LoadLuminaireSet(c->luminaire);
   const std::string out = RegistrationJsonPath(c->luminaire);
   if (set.orientations.size() < 2)
-    throw InputError(LuminaireJsonPath(c->luminaire), "orientations",
-                     "at least two to register", std::to_string(set.orientations.size()));
+    throw InputError(LuminaireJsonPath(c->luminaire), "orientations", "at least two to register",
+                     std::to_string(set.orientations.size()));
   if (std::filesystem::exists(out) && !c->force)
     throw BadInput(out + ": exists; use --force to replace it");
 

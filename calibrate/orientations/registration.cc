@@ -18,9 +18,12 @@ constexpr double kDegPerRad = 180.0 / kPi;
 // A pair is compared when at least this many sample directions lie in its overlap.
 constexpr int kMinPairSamples = 20;
 // A direction of the corrections' space is unconstrained when its curvature is below this
-// fraction of the largest (its sigma 1000 times the best-fixed one's) or its sigma above
-// kFreeSigmaDeg: no small sigma is reported for what the overlaps do not fix.
-constexpr double kFreeCurvatureRatio = 1e-6;
+// fraction of the largest, or when turning kFreeSigmaDeg about it changes the overlaps'
+// intensities by less than their residual RMS after the fit, i.e. when the residual, were it
+// all systematic, could move it by more than kFreeSigmaDeg: the curvature then comes from the
+// far fields' own errors (a rotationally symmetric overlap still has some), not from the
+// luminaire. No small sigma is reported for what the overlaps do not fix.
+constexpr double kFreeCurvatureRatio = 1e-12;
 constexpr double kFreeSigmaDeg = 5.0;
 
 std::vector<Eigen::Vector3d> FibonacciSphere(int n) {
@@ -101,8 +104,7 @@ void RegistrationOptions::Check() const {
   if (!(loss_scale > 0)) throw BadInput("loss_scale: expected > 0, got " + Num(loss_scale));
   if (!(max_relative_rms > 0))
     throw BadInput("max_relative_rms: expected > 0, got " + Num(max_relative_rms));
-  if (max_iterations < 1 || threads < 1)
-    throw BadInput("max_iterations, threads: expected >= 1");
+  if (max_iterations < 1 || threads < 1) throw BadInput("max_iterations, threads: expected >= 1");
 }
 
 Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
@@ -127,8 +129,8 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     std::vector<PairSamples> pairs;
     for (const PairOverlap& p : coverage.pairs) {
       if (p.overlap_sr < kMinOverlapSr) continue;
-      PairSamples s = SelectSamples(sphere, samplers[size_t(p.a)], pose(p.a),
-                                    samplers[size_t(p.b)], pose(p.b), options.margin_deg);
+      PairSamples s = SelectSamples(sphere, samplers[size_t(p.a)], pose(p.a), samplers[size_t(p.b)],
+                                    pose(p.b), options.margin_deg);
       s.a = p.a;
       s.b = p.b;
       s.overlap_sr = p.overlap_sr;
@@ -191,7 +193,8 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
   // overlaps fix and "unconstrained" on the others (ceres::Covariance's pseudo-inverse would
   // give those a zero, i.e. a fake small, variance).
   out.orientations.resize(static_cast<size_t>(count));
-  std::vector<int> block_of(static_cast<size_t>(count), -1);  // column block of each free orientation
+  std::vector<int> block_of(static_cast<size_t>(count),
+                            -1);  // column block of each free orientation
   std::vector<double*> blocks;
   for (int k = 1; k < count; ++k)
     if (problem && problem->HasParameterBlock(corrections[size_t(k)].data())) {
@@ -222,13 +225,24 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     for (int i = 0; i < eigen.eigenvalues().size(); ++i) {
       const double lambda = eigen.eigenvalues()(i);
       const Eigen::VectorXd v = eigen.eigenvectors().col(i);
-      if (!(lambda > kFreeCurvatureRatio * largest) || variance / lambda > free_sigma_rad * free_sigma_rad) {
+      const bool free = !(lambda > kFreeCurvatureRatio * largest) ||
+                        variance * crs.num_rows / lambda > free_sigma_rad * free_sigma_rad;
+      if (free) {
         free_weight += v.cwiseAbs2();
         free_vectors.push_back(v);
       } else {
         cov += variance / lambda * v * v.transpose();
       }
     }
+  }
+  // What the overlaps do not fix stays nominal: the solver's drift along a free direction (its
+  // curvature is the far fields' own errors) is taken out of the corrections.
+  for (const Eigen::VectorXd& v : free_vectors) {
+    double along = 0;
+    for (size_t j = 0; j < blocks.size(); ++j)
+      along += v.segment<3>(3 * long(j)).dot(Eigen::Vector3d(blocks[j]));
+    for (size_t j = 0; j < blocks.size(); ++j)
+      Eigen::Map<Eigen::Vector3d>(blocks[j]) -= along * v.segment<3>(3 * long(j));
   }
   for (int k = 0; k < count; ++k) {
     RegisteredOrientation& o = out.orientations[size_t(k)];
@@ -242,8 +256,7 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     if (j < 0) {  // no pair compared: nothing fixes it
       o.unconstrained = {true, true, true};
       o.sigma_deg.setConstant(std::numeric_limits<double>::infinity());
-      o.free_axes = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
-                     Eigen::Vector3d::UnitZ()};
+      o.free_axes = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
       continue;
     }
     for (int i = 0; i < 3; ++i) {
@@ -263,13 +276,12 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
   for (const RegisteredPair& r : out.pairs) {
     if (r.samples < kMinPairSamples || !(r.rms_after > options.max_relative_rms)) continue;
     if (!out.disagreement.empty()) out.disagreement += "; ";
-    out.disagreement += "orientations " + inputs[size_t(r.a)].name + " and " +
-                        inputs[size_t(r.b)].name + " disagree over their overlap beyond noise: " +
-                        "relative RMS " + Num(r.rms_after) + " after the registration (" +
-                        Num(r.rms_before) + " before; threshold " +
-                        Num(options.max_relative_rms) + "), intensity ratio " + Num(r.ratio) +
-                        " over " + std::to_string(r.samples) + " directions (" +
-                        Num(r.overlap_sr) + " sr)";
+    out.disagreement +=
+        "orientations " + inputs[size_t(r.a)].name + " and " + inputs[size_t(r.b)].name +
+        " disagree over their overlap beyond noise: " + "relative RMS " + Num(r.rms_after) +
+        " after the registration (" + Num(r.rms_before) + " before; threshold " +
+        Num(options.max_relative_rms) + "), intensity ratio " + Num(r.ratio) + " over " +
+        std::to_string(r.samples) + " directions (" + Num(r.overlap_sr) + " sr)";
   }
   return out;
 }

@@ -17,13 +17,13 @@ namespace lumislab {
 // A pair whose relative RMS disagreement over its overlap stays above this after the fit is
 // refused (docs/method.md §4.12, "Registration", derives it: three times the RMS difference of
 // two slabs each within the single-slab far-field error).
-constexpr double kMaxOverlapRelativeRms = 0.05;
+constexpr double kMaxOverlapRelativeRms = 0.10;
 
 struct RegistrationOptions {
-  int directions = 40000;       // luminaire-frame directions sampled (Fibonacci sphere)
-  double margin_deg = 3;        // a sample must lie this far inside both cones
-  double nodes_per_tan = 40;    // far-field grid density (nodes per unit of x/z)
-  double loss_scale = 0.05;     // Huber scale of the relative residuals
+  int directions = 40000;     // luminaire-frame directions sampled (Fibonacci sphere)
+  double margin_deg = 3;      // a sample must lie this far inside both cones
+  double nodes_per_tan = 40;  // far-field grid density (nodes per unit of x/z)
+  double loss_scale = 0.05;   // Huber scale of the relative residuals
   double max_relative_rms = kMaxOverlapRelativeRms;
   int max_iterations = 100;
   int threads = 1;
@@ -39,8 +39,8 @@ struct RegistrationInput {
 };
 
 struct RegisteredOrientation {
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();    // refined capture_from_luminaire
-  Eigen::Vector3d correction_deg = Eigen::Vector3d::Zero();  // rotation vector, capture frame
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();     // refined capture_from_luminaire
+  Eigen::Vector3d correction_deg = Eigen::Vector3d::Zero();   // rotation vector, capture frame
   double angle_deg = 0;                                       // |correction|
   Eigen::Vector3d sigma_deg = Eigen::Vector3d::Zero();        // 1 sigma per component
   std::array<bool, 3> unconstrained = {false, false, false};  // components the overlaps leave free

@@ -24,7 +24,7 @@ constexpr int kMinPairSamples = 20;
 // far fields' own errors (a rotationally symmetric overlap still has some), not from the
 // luminaire. No small sigma is reported for what the overlaps do not fix.
 constexpr double kFreeCurvatureRatio = 1e-12;
-constexpr double kFreeSigmaDeg = 5.0;
+constexpr double kFreeSigmaDeg = 10.0;
 
 std::vector<Eigen::Vector3d> FibonacciSphere(int n) {
   std::vector<Eigen::Vector3d> out(static_cast<size_t>(n));

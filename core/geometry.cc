@@ -39,6 +39,21 @@ Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees) {
       .toRotationMatrix();
 }
 
+Eigen::Vector3d RotationZyxDegreesOf(const Eigen::Matrix3d& r) {
+  // R = Rz Ry Rx: R(2,0) = -sin y, R(2,1) / R(2,2) = tan x, R(1,0) / R(0,0) = tan z.
+  double x, y, z;
+  if (std::abs(r(2, 0)) < 1 - 1e-12) {
+    y = std::asin(-r(2, 0));
+    x = std::atan2(r(2, 1), r(2, 2));
+    z = std::atan2(r(1, 0), r(0, 0));
+  } else {  // gimbal lock (y = +-90): only x -+ z is defined; take x = 0
+    y = r(2, 0) < 0 ? kPi / 2 : -kPi / 2;
+    x = 0;
+    z = std::atan2(-r(0, 1), r(1, 1));
+  }
+  return Eigen::Vector3d(x, y, z) * 180 / kPi;
+}
+
 Eigen::Vector3d TypeCDirection(double c_deg, double gamma_deg) {
   const double c = c_deg * kPi / 180, g = gamma_deg * kPi / 180;
   return {std::sin(g) * std::cos(c), -std::sin(g) * std::sin(c), std::cos(g)};

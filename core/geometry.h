@@ -18,6 +18,8 @@ double ShiftInvariantError(double theta0, double relative_width);
 // The rotation Rz(z) Ry(y) Rx(x) of angles in degrees (x about X first, then y about Y, z about
 // Z, all about the fixed axes): how scene files, emitters and --luminaire-pose give orientations.
 Eigen::Matrix3d RotationZyxDegrees(const Eigen::Vector3d& degrees);
+// Its inverse: the angles (x, y, z) in degrees, y within [-90, 90], of a rotation matrix.
+Eigen::Vector3d RotationZyxDegreesOf(const Eigen::Matrix3d& rotation);
 
 // The rotation of a rotation vector (axis times angle in radians: OpenCV's rvec, what Rodrigues'
 // formula takes; the calibrations' poses); the identity for the zero vector.

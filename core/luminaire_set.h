@@ -41,8 +41,8 @@ struct OrientationCone {
   double MarginDeg(const Eigen::Vector3d& w_capture) const;
 };
 
-// The cone of a dataset: d, and the screen's half-sizes less the positions' support on S (the
-// grid's half-extent plus (k_max + 1) h, the bell's reach).
+// The cone of a dataset: d, and the screen's half-sizes (the slab window) less the positions'
+// support on S as the far field integrates it (the grid's half-extent plus h, a bell's reach).
 OrientationCone ConeOfDataset(const Dataset& dataset);
 
 // The taper of an orientation at a capture-frame direction: 0 outside the cone, smoothstep
@@ -55,7 +55,7 @@ struct Orientation {
   std::string name;     // unique, e.g. "o03"
   std::string dataset;  // its dataset folder, relative to the luminaire folder
   Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero();  // nominal: R = Rz Ry Rx (degrees)
-  Eigen::Vector3d centre_mm = Eigen::Vector3d::Zero();  // luminaire origin in the capture frame
+  Eigen::Vector3d centre_mm = Eigen::Vector3d::Zero();     // luminaire origin in the capture frame
   // How the lab gets there (optional, written by the planner): the hand mount (0, 1, ...) and
   // the rotation axis's angle; the driver moves the axis and asks the operator to remount.
   std::optional<int> mount;
@@ -65,14 +65,15 @@ struct Orientation {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // R_k, capture_from_luminaire
   bool registered = false;
   Eigen::Vector3d correction_deg = Eigen::Vector3d::Zero();  // rotation vector R_k R_nominal^T
-  Eigen::Vector3d sigma_deg = Eigen::Vector3d::Zero();       // its 1-sigma per component
+  // Its 1-sigma per component, degrees; +infinity where the overlaps do not constrain it.
+  Eigen::Vector3d sigma_deg = Eigen::Vector3d::Zero();
 
   Eigen::Matrix3d NominalRotation() const;
 };
 
 struct LuminaireSet {
-  std::string folder;          // the luminaire folder as given
-  std::string coverage;        // "sphere" or "hemisphere": what the lab asked to measure
+  std::string folder;    // the luminaire folder as given
+  std::string coverage;  // "sphere" or "hemisphere": what the lab asked to measure
   std::vector<Orientation> orientations;
 
   // The dataset folder of orientation k (folder / dataset).
@@ -93,19 +94,20 @@ std::string RegistrationJsonPath(const std::string& folder);
 // Coverage of a set of orientations over the sphere (or the hemisphere z >= 0 of the luminaire
 // frame), from a Fibonacci sphere of `samples` directions, and the overlap of every pair.
 struct PairOverlap {
-  int a = 0, b = 0;        // orientation indices, a < b
-  double overlap_sr = 0;   // solid angle both see with margin > 0
+  int a = 0, b = 0;       // orientation indices, a < b
+  double overlap_sr = 0;  // solid angle both see with margin > 0
 };
 struct CoverageReport {
   double covered_fraction = 0;  // of the sphere / hemisphere seen by at least one orientation
   double unseen_sr = 0;
   std::vector<PairOverlap> pairs;  // every pair with overlap_sr > 0
   // Empty when every orientation is connected to the first through pairs of overlap_sr >=
-  // kMinOverlapSr; otherwise why not, naming the orientation(s) and the largest overlap found.
+  // kMinOverlapSr; otherwise why not, naming the orientation(s) (by `names` where given) and
+  // the largest overlap found.
   std::string overlap_problem;
 };
 CoverageReport AnalyseCoverage(const std::vector<Eigen::Matrix3d>& capture_from_luminaire,
                                const std::vector<OrientationCone>& cones, bool hemisphere,
-                               int samples = 20000);
+                               int samples = 20000, const std::vector<std::string>& names = {});
 
 }  // namespace lumislab

@@ -231,23 +231,20 @@ void CancelNegativeRayCells(const RayCellAxis& ax, const RayCellAxis& ay,
 
 }  // namespace
 
-FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& positions,
-                         const std::vector<double>& c_deg, const std::vector<double>& gamma_deg,
-                         const FarFieldOptions& options) {
+FarFieldAt ComputeFarFieldAt(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                             const std::vector<Eigen::Vector3d>& directions,
+                             const FarFieldOptions& options) {
   LUMISLAB_CHECK(int(positions.size()) == info.grid.count(), "one slab position per grid index");
   std::vector<double> offsets, weights;
   BellQuadrature(options.samples, &offsets, &weights);
   const int n = options.samples;
   const double h = info.grid.spacing_mm, d = info.distance_mm;
   const Eigen::Vector3d channel_weights = options.channel_weights.value_or(info.channel_weights);
-  FarField out;
-  out.c_deg = c_deg;
-  out.gamma_deg = gamma_deg;
-  const size_t ng = gamma_deg.size(), count = c_deg.size() * ng;
-  out.values.assign(count, 0.0);
-  out.seen.assign(count, 0);
-  ParallelFor(int(count), options.threads, [&](int k) {
-    const Eigen::Vector3d w = TypeCDirection(c_deg[k / ng], gamma_deg[k % ng]);
+  FarFieldAt out;
+  out.values.assign(directions.size(), 0.0);
+  out.seen.assign(directions.size(), 0);
+  ParallelFor(int(directions.size()), options.threads, [&](int k) {
+    const Eigen::Vector3d w = directions[size_t(k)].normalized();
     const double cos_g = w.z();
     if (!(cos_g > 1e-9)) return;  // light leaves S only towards +z
     // (s, t) - (u, v) on M, mm: where the direction meets M from a point of S.
@@ -269,12 +266,28 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
         }
       }
     }
-    out.values[k] = sum * d * d / (cos_g * cos_g * cos_g * 1e6);
-    out.seen[k] = 1;
+    out.values[size_t(k)] = sum * d * d / (cos_g * cos_g * cos_g * 1e6);
+    out.seen[size_t(k)] = 1;
   });
+  return out;
+}
+
+FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                         const std::vector<double>& c_deg, const std::vector<double>& gamma_deg,
+                         const FarFieldOptions& options) {
+  const size_t ng = gamma_deg.size(), count = c_deg.size() * ng;
+  std::vector<Eigen::Vector3d> directions(count);
+  for (size_t k = 0; k < count; ++k)
+    directions[k] = TypeCDirection(c_deg[k / ng], gamma_deg[k % ng]);
+  FarFieldAt at = ComputeFarFieldAt(info, positions, directions, options);
+  FarField out;
+  out.c_deg = c_deg;
+  out.gamma_deg = gamma_deg;
+  out.values = std::move(at.values);
+  out.seen = std::move(at.seen);
   for (size_t k = 0; k < count; ++k) {
     if (!out.seen[k]) ++out.unseen;
-    if (!out.seen[k] && !(TypeCDirection(0, gamma_deg[k % ng]).z() > 1e-9)) ++out.behind;
+    if (!out.seen[k] && !(directions[k].z() > 1e-9)) ++out.behind;
   }
   return out;
 }

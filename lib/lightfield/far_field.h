@@ -45,6 +45,17 @@ FarField ComputeFarField(const SlabInfo& info, const std::vector<SlabPosition>& 
                          const std::vector<double>& c_deg, const std::vector<double>& gamma_deg,
                          const FarFieldOptions& options);
 
+// The same I(w) at arbitrary unit directions of the slab's frame (normalised here), with each
+// direction's seen flag: ComputeFarField is this on its C / gamma grid. The registration and the
+// merged far field of a luminaire folder (core/luminaire_set.h) look slabs up with it.
+struct FarFieldAt {
+  std::vector<double> values;  // W/sr (cd for lux slabs), 0 where unseen
+  std::vector<uint8_t> seen;
+};
+FarFieldAt ComputeFarFieldAt(const SlabInfo& info, const std::vector<SlabPosition>& positions,
+                             const std::vector<Eigen::Vector3d>& directions,
+                             const FarFieldOptions& options);
+
 struct SlabRay {
   Eigen::Vector3d origin_mm;  // on S (z = 0), luminaire frame
   Eigen::Vector3d direction;  // unit, z > 0

@@ -55,8 +55,9 @@ double Emitter::LuminousIntensity(const Eigen::Vector3d& w) const {
 }
 
 double Emitter::Shape(const Eigen::Vector3d& w) const {
-  if (!(w.z() > 0)) return 0;
-  return measured ? measured->Shape(w) : PowCos(w.z(), lobe_exponent);
+  const double c = w.dot(axis);
+  if (!(c > 0)) return 0;
+  return measured ? measured->Shape(w) : PowCos(c, lobe_exponent);
 }
 
 double EmitterIrradianceFactor(const Emitter& e, double d_mm, double s_mm, double t_mm,
@@ -72,9 +73,36 @@ double EmitterIrradianceFactor(const Emitter& e, double d_mm, double s_mm, doubl
   const double r2 = dx * dx + dy * dy + dz * dz;  // mm^2
   const double r = std::sqrt(r2);
   const double cos_m = dz / r;
-  // I cos / r^2 with r in metres: the plane M is normal to z, as is the lobe axis.
-  if (e.measured) return e.Shape(Eigen::Vector3d(dx, dy, dz) / r) * cos_m * 1e6 / r2;
+  // I cos / r^2 with r in metres: the plane M is normal to z (and so is the lobe's default axis).
+  if (e.measured || e.axis != Eigen::Vector3d::UnitZ())
+    return e.Shape(Eigen::Vector3d(dx, dy, dz) / r) * cos_m * 1e6 / r2;
   return PowCos(cos_m, e.lobe_exponent + 1) * 1e6 / r2;
+}
+
+Luminaire Luminaire::Turned(const Eigen::Matrix3d& rotation,
+                            const Eigen::Vector3d& new_centre_mm) const {
+  if (!ray_sources.empty())
+    throw BadInput("a luminaire with ray sources (TM-25 files) cannot be turned into orientations");
+  Luminaire out;
+  out.centre_mm = new_centre_mm;
+  for (size_t k = 0; k < emitters.size(); ++k) {
+    Emitter e = emitters[k];
+    e.position_mm = rotation * (e.position_mm - centre_mm) + new_centre_mm;
+    if (!(e.position_mm.z() < 0))
+      throw BadInput("emitter " + std::to_string(k) +
+                     " lands at z = " + std::to_string(e.position_mm.z()) +
+                     " mm, on or in front of S, in this orientation: move the luminaire's centre "
+                     "further behind S");
+    e.axis = (rotation * e.axis).normalized();
+    if (e.measured) {
+      auto lobe = std::make_shared<MeasuredLobe>(*e.measured);
+      lobe->luminaire_from_file = rotation * e.measured->luminaire_from_file;
+      lobe->rotation_deg = RotationZyxDegreesOf(lobe->luminaire_from_file);
+      e.measured = lobe;
+    }
+    out.emitters.push_back(std::move(e));
+  }
+  return out;
 }
 
 Eigen::Vector3d Luminaire::PlaneIrradiance(double x_mm, double y_mm, double plane_z_mm) const {

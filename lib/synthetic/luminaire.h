@@ -31,12 +31,15 @@ struct MeasuredLobe {
   double Shape(const Eigen::Vector3d& w) const;
 };
 
-// One point emitter. Intensity towards direction w (unit) is I0 cos^n(angle of w to +z), or
-// I0 times a measured lobe, for w_z > 0 and zero behind.
+// One point emitter. Intensity towards direction w (unit) is I0 cos^n(angle of w to the axis), or
+// I0 times a measured lobe, for w . axis > 0 and zero behind (the axis is +z unless the scene
+// gives one: light leaves S only towards +z, so an emitter of a captured luminaire looks there;
+// a turned luminaire's emitters look wherever the turn takes them, Luminaire::Turned).
 struct Emitter {
   Eigen::Vector3d position_mm;     // luminaire frame, z < 0 (behind S)
   Eigen::Vector3d intensity_w_sr;  // I0 per RGB channel, W/sr (a measured lobe's peak)
   double lobe_exponent = 0;        // n >= 0
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();         // unit; the lobe's axis, luminaire frame
   std::shared_ptr<const MeasuredLobe> measured = nullptr;  // set: replaces cos^n
   // > 0: the emitter's light is a blackbody at this temperature (scene field "cct_k", with
   // intensity_w_sr a single number, the radiant intensity over 380 - 780 nm, W/sr = radiant_w_sr);
@@ -45,7 +48,7 @@ struct Emitter {
   double cct_k = 0;
   double radiant_w_sr = 0;
 
-  // cos^n(angle of the unit direction w to +z) or the measured lobe, zero for w_z <= 0.
+  // cos^n(angle of the unit direction w to the axis) or the measured lobe, zero for w . axis <= 0.
   double Shape(const Eigen::Vector3d& w) const;
   // I0 Shape(w) (W/sr).
   Eigen::Vector3d Intensity(const Eigen::Vector3d& w) const { return Shape(w) * intensity_w_sr; }
@@ -61,6 +64,15 @@ struct Emitter {
 struct Luminaire {
   std::vector<Emitter> emitters;
   std::vector<RaySource> ray_sources;  // scene emitters with "rays" (a TM-25 file)
+  // The luminaire's own origin in the frame its positions are given in (scene field
+  // luminaire.centre_mm, default the origin of S): the point a turn is about.
+  Eigen::Vector3d centre_mm = Eigen::Vector3d::Zero();
+
+  // The luminaire turned by R about its centre, the centre moved to centre_mm: the luminaire as
+  // an orientation of a luminaire folder sees it (core/luminaire_set.h: x' = R (x - centre) +
+  // centre_mm, axes and measured lobes turned by R). BadInput naming the emitter when one lands
+  // on or in front of S (z >= 0), or when the luminaire has ray sources (not turned yet).
+  Luminaire Turned(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& centre_mm) const;
 
   // The three functions below are the point emitters' light at one point, analytic; a ray
   // source's light needs its rays splatted over a region first: PlaneLight does both.

@@ -26,6 +26,32 @@ const char* kDefaultSceneJson = R"({
 }
 )";
 
+// A luminaire that emits into the whole sphere, to be captured from several orientations
+// (docs/formats.md §19): six broad lobes along +-x, +-y, +-z of unequal strength (so every
+// overlap of two orientations has gradients to register on), a side lobe towards +x, a little
+// down, and a narrow asymmetric lobe towards C 60, gamma 120 (behind the gamma = 90 plane). Its
+// own origin, centre_mm, 40 mm behind S, every emitter within 4 mm of it; a screen of 2000 mm at
+// 750 mm sees 52 degrees either side of the axis, so the six cube faces overlap.
+const char* kFullSphereSceneJson = R"({
+  "schema_version": 1,
+  "setup": { "distance_mm": 750, "grid": {"nu": 5, "nv": 5, "spacing_mm": 5},
+             "screen_mm": [2000, 2000] },
+  "filter": { "k_max": 1 },
+  "luminaire": { "centre_mm": [0, 0, -40], "emitters": [
+    {"position_mm": [0, 0, -38], "axis": [0, 0, 1], "intensity_w_sr": [0.60, 0.60, 0.60], "lobe_exponent": 1.5},
+    {"position_mm": [0, 0, -42], "axis": [0, 0, -1], "intensity_w_sr": [0.35, 0.35, 0.35], "lobe_exponent": 1.5},
+    {"position_mm": [2, 0, -40], "axis": [1, 0, 0], "intensity_w_sr": [0.50, 0.50, 0.50], "lobe_exponent": 2},
+    {"position_mm": [-2, 0, -40], "axis": [-1, 0, 0], "intensity_w_sr": [0.30, 0.30, 0.30], "lobe_exponent": 2},
+    {"position_mm": [0, 2, -40], "axis": [0, 1, 0], "intensity_w_sr": [0.45, 0.45, 0.45], "lobe_exponent": 2.5},
+    {"position_mm": [0, -2, -40], "axis": [0, -1, 0], "intensity_w_sr": [0.25, 0.25, 0.25], "lobe_exponent": 2.5},
+    {"position_mm": [3, -1, -40], "axis": [0.94, 0, -0.34], "intensity_w_sr": [1.0, 0.8, 0.6], "lobe_exponent": 12},
+    {"position_mm": [1, -2, -41], "axis": [0.433, -0.75, -0.5], "intensity_w_sr": [0.8, 0.9, 1.0], "lobe_exponent": 20} ] },
+  "camera": { "size_px": [1600, 1200], "focal_px": 700, "position_mm": [0, -400, 2400],
+              "look_at_mm": [0, 0, 750] },
+  "effects": []
+}
+)";
+
 // A point of the lab or luminaire frame, mm: three finite numbers within kMaxCoordinateMm.
 Eigen::Vector3d Vec3(const JsonView& v) {
   const std::vector<double> a = v.Numbers(3);
@@ -93,6 +119,8 @@ RaySource ParseRaySource(const JsonView& e, const Eigen::Vector3d& position_mm,
 // without cell_mm gets `default_cell_mm` (0 where no screen is known: LoadLuminaire).
 Luminaire ParseLuminaire(const JsonView& root, double default_cell_mm) {
   Luminaire luminaire;
+  if (root["luminaire"].Has("centre_mm"))
+    luminaire.centre_mm = Vec3(root["luminaire"]["centre_mm"]);
   const JsonView emitters = root["luminaire"]["emitters"];
   if (emitters.Size() == 0) emitters.Fail("a non-empty array of emitters");
   for (size_t k = 0; k < emitters.Size(); ++k) {
@@ -127,6 +155,11 @@ Luminaire ParseLuminaire(const JsonView& root, double default_cell_mm) {
     } else {
       for (size_t c = 0; c < 3; ++c) emitter.intensity_w_sr[c] = intensity[c].NumberIn(0, 1e9);
       if (intensity.Size() != 3) intensity.Fail("[R, G, B] in W/sr (or one number with cct_k)");
+    }
+    if (e.Has("axis")) {
+      const Eigen::Vector3d axis = Vec3(e["axis"]);
+      if (!(axis.norm() > 1e-9)) e["axis"].Fail("a non-zero direction");
+      emitter.axis = axis.normalized();
     }
     if (e.Has("lobe_exponent")) {
       emitter.lobe_exponent = e["lobe_exponent"].NumberIn(0, 1e6);
@@ -325,10 +358,11 @@ double SynthScene::LuminousEfficacy() const {
   double lumens = 0, watts = 0;
   for (const Emitter& e : luminaire.emitters) {
     if (!(e.cct_k > 0)) return DefaultLuminousEfficacy();
-    // Radiant flux (W) = I0 x the lobe's solid angle: a midpoint sum over the front hemisphere.
+    // Radiant flux (W) = I0 x the lobe's solid angle: a midpoint sum over the sphere (the lobe
+    // looks along its axis; the default +z lobe has nothing behind S).
     constexpr int kSteps = 90;
     double solid_angle = 0;
-    for (int a = 0; a < kSteps; ++a)
+    for (int a = 0; a < 2 * kSteps; ++a)
       for (int b = 0; b < 2 * kSteps; ++b) {
         const double theta = (a + 0.5) * 0.5 * kPi / kSteps, phi = (b + 0.5) * kPi / kSteps;
         const Eigen::Vector3d w(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
@@ -344,6 +378,11 @@ double SynthScene::LuminousEfficacy() const {
 
 SynthScene LoadScene(const std::string& path_or_default) {
   if (path_or_default == "default") return DefaultScene();
+  if (path_or_default == "full-sphere") {
+    SynthScene scene = ParseScene(kFullSphereSceneJson, "full-sphere scene");
+    scene.source = "full-sphere";
+    return scene;
+  }
   return ParseScene(JsonDocument::Load(path_or_default), path_or_default);
 }
 
@@ -355,8 +394,10 @@ SynthScene DefaultScene() {
 
 std::string DefaultSceneJson() { return kDefaultSceneJson; }
 
+std::string FullSphereSceneJson() { return kFullSphereSceneJson; }
+
 Luminaire LoadLuminaire(const std::string& source) {
-  if (source == "default") return DefaultScene().luminaire;
+  if (source == "default" || source == "full-sphere") return LoadScene(source).luminaire;
   const std::string path =
       std::filesystem::is_directory(source)
           ? (std::filesystem::path(source) / "truth" / "luminaire.json").string()

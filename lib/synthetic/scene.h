@@ -59,15 +59,18 @@ struct SynthScene {
   Eigen::Vector2d StageOffsetMm(int i, int j) const;
 };
 
-// "default" or a scene file; errors name the file and the field (exit 2).
+// "default", "full-sphere" (a luminaire lighting every direction, for luminaire folders,
+// docs/formats.md §19) or a scene file; errors name the file and the field (exit 2).
 SynthScene LoadScene(const std::string& path_or_default);
 SynthScene ParseScene(const std::string& json_text, const std::string& name);
 SynthScene ParseScene(const JsonDocument& doc, const std::string& name);
 SynthScene DefaultScene();
-std::string DefaultSceneJson();  // the built-in scene as a scene file
-// The luminaire of `source`: "default" (the built-in scene's), a synthetic dataset folder (its
-// truth/luminaire.json), or a JSON file with a scene file's "luminaire" block and schema_version
-// 1 (a scene file or truth/luminaire.json). Errors name the file and the field (exit 2).
+std::string DefaultSceneJson();     // the built-in scene as a scene file
+std::string FullSphereSceneJson();  // the built-in "full-sphere" scene as a scene file
+// The luminaire of `source`: "default" or "full-sphere" (a built-in scene's), a synthetic dataset
+// folder (its truth/luminaire.json), or a JSON file with a scene file's "luminaire" block and
+// schema_version 1 (a scene file or truth/luminaire.json). Errors name the file and the field (exit
+// 2).
 Luminaire LoadLuminaire(const std::string& source);
 
 // dataset.json without photos or radiometric scale: setup, filter, calibration, synthetic.

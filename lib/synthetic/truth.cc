@@ -145,6 +145,7 @@ void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
       j["intensity_w_sr"] = e.radiant_w_sr;
       j["cct_k"] = e.cct_k;
     }
+    if (e.axis != Eigen::Vector3d::UnitZ()) j["axis"] = Vec(e.axis);
     if (e.measured) {
       // A copy of the measured file beside luminaire.json, so the dataset stands on its own.
       const std::string name = "emitter_" + std::to_string(k) +
@@ -173,6 +174,8 @@ void WriteTruthLuminaire(const Luminaire& luminaire, const std::string& path) {
   nlohmann::json j;
   j["schema_version"] = 1;
   j["luminaire"] = {{"emitters", emitters}};
+  if (luminaire.centre_mm != Eigen::Vector3d::Zero())
+    j["luminaire"]["centre_mm"] = Vec(luminaire.centre_mm);
   WriteJsonAtomically(path, j);
 }
 

@@ -9,6 +9,7 @@
 #include <regex>
 
 #include "core/error.h"
+#include "core/geometry.h"
 #include "lib/synthetic/camera.h"
 #include "lib/synthetic/luminaire.h"
 #include "lib/synthetic/spectral.h"
@@ -247,6 +248,45 @@ TEST(Camera, UprightPinholeWithCentredPrincipalPoint) {
     EXPECT_NEAR((s.head<2>() / s.z() - xy).norm(), 0, 1e-9);
     EXPECT_NEAR((cam.Project({xy.x(), xy.y(), 750}) - px).norm(), 0, 1e-9);
   }
+}
+
+}  // namespace
+}  // namespace lumislab
+
+namespace lumislab {
+namespace {
+
+// The built-in full-sphere luminaire turned into an orientation (docs/formats.md §19): the
+// intensity towards R w of the turned luminaire is the luminaire's towards w, its emitters sit
+// at R (x - centre) + centre', and a turn that brings one in front of S is refused.
+TEST(SceneFile, FullSphereLuminaireTurnsIntoOrientations) {
+  const SynthScene scene = LoadScene("full-sphere");
+  const Luminaire& lum = scene.luminaire;
+  EXPECT_EQ(lum.centre_mm, Eigen::Vector3d(0, 0, -40));
+  const auto intensity = [](const Luminaire& l, const Eigen::Vector3d& w) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const Emitter& e : l.emitters) sum += e.Intensity(w);
+    return sum;
+  };
+  // Light in every direction, behind S included.
+  for (const Eigen::Vector3d w :
+       {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(1, 0, 0),
+        Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0)})
+    EXPECT_GT(intensity(lum, w).sum(), 0.5) << w.transpose();
+  const Eigen::Matrix3d r = RotationZyxDegrees({10, 120, -30});
+  const Luminaire turned = lum.Turned(r, {0, 0, -60});
+  for (int k = 0; k < 50; ++k) {
+    const Eigen::Vector3d w =
+        Eigen::Vector3d(std::sin(k * 1.3), std::cos(k * 0.7), std::sin(k * 2.1)).normalized();
+    EXPECT_TRUE(intensity(turned, r * w).isApprox(intensity(lum, w), 1e-12)) << w.transpose();
+  }
+  for (size_t k = 0; k < lum.emitters.size(); ++k)
+    EXPECT_TRUE(turned.emitters[k].position_mm.isApprox(
+        r * (lum.emitters[k].position_mm - lum.centre_mm) + Eigen::Vector3d(0, 0, -60)));
+  EXPECT_THROW(lum.Turned(r, {0, 0, 0}), Error);
+  // The default scene's emitters keep their +z lobes: nothing behind S.
+  for (const Emitter& e : DefaultScene().luminaire.emitters)
+    EXPECT_EQ(e.Intensity({0.1, 0, -1}).sum(), 0);
 }
 
 }  // namespace

@@ -8,22 +8,12 @@
 #include "core/atomic_file.h"
 #include "core/dataset.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/log.h"
 #include "core/slab.h"
 
 namespace lumislab {
 namespace {
-
-// Angles (degrees) of R = Rz Ry Rx (core RotationZyxDegrees); at gimbal lock (ry = +-90) rx = 0.
-Eigen::Vector3d ZyxDegreesOf(const Eigen::Matrix3d& r) {
-  constexpr double kDeg = 180.0 / 3.14159265358979323846;
-  const double sy = std::clamp(-r(2, 0), -1.0, 1.0);
-  if (std::abs(sy) > 1 - 1e-12)
-    return Eigen::Vector3d(0, std::asin(sy), std::atan2(-r(0, 1), r(1, 1))) * kDeg;
-  return Eigen::Vector3d(std::atan2(r(2, 1), r(2, 2)), std::asin(sy),
-                         std::atan2(r(1, 0), r(0, 0))) *
-         kDeg;
-}
 
 nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
@@ -100,10 +90,10 @@ std::string RegistrationJson(const LuminaireSet& set, const Registration& r,
     const RegisteredOrientation& o = r.orientations[k];
     nlohmann::json e;
     e["name"] = set.orientations[k].name;
-    e["rotation_deg"] = Vec(ZyxDegreesOf(o.rotation));
+    e["rotation_deg"] = Vec(RotationZyxDegreesOf(o.rotation));
     nlohmann::json rows = nlohmann::json::array();
     for (int i = 0; i < 3; ++i) rows.push_back(Vec(o.rotation.row(i).transpose()));
-    e["capture_from_luminaire"] = rows;
+    e["rotation_matrix"] = rows;
     e["correction_deg"] = Vec(o.correction_deg);
     e["angle_deg"] = o.angle_deg;
     e["sigma_deg"] = {Sigma(o.sigma_deg.x()), Sigma(o.sigma_deg.y()), Sigma(o.sigma_deg.z())};
@@ -161,13 +151,16 @@ int RunOrientationsCommand(OrientationsCommand* c, int threads) {
   std::vector<RegistrationInput> inputs;
   std::vector<Eigen::Matrix3d> nominal;
   std::vector<OrientationCone> cones;
+  std::vector<std::string> names;
   for (size_t k = 0; k < set.orientations.size(); ++k) {
     // The planner's reason first, before the slabs are read.
     const Dataset dataset = Dataset::Load(set.DatasetFolder(k));
     nominal.push_back(set.orientations[k].NominalRotation());
     cones.push_back(ConeOfDataset(dataset));
+    names.push_back(set.orientations[k].name);
   }
-  const CoverageReport coverage = AnalyseCoverage(nominal, cones, set.coverage == "hemisphere");
+  const CoverageReport coverage =
+      AnalyseCoverage(nominal, cones, set.coverage == "hemisphere", 20000, names);
   if (!coverage.overlap_problem.empty())
     throw BadInput(LuminaireJsonPath(c->luminaire) +
                    ": the orientations cannot be registered: " + coverage.overlap_problem);

@@ -4,8 +4,6 @@
 #include <cmath>
 
 #include "core/error.h"
-#include "core/geometry.h"
-#include "core/parallel.h"
 #include "lib/lightfield/far_field.h"
 
 namespace lumislab {
@@ -40,15 +38,14 @@ FarFieldGrid SampleFarFieldGrid(const SlabInfo& info, const std::vector<SlabPosi
   const size_t count = size_t(grid.nx) * grid.ny;
   grid.values.assign(count, 0.0);
   grid.seen.assign(count, 0);
+  std::vector<Eigen::Vector3d> directions(count);
+  for (size_t k = 0; k < count; ++k)
+    directions[k] = grid.Direction(int(k % size_t(grid.nx)), int(k / size_t(grid.nx)));
   FarFieldOptions options;
-  options.threads = 1;
-  // One direction at a time: ComputeFarField's grid is C x gamma, the nodes are not.
-  ParallelFor(int(count), threads, [&](int k) {
-    const Eigen::Vector2d angles = TypeCAngles(grid.Direction(k % grid.nx, k / grid.nx));
-    const FarField f = ComputeFarField(info, positions, {angles.x()}, {angles.y()}, options);
-    grid.values[size_t(k)] = f.values[0];
-    grid.seen[size_t(k)] = f.seen[0];
-  });
+  options.threads = threads;
+  FarFieldAt far = ComputeFarFieldAt(info, positions, directions, options);
+  grid.values = std::move(far.values);
+  grid.seen = std::move(far.seen);
   return grid;
 }
 

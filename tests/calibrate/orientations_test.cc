@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calibrate/cli.h"
+#include "calibrate/orientations/registration.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/luminaire_set.h"
@@ -25,7 +26,11 @@ namespace lumislab {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / kPi;
-constexpr int kResolution = 64;  // slab texels per side
+// Slab texels per side: the cube's recovered rotations are limited by the slabs' own far-field
+// error (docs/results.md §13), 96 texels keep it under the 0.1 degrees asked; the refusals and
+// the free axis need less.
+constexpr int kCubeResolution = 96;
+constexpr int kResolution = 48;
 
 struct Result {
   int exit_code;
@@ -52,17 +57,21 @@ std::string TestDir(const std::string& name) {
 }
 
 // The capture set-up of every orientation: the full-sphere scene's luminaire before a 2000 mm
-// screen at d = 750 mm, a 3 x 3 grid.
-SynthScene Setup() {
+// screen at d = 750 mm, a 9 x 9 grid of h = 4 mm.
+SynthScene CaptureScene() {
   SynthScene scene = LoadScene("full-sphere");
   scene.distance_mm = 750;
   scene.screen_w_mm = 2000;
   scene.screen_h_mm = 2000;
+  scene.grid = {9, 9, 4};
   return scene;
 }
 
-// The luminaire's origin in every capture frame: far enough behind S that all its emitters are.
-const Eigen::Vector3d kCentreMm(0, 0, -40);
+// The luminaire's origin in every capture frame: its emitters (within 3.4 mm of it) all behind
+// S, and the light they send into the cone the registration reads (50 degrees: 3 degrees inside
+// the 53 the screen sees) crossing S within the grid's cover (GridCovers: ((9 - 1) / 2 - K) h =
+// 12 mm of the axis), as a slab must hold it.
+const Eigen::Vector3d kCentreMm(0, 0, -3.5);
 
 struct OrientationSpec {
   std::string name;
@@ -85,18 +94,22 @@ Eigen::Matrix3d TrueRotation(const OrientationSpec& o) {
 // <dir>/luminaire.json and one dataset folder per orientation with its truth slab of
 // `luminaire` turned by the true rotation (slabs: false writes dataset.json only).
 void WriteLuminaireFolder(const std::string& dir, const std::vector<OrientationSpec>& specs,
-                          const Luminaire& luminaire, bool slabs = true) {
-  const SynthScene scene = Setup();
+                          const Luminaire& luminaire, int resolution, bool slabs = true) {
+  const SynthScene scene = CaptureScene();
   LuminaireSet set;
   set.folder = dir;
   set.coverage = "sphere";
   for (const OrientationSpec& o : specs) {
     const std::string folder = dir + "/" + o.name;
     fs::create_directories(folder);
-    DatasetSkeleton(scene).Save(folder);
+    // dataset.json as acquire synth writes it (the photos listed, none needed: the slab is
+    // the truth's).
+    Dataset dataset = DatasetSkeleton(scene);
+    dataset.photos = PhotoList(scene);
+    dataset.Save(folder);
     if (slabs)
-      WriteTruthSlab(luminaire.Turned(TrueRotation(o), kCentreMm),
-                     TruthSlabInfo(scene, kResolution), folder + "/slab", 2);
+      WriteTruthSlab(luminaire.Turned(TrueRotation(o), kCentreMm), TruthSlabInfo(scene, resolution),
+                     folder + "/slab", 2);
     Orientation entry;
     entry.name = o.name;
     entry.dataset = o.name;
@@ -113,10 +126,55 @@ double AngleDeg(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle() 
 const std::string& CubeFolder() {
   static const std::string dir = [] {
     const std::string d = TestDir("cube");
-    WriteLuminaireFolder(d, CubeFaces(), Setup().luminaire);
+    WriteLuminaireFolder(d, CubeFaces(), CaptureScene().luminaire, kCubeResolution);
     return d;
   }();
   return dir;
+}
+
+// The registration itself, without slabs: the six faces' far-field grids filled with the
+// luminaire's analytic intensity recover the relative rotations to 0.001 degrees, so what the
+// truth-slab test below measures beyond that is the slabs' own far-field error.
+TEST(Orientations, AnalyticFarFieldsRegisterExactly) {
+  const SynthScene scene = CaptureScene();
+  const std::vector<OrientationSpec> specs = CubeFaces();
+  std::vector<RegistrationInput> inputs;
+  std::vector<Eigen::Matrix3d> nominal;
+  std::vector<OrientationCone> cones;
+  for (const OrientationSpec& o : specs) {
+    RegistrationInput in;
+    in.name = o.name;
+    in.nominal = RotationZyxDegrees(o.nominal_deg);
+    in.cone.distance_mm = 750;
+    in.cone.half_w_mm = in.cone.half_h_mm = 980;
+    FarFieldGrid& g = in.far_field;
+    g.nx = g.ny = 101;
+    g.x_max = g.y_max = 1.4;
+    const Eigen::Matrix3d truth = TrueRotation(o);
+    for (int row = 0; row < g.ny; ++row)
+      for (int col = 0; col < g.nx; ++col) {
+        const Eigen::Vector3d w = truth.transpose() * g.Direction(col, row);
+        double intensity = 0;
+        for (const Emitter& e : scene.luminaire.emitters) intensity += e.Intensity(w).x();
+        g.values.push_back(intensity);
+        g.seen.push_back(1);
+      }
+    nominal.push_back(in.nominal);
+    cones.push_back(in.cone);
+    inputs.push_back(std::move(in));
+  }
+  RegistrationOptions options;
+  options.threads = 2;
+  const Registration r =
+      RegisterOrientations(inputs, AnalyseCoverage(nominal, cones, false), options);
+  ASSERT_EQ(r.pairs.size(), 12u);
+  EXPECT_TRUE(r.disagreement.empty()) << r.disagreement;
+  for (size_t k = 1; k < specs.size(); ++k) {
+    const Eigen::Matrix3d relative =
+        r.orientations[k].rotation * r.orientations[0].rotation.transpose();
+    const Eigen::Matrix3d truth = TrueRotation(specs[k]) * TrueRotation(specs[0]).transpose();
+    EXPECT_LT(AngleDeg(relative * truth.transpose()), 1e-3) << specs[k].name;
+  }
 }
 
 TEST(Orientations, CubeFacesRecoverTheRelativeRotations) {
@@ -160,7 +218,8 @@ TEST(Orientations, TooLittleOverlapIsRefusedNamingTheOrientation) {
   const std::string dir = TestDir("apart");
   // Opposite faces only: they share no direction.
   std::vector<OrientationSpec> specs = CubeFaces();
-  WriteLuminaireFolder(dir, {specs[0], specs[1]}, Setup().luminaire, /*slabs=*/false);
+  WriteLuminaireFolder(dir, {specs[0], specs[1]}, CaptureScene().luminaire, kResolution,
+                       /*slabs=*/false);
   const Result r = RunTool({"orientations", "--luminaire", dir});
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("cannot be registered"), std::string::npos) << r.output;
@@ -173,8 +232,8 @@ TEST(Orientations, AnotherLuminairesSlabIsRefusedNamingThePair) {
   const std::vector<OrientationSpec> specs = CubeFaces();
   // Faces +z, +x, +y; the +x one holds the slab of another luminaire (the built-in default
   // scene's, turned as the +x face would be).
-  WriteLuminaireFolder(dir, {specs[0], specs[2], specs[4]}, Setup().luminaire);
-  const SynthScene scene = Setup();
+  WriteLuminaireFolder(dir, {specs[0], specs[2], specs[4]}, CaptureScene().luminaire, kResolution);
+  const SynthScene scene = CaptureScene();
   fs::remove_all(dir + "/o02/slab");
   WriteTruthSlab(DefaultScene().luminaire.Turned(TrueRotation(specs[2]), kCentreMm),
                  TruthSlabInfo(scene, kResolution), dir + "/o02/slab", 2);
@@ -196,7 +255,7 @@ TEST(Orientations, ARotationallySymmetricOverlapIsReportedUnconstrained) {
   Luminaire luminaire;
   luminaire.emitters.push_back(e);
   WriteLuminaireFolder(dir, {{"o00", {0, 0, 0}, {0, 0, 0}}, {"o01", {30, 0, 0}, {1, 0, 0}}},
-                       luminaire);
+                       luminaire, kResolution);
   const Result r = RunTool({"orientations", "--luminaire", dir, "--threads", "2"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const LuminaireSet set = LoadLuminaireSet(dir);
@@ -212,8 +271,8 @@ TEST(Orientations, ARotationallySymmetricOverlapIsReportedUnconstrained) {
   EXPECT_GT(std::abs(j["free_axes"][0][2].get<double>()), 0.99) << j.dump();
   // The tilt is recovered: the lobe's axis lands where it is.
   EXPECT_NEAR(o.correction_deg.x(), 1.0, 0.15);
-  EXPECT_EQ(o.correction_deg.y(), 0.0);  // free: left nominal
-  EXPECT_NE(r.output.find("free"), std::string::npos);
+  EXPECT_NEAR(o.correction_deg.y(), 0.0, 1e-3);  // free: left nominal
+  EXPECT_NEAR(o.correction_deg.z(), 0.0, 1e-3);
 }
 
 }  // namespace

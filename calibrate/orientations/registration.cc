@@ -273,8 +273,17 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     }
   }
 
+  std::vector<int> disagreeing(static_cast<size_t>(count), 0);  // pairs each orientation is in
+  int disagreements = 0;
   for (const RegisteredPair& r : out.pairs) {
     if (r.samples < kMinPairSamples || !(r.rms_after > options.max_relative_rms)) continue;
+    // A pair that agreed at the nominal poses was dragged by the fit: not counted for the
+    // culprit below.
+    if (r.rms_before > options.max_relative_rms) {
+      ++disagreements;
+      ++disagreeing[size_t(r.a)];
+      ++disagreeing[size_t(r.b)];
+    }
     if (!out.disagreement.empty()) out.disagreement += "; ";
     out.disagreement +=
         "orientations " + inputs[size_t(r.a)].name + " and " + inputs[size_t(r.b)].name +
@@ -283,6 +292,14 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
         Num(options.max_relative_rms) + "), intensity ratio " + Num(r.ratio) + " over " +
         std::to_string(r.samples) + " directions (" + Num(r.overlap_sr) + " sr)";
   }
+  // One orientation in every pair that disagrees before and after the fit (two or more) is the
+  // likely culprit.
+  for (int k = 0; k < count && disagreements >= 2; ++k)
+    if (disagreeing[size_t(k)] == disagreements)
+      out.disagreement += "; " + inputs[size_t(k)].name +
+                          " is in every pair that disagrees at the nominal poses and after the "
+                          "fit: its slab (another luminaire, another scale) or its nominal pose "
+                          "is the likely cause";
   return out;
 }
 

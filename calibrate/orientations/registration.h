@@ -22,7 +22,7 @@ constexpr double kMaxOverlapRelativeRms = 0.10;
 struct RegistrationOptions {
   int directions = 40000;     // luminaire-frame directions sampled (Fibonacci sphere)
   double margin_deg = 3;      // a sample must lie this far inside both cones
-  double nodes_per_tan = 40;  // far-field grid density (nodes per unit of x/z)
+  double nodes_per_tan = 30;  // far-field grid density (nodes per unit of x/z)
   double loss_scale = 0.05;   // Huber scale of the relative residuals
   double max_relative_rms = kMaxOverlapRelativeRms;
   int max_iterations = 100;

@@ -214,16 +214,18 @@ TEST(Orientations, CubeFacesRecoverTheRelativeRotations) {
   }
 }
 
-TEST(Orientations, TooLittleOverlapIsRefusedNamingTheOrientation) {
+TEST(Orientations, TooLittleOverlapIsRefusedNamingThePair) {
   const std::string dir = TestDir("apart");
-  // Opposite faces only: they share no direction.
-  std::vector<OrientationSpec> specs = CubeFaces();
-  WriteLuminaireFolder(dir, {specs[0], specs[1]}, CaptureScene().luminaire, kResolution,
-                       /*slabs=*/false);
+  // Two orientations 104.5 degrees apart about x: their cones (52.6 degrees either side of the
+  // axis in the y-z plane) share a sliver 0.6 degrees wide, under kMinOverlapSr.
+  WriteLuminaireFolder(dir, {{"o00", {0, 0, 0}, {0, 0, 0}}, {"o01", {104.5, 0, 0}, {0, 0, 0}}},
+                       CaptureScene().luminaire, kResolution, /*slabs=*/false);
   const Result r = RunTool({"orientations", "--luminaire", dir});
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("cannot be registered"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("o01"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cannot be registered: o01 does not connect to o00"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("its largest overlap is"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("with o00"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(RegistrationJsonPath(dir)));
 }
 

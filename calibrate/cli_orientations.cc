@@ -23,7 +23,7 @@ nlohmann::json Sigma(double v) { return std::isfinite(v) ? nlohmann::json(v) : n
 std::string SigmaText(double v) { return std::isfinite(v) ? Num(v, 3) : std::string("free"); }
 
 RegistrationInput ReadOrientation(const LuminaireSet& set, size_t k, const RegistrationOptions& o,
-                                  int threads) {
+                                  int threads, std::string* units) {
   const Orientation& orientation = set.orientations[k];
   const Dataset dataset = Dataset::Load(set.DatasetFolder(k));
   const std::string slab_dir = dataset.Path("slab");
@@ -38,6 +38,11 @@ RegistrationInput ReadOrientation(const LuminaireSet& set, size_t k, const Regis
                          std::to_string(info.grid.nv) +
                          " grid (finish it with lumislab-reconstruct)",
                      std::to_string(info.present.size()) + " position(s)");
+  // Intensities of different units cannot be compared (and the merge could not add them).
+  if (units->empty()) *units = info.units;
+  if (info.units != *units)
+    throw InputError(slab_dir + "/slab.json", "units", "the first orientation's (" + *units + ")",
+                     info.units);
   RegistrationInput in;
   in.name = orientation.name;
   in.nominal = orientation.NominalRotation();
@@ -164,8 +169,9 @@ int RunOrientationsCommand(OrientationsCommand* c, int threads) {
   if (!coverage.overlap_problem.empty())
     throw BadInput(LuminaireJsonPath(c->luminaire) +
                    ": the orientations cannot be registered: " + coverage.overlap_problem);
+  std::string units;
   for (size_t k = 0; k < set.orientations.size(); ++k)
-    inputs.push_back(ReadOrientation(set, k, c->options, threads));
+    inputs.push_back(ReadOrientation(set, k, c->options, threads, &units));
 
   const Registration registration = RegisterOrientations(inputs, coverage, c->options);
   PrintTable(set, registration);

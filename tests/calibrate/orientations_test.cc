@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "../e2e/test_util.h"
 #include "calibrate/cli.h"
 #include "calibrate/orientations/registration.h"
 #include "core/error.h"
@@ -178,6 +179,7 @@ TEST(Orientations, AnalyticFarFieldsRegisterExactly) {
 }
 
 TEST(Orientations, CubeFacesRecoverTheRelativeRotations) {
+  if (testing::kSanitized) GTEST_SKIP() << "accuracy run: the Release build's";
   const std::string dir = CubeFolder();
   const Result r = RunTool({"orientations", "--luminaire", dir, "--threads", "2", "--force"});
   ASSERT_EQ(r.exit_code, 0) << r.output;

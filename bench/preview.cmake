@@ -14,3 +14,10 @@ if(TARGET lumislab_preview_renderer)
                         lumislab_synthetic ${CMAKE_DL_LIBS})
   lumislab_warnings(preview_gpu_check)
 endif()
+
+if(TARGET lumislab_preview)
+  # A luminaire folder's preview against its number of orientations (docs/results.md §13).
+  add_executable(preview_orientations ${CMAKE_CURRENT_LIST_DIR}/preview_orientations.cc)
+  target_link_libraries(preview_orientations PRIVATE lumislab_preview)
+  lumislab_warnings(preview_orientations)
+endif()

@@ -16,12 +16,14 @@
 #include "core/dataset.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/luminaire_set.h"
 #include "core/slab_light.h"
 #include "core/stop_signal.h"
 #include "lib/lightfield/light_field.h"
 #include "lib/synthetic/scene.h"
 #include "lib/synthetic/truth.h"
 #include "preview/headless.h"
+#include "preview/light_source.h"
 #include "preview/reference_mode.h"
 #include "preview/window.h"
 
@@ -44,7 +46,9 @@ struct CommandLineExtras {
 };
 
 void AddSceneOptions(CLI::App& app, PreviewConfig& config, CommandLineExtras& extras) {
-  app.add_option("--slab", config.slab_dir, "slab folder (slab.json + pos_<i>_<j>.exr)")
+  app.add_option("--slab", config.slab_dir,
+                 "slab folder (slab.json + pos_<i>_<j>.exr), or a luminaire folder "
+                 "(luminaire.json: every orientation's slab, posed into the luminaire frame)")
       ->required();
   app.add_option("--scene", config.scene.name, "crypt | cloister | plane | scene file (Assimp)")
       ->capture_default_str();
@@ -233,6 +237,18 @@ void CheckOptions(const CommandLineExtras& extras, PreviewConfig& config) {
   config.false_colour_scale.log = extras.false_colour_scale == "log";
   ParseFalseColourRange(extras.false_colour_range, "--false-colour-range",
                         &config.false_colour_scale);
+  // A luminaire folder (docs/method.md §4.12): the shortcuts and the exact reference serve one
+  // slab; --analytic renders the truth over the whole luminaire frame.
+  config.luminaire_folder = IsLuminaireFolder(config.slab_dir);
+  if (config.luminaire_folder) {
+    for (const auto& [set, option] : {std::pair{config.reference, "--reference"},
+                                      {config.shadow_share > 0, "--shadow-share"},
+                                      {config.merge_group > 1, "--merge-group"},
+                                      {extras.write_test_slab, "--write-test-slab"}})
+      if (set)
+        throw BadInput(std::string(option) + " serves one slab, not a luminaire folder (" +
+                       config.slab_dir + ")");
+  }
   if (config.reference || !config.analytic.empty()) {
     const char* mode = config.reference ? "--reference" : "--analytic";
     for (const auto& [set, option] : {std::pair{window, "--window"},
@@ -308,15 +324,21 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     if (std::filesystem::is_directory(folder)) RemoveOrphanedTemporaries(folder);
   }
   const StopSignalScope stop_signals;
-  const std::optional<SlabInfo> info = WaitForSlabInfo(config);
+  const LightSource source = OpenLightSource(config.slab_dir);
+  const std::optional<SlabInfo> info = WaitForFirstSlab(config, source);
   if (!info) {
-    LogInfo("stopped before ", config.slab_dir, "/slab.json appeared");
+    LogInfo("stopped before ", config.slab_dir,
+            source.luminaire ? "'s first slab.json" : "/slab.json", " appeared");
     return 0;
   }
-  CheckReceiverPlane(config, *info);
-  if (config.analytic.empty()) CheckSlabBeforeRendering(config, *info);
+  // One slab's checks (a luminaire folder's orientations are checked by their own stages).
+  if (!source.luminaire) {
+    CheckReceiverPlane(config, *info);
+    if (config.analytic.empty()) CheckSlabBeforeRendering(config, *info);
+  }
   if (config.reference || !config.analytic.empty()) return RunReferenceMode(config, *info);
-  return config.backend == Backend::kWindow ? RunWindow(config, *info) : RunHeadless(config, *info);
+  return config.backend == Backend::kWindow ? RunWindow(config, source, *info)
+                                            : RunHeadless(config, source, *info);
 }
 
 }  // namespace

@@ -92,7 +92,7 @@ void SetCameraValues(const std::vector<double>& values, SceneSetup& setup) {
 
 int MergeGroup(const PreviewConfig& config) {
   if (config.merge_group > 0) return config.merge_group;
-  return config.shadows ? 1 : 2;
+  return config.shadows || config.luminaire_folder ? 1 : 2;
 }
 
 double CoarseTolerance(const PreviewConfig& config, const SceneSetup& setup) {
@@ -119,21 +119,12 @@ RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& s
   return options;
 }
 
-std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config) {
-  const std::string json = config.slab_dir + "/slab.json";
-  if (config.watch && !std::filesystem::exists(json)) LogInfo("waiting for ", json);
-  while (config.watch && !std::filesystem::exists(json)) {
-    if (StopRequested()) return std::nullopt;
-    std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
-  }
-  return SlabInfo::Load(config.slab_dir);
-}
-
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
-                                                  Renderer& renderer, int threads) {
+                                                  Renderer& renderer, int threads,
+                                                  int orientation) {
   std::vector<std::pair<int, int>> added;
   for (const auto& [i, j] : ScanSlabPositions(slab_dir, info)) {
-    if (!renderer.HasPosition(i, j)) added.emplace_back(i, j);
+    if (!renderer.HasPosition(i, j, orientation)) added.emplace_back(i, j);
   }
   // E' of a batch on `threads` threads, then uploaded on this one (the GL context's); batches
   // bound the memory held for a large slab.
@@ -143,7 +134,7 @@ std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, c
         added.begin() + start, added.begin() + std::min(added.size(), start + batch));
     const std::vector<ImageF> intensities = ReadIntensities(slab_dir, info, part, threads);
     for (size_t k = 0; k < part.size(); ++k) {
-      renderer.SetPosition(part[k].first, part[k].second, intensities[k]);
+      renderer.SetPosition(part[k].first, part[k].second, intensities[k], orientation);
     }
   }
   return added;

@@ -25,8 +25,9 @@ const char* BackendName(Backend backend);
 const char* TextureFilterName(TextureFilter filter);
 
 struct PreviewConfig {
-  std::string slab_dir;
-  SceneRequest scene;  // name, pose, receiver plane D and extent
+  std::string slab_dir;           // a slab folder, or a luminaire folder (preview/light_source.h)
+  bool luminaire_folder = false;  // slab_dir holds luminaire.json (set by the command line)
+  SceneRequest scene;             // name, pose, receiver plane D and extent
   // --luminaire-depth-mm: how far behind S the deepest light sits, to check a receiver plane
   // near S (CheckReceiverPlane); < 0: a synthetic dataset's truth/luminaire.json beside the slab,
   // else unknown.
@@ -93,19 +94,19 @@ void SetCameraValues(const std::vector<double>& values, SceneSetup& setup);
 
 // Renderer options from the command line, for the scene it sets up (one place for both contexts).
 RenderOptions MakeRenderOptions(const PreviewConfig& config, const SceneSetup& setup);
-// --merge-group resolved: 0 (auto) is 2 without shadows, 1 (off) with them.
+// --merge-group resolved: 0 (auto) is 2 without shadows, 1 (off) with them or for a luminaire
+// folder (merging serves one slab).
 int MergeGroup(const PreviewConfig& config);
 // Coarse shading's tolerance: --coarse-shading, or auto: 0.1 in a room with shadows; 0 without
 // them and on the plane (its irradiance is a measurement, written in W/m^2).
 double CoarseTolerance(const PreviewConfig& config, const SceneSetup& setup);
 
-// slab.json of --slab; with --watch, waits for it to appear (a live reconstruct writes it with
-// its first position); nothing when a stop signal arrives first.
-std::optional<SlabInfo> WaitForSlabInfo(const PreviewConfig& config);
-// Loads every slab position present on disk that the renderer lacks into it (E' derived on
-// `threads` threads); returns the positions loaded.
+// Loads every slab position present on disk that the renderer lacks into it, as positions of
+// `orientation` (E' derived on `threads` threads); returns the positions loaded. (--slab's
+// waiting and loading for one slab or a luminaire folder: preview/light_source.h.)
 std::vector<std::pair<int, int>> LoadNewPositions(const std::string& slab_dir, const SlabInfo& info,
-                                                  Renderer& renderer, int threads);
+                                                  Renderer& renderer, int threads,
+                                                  int orientation = 0);
 // The picture --out gets in false colour: `irradiance` (the renderer's image with unit albedo and
 // radiance scale 1, or the reference's irradiance) with the bar in the slab's unit; on the plane
 // a scale bar (its extent over `width` pixels) and the plane's distance as the title.

@@ -12,24 +12,10 @@
 #include "lib/lightfield/tone_map.h"
 #include "preview/gl_context.h"
 #include "preview/image_files.h"
+#include "preview/light_source.h"
 
 namespace lumislab {
 namespace {
-
-// Without --watch the slab is finished: every position slab.json lists must be there, complete
-// and of its resolution (ScanSlabPositions leaves out any that is not), and there must be one.
-void CheckListedPositionsLoaded(const std::string& slab_dir, const SlabInfo& info,
-                                const Renderer& renderer) {
-  if (info.present.empty())
-    throw InputError(slab_dir + "/slab.json", "present", "at least one position", "none");
-  for (const auto& [i, j] : info.present)
-    if (!renderer.HasPosition(i, j))
-      throw InputError(SlabPositionPath(slab_dir, i, j), "",
-                       "a complete EXR of " + std::to_string(info.layout.res_x) + "x" +
-                           std::to_string(info.layout.res_y) +
-                           " texels (slab.json lists the position)",
-                       "a missing, truncated or other-sized file");
-}
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -82,54 +68,61 @@ void RunBench(const PreviewConfig& config, const SceneSetup& setup, double aspec
           median * 1000, " ms = ", 1.0 / median, " fps");
 }
 
-// --watch: polls the slab folder, re-rendering and rewriting --out as positions arrive, until
-// all of them are in or a stop signal arrives.
-void WatchSlab(const PreviewConfig& config, const SceneSetup& setup, SlabInfo info,
-               Renderer& renderer) {
-  while (renderer.PositionCount() < info.grid.count() && !StopRequested()) {
+// --watch: polls the slab folder (a luminaire folder: every orientation's), re-rendering and
+// rewriting --out as positions arrive (an orientation whose slab appears joins), until all of
+// them are in or a stop signal arrives.
+void WatchSlab(const PreviewConfig& config, const SceneSetup& setup, const LightSource& source,
+               SlabInfo info, Renderer& renderer) {
+  while (renderer.PositionCount() < renderer.LightCount() && !StopRequested()) {
     std::this_thread::sleep_for(std::chrono::duration<double>(config.poll_s));
+    std::vector<std::pair<int, int>> added;
     try {
-      info = SlabInfo::Load(config.slab_dir);
-    } catch (const Error&) {
+      if (!source.luminaire) info = SlabInfo::Load(config.slab_dir);
+      added = LoadNewLights(source, info, renderer, config.threads);
+    } catch (const Error& e) {
+      LogDebug("poll: ", e.what());
       continue;  // slab.json being replaced: try again at the next poll
     }
-    const auto added = LoadNewPositions(config.slab_dir, info, renderer, config.threads);
     if (added.empty()) continue;
     // The last update sums every light afresh: the float sum of batches depends on how the
     // positions happened to arrive, and the final image should not (it then equals a render of
     // the finished slab, byte for byte).
-    if (renderer.PositionCount() == info.grid.count()) renderer.SetOptions(renderer.options());
+    if (renderer.PositionCount() == renderer.LightCount()) renderer.SetOptions(renderer.options());
     renderer.Render();
     WriteOutput(config, setup, info, renderer);
-    LogInfo("positions ", renderer.PositionCount(), "/", info.grid.count(), " (new: ", added.size(),
-            ")");
+    LogInfo("positions ", renderer.PositionCount(), "/", renderer.LightCount(),
+            " (new: ", added.size(), ")");
   }
 }
 
 }  // namespace
 
-int RunHeadless(const PreviewConfig& config, const SlabInfo& info) {
+int RunHeadless(const PreviewConfig& config, const LightSource& source, const SlabInfo& info) {
   const HeadlessContext context(config.backend == Backend::kEgl);
   LogInfo("backend ", BackendName(config.backend), ": ", context.Renderer());
   const SceneSetup setup = MakePreviewSetup(config, info);
   const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
   const double aspect = double(width) / height;
-  Renderer renderer(info, width, height, MakeRenderOptions(config, setup));
+  Renderer renderer(info, width, height, MakeRenderOptions(config, setup),
+                    RendererOrientations(source, info));
   renderer.SetScene(setup.mesh);
   renderer.SetPose(setup.pose);
   renderer.SetCamera(setup.plane ? PlaneView(setup.plane_z, setup.extent)
                                  : OrbitCamera(setup, aspect));
-  LoadNewPositions(config.slab_dir, info, renderer, config.threads);
-  if (!config.watch) CheckListedPositionsLoaded(config.slab_dir, info, renderer);
+  LoadNewLights(source, info, renderer, config.threads);
+  if (!config.watch) CheckListedLightsLoaded(source, renderer);
   renderer.Render();
   WriteOutput(config, setup, info, renderer);
-  LogInfo("rendered ", renderer.PositionCount(), "/", info.grid.count(), " positions, ",
+  LogInfo("rendered ", renderer.PositionCount(), "/", renderer.LightCount(), " positions",
+          source.luminaire
+              ? " of " + std::to_string(renderer.OrientationCount()) + " orientations, "
+              : std::string(", "),
           setup.mesh.triangles(), " triangles, ", width, "x", height,
           config.out.empty() ? "" : " -> " + config.out);
   if (config.report_srgbe_error || config.srgbe) ReportSrgbeError(renderer);
   if (config.bench) RunBench(config, setup, aspect, renderer);
-  if (config.watch) WatchSlab(config, setup, info, renderer);
+  if (config.watch) WatchSlab(config, setup, source, info, renderer);
   return 0;
 }
 

@@ -5,9 +5,11 @@
 
 #include "core/slab.h"
 #include "preview/config.h"
+#include "preview/light_source.h"
 
 namespace lumislab {
 
-int RunHeadless(const PreviewConfig& config, const SlabInfo& info);
+// `info`: the layout of the slab (of every orientation's, for a luminaire folder).
+int RunHeadless(const PreviewConfig& config, const LightSource& source, const SlabInfo& info);
 
 }  // namespace lumislab

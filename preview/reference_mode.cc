@@ -14,11 +14,15 @@
 namespace lumislab {
 namespace {
 
-// The synthetic luminaire's emitters as the reference's point sources.
-std::vector<PointSource> PointSources(const Luminaire& luminaire) {
+// The synthetic luminaire's emitters as the reference's point sources: in the frame of its
+// positions (a slab's: S at z = 0), or for a luminaire folder in the luminaire's own frame (the
+// origin at its centre_mm, the frame the folder's poses map from).
+std::vector<PointSource> PointSources(const Luminaire& luminaire, bool own_frame) {
+  const Eigen::Vector3d origin = own_frame ? luminaire.centre_mm : Eigen::Vector3d::Zero();
   std::vector<PointSource> sources;
   for (const Emitter& e : luminaire.emitters)
-    sources.push_back({e.position_mm, [e](const Eigen::Vector3d& w) { return e.Intensity(w); }});
+    sources.push_back(
+        {e.position_mm - origin, [e](const Eigen::Vector3d& w) { return e.Intensity(w); }});
   return sources;
 }
 
@@ -30,6 +34,7 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
   options.samples = config.samples;
   options.threads = config.threads;
   options.visibility = config.shadows;
+  options.whole_frame = config.luminaire_folder;  // the luminaire's own frame, every direction
   // Inputs first: a bad luminaire or slab is refused before the scene is built.
   const bool analytic = !config.analytic.empty();
   const Luminaire luminaire = analytic ? LoadLuminaire(config.analytic) : Luminaire{};
@@ -38,8 +43,9 @@ int RunReferenceMode(const PreviewConfig& config, const SlabInfo& info) {
       analytic ? std::vector<ImageF>{} : ReadSlabIrradiance(config.slab_dir, info, config.threads);
   const ReferenceScene view(setup, config.width, config.height);
   const auto start = std::chrono::steady_clock::now();
-  const ReferenceImage image = analytic ? RenderPointSources(view, PointSources(luminaire), options)
-                                        : RenderReference(view, info, irradiance, options);
+  const ReferenceImage image =
+      analytic ? RenderPointSources(view, PointSources(luminaire, options.whole_frame), options)
+               : RenderReference(view, info, irradiance, options);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!image.complete) throw Failure("stopped by a signal; " + config.out + " not written");

@@ -27,9 +27,21 @@ std::string ShadowVertex(bool layered) {
 
 }  // namespace
 
-Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options)
-    : info_(info), width_(width), height_(height), options_(options), gl_(new Gl) {
-  const int lights = info_.grid.count();
+Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options,
+                   const std::vector<LightOrientation>& orientations)
+    : info_(info),
+      orientations_(orientations.empty() ? std::vector<LightOrientation>(1) : orientations),
+      posed_(!orientations.empty()),
+      width_(width),
+      height_(height),
+      options_(options),
+      gl_(new Gl) {
+  if (int(orientations_.size()) > kMaxOrientations)
+    throw BadInput("at most " + std::to_string(kMaxOrientations) + " orientations, got " +
+                   std::to_string(orientations_.size()));
+  CheckOrientationOptions(options_);
+  orientation_present_.assign(orientations_.size(), false);
+  const int lights = info_.grid.count() * int(orientations_.size());
   present_.assign(lights, false);
   shadow_valid_.assign(lights, false);
   accumulated_.assign(lights, false);
@@ -39,10 +51,11 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   shadow_centre_.resize(lights);
   for (int l = 0; l < lights; ++l) {
     shadow_layer_[l] = l;
-    shadow_centre_[l] = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
+    const int p = GridIndexOf(l);
+    shadow_centre_[l] = info_.grid.Centre(p % info_.grid.nu, p / info_.grid.nu);
   }
   intensity_.resize(lights);
-  // Merged textures follow the positions' layers: at most one per 2 x 2 block.
+  // Merged textures follow the positions' layers (one slab only): at most one per 2 x 2 block.
   const int merge_layers = ((info_.grid.nu + 1) / 2) * ((info_.grid.nv + 1) / 2);
   // The light program of these options now, so that a driver that refuses it fails here; the
   // others are linked when first used (the shortcuts' uniform arrays are larger: a driver that
@@ -62,6 +75,13 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glGenVertexArrays(1, &gl_->quad_vao);
   glGenBuffers(1, &gl_->vbo);
 
+  // Every orientation's positions are layers of one texture array.
+  GLint max_layers = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  if (lights + merge_layers > max_layers)
+    throw BadInput(std::to_string(lights) + " positions (" + std::to_string(OrientationCount()) +
+                   " orientations) exceed the driver's " + std::to_string(max_layers) +
+                   " texture-array layers");
   glGenTextures(1, &gl_->intensity);
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
   glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, info_.layout.res_x, info_.layout.res_y,
@@ -242,6 +262,7 @@ void Renderer::SetOptions(const RenderOptions& options) {
         "merge group must be >= 1, merge error > 0, shadow sharing >= 0 texels, coarse and "
         "reprojection tolerances >= 0");
   }
+  CheckOrientationOptions(options);
   // Maps drawn for the old options may be shared, or cover less than merged lights read.
   if (options.shadow_share_texels != options_.shadow_share_texels ||
       options.shadow_cull != options_.shadow_cull || options.merge_group != options_.merge_group ||
@@ -264,12 +285,20 @@ void Renderer::Resize(int width, int height) {
   AllocateTargets();
 }
 
-void Renderer::SetPosition(int i, int j, const ImageF& intensity) {
+void Renderer::SetPosition(int i, int j, const ImageF& intensity, int orientation) {
   if (intensity.width != info_.layout.res_x || intensity.height != info_.layout.res_y ||
       intensity.channels != 3) {
     throw BadInput("slab position texture does not match the slab layout");
   }
-  const int layer = info_.grid.Index(i, j);
+  if (orientation < 0 || orientation >= OrientationCount())
+    throw BadInput("orientation " + std::to_string(orientation) + " of " +
+                   std::to_string(OrientationCount()));
+  const int layer = orientation * info_.grid.count() + info_.grid.Index(i, j);
+  if (!orientation_present_[orientation]) {
+    orientation_present_[orientation] = true;
+    // The others' blend weights change where its cone overlaps theirs: the sums are redone.
+    if (OrientationCount() > 1) view_valid_ = source_valid_ = view_shaded_in_full_ = false;
+  }
   glBindTexture(GL_TEXTURE_2D_ARRAY, gl_->intensity);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, layer, intensity.width, intensity.height, 1, GL_RGB,
@@ -304,7 +333,9 @@ void Renderer::SetPosition(int i, int j, const ImageF& intensity) {
   merged_valid_.clear();  // the merged textures are rebuilt from the copies when next used
 }
 
-bool Renderer::HasPosition(int i, int j) const { return present_[info_.grid.Index(i, j)]; }
+bool Renderer::HasPosition(int i, int j, int orientation) const {
+  return present_[orientation * info_.grid.count() + info_.grid.Index(i, j)];
+}
 
 int Renderer::PositionCount() const {
   int n = 0;

@@ -3,6 +3,8 @@
 // light only towards +z of the luminaire frame and only through the screen window; Lambertian
 // materials; float (RGBA32F, additive blending) or sRGBE-packed accumulation (paper §4.2).
 // Needs a current GL 4.5 core context (OffscreenContext or WindowContext).
+// A luminaire folder (docs/method.md §4.12): every orientation's positions are lights, each pass
+// one orientation's, shaded in its capture frame and weighted by the blend (LightOrientation).
 //
 // Deferred shading: a G-buffer (luminaire-frame position, normal, albedo per pixel) is drawn when
 // the view changes, and each light pass is one full-screen pass over it; the shaders have the
@@ -17,7 +19,8 @@
 // The methods are in files by phase: renderer.cc (set-up, uploads, Render(), read-back),
 // renderer_shadows.cc (shadow maps and their sharing), renderer_merge.cc (merged lights),
 // renderer_tiles.cc (light culling by tiles), renderer_light.cc (light passes, coarse shading),
-// renderer_reproject.cc (reprojection); the shaders in preview/shaders/.
+// renderer_reproject.cc (reprojection), renderer_orientations.cc (a luminaire folder's
+// orientations); the shaders in preview/shaders/.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,6 +30,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/luminaire_set.h"
 #include "core/slab.h"
 #include "lib/lightfield/scenes.h"
 
@@ -121,9 +125,29 @@ struct ShortcutState {
   double reprojected_exact = 0;
 };
 
+// One orientation of a luminaire folder (docs/method.md §4.12, "The preview of a luminaire
+// folder"): its pose (x_capture = R x_luminaire + centre, w_capture = R w_luminaire) and the cone
+// of directions its slab sees (core/luminaire_set.h). Its positions light the scene from
+// R^T (c - centre), their directions looked up through R, each weighted per direction w
+// (luminaire frame, from its origin) by t_k / sum_j t_j, t_j = ConeTaper(cone_j, R_j w) over the
+// orientations with a position present (where no cone holds w, the one with the largest margin
+// adds its light alone).
+struct LightOrientation {
+  Eigen::Matrix3d capture_from_luminaire = Eigen::Matrix3d::Identity();  // R_k
+  Eigen::Vector3d centre_mm = Eigen::Vector3d::Zero();                   // centre_k
+  OrientationCone cone;
+};
+// The largest number of orientations the light program's uniform arrays hold.
+constexpr int kMaxOrientations = 32;
+
 class Renderer {
  public:
-  Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options);
+  // `orientations` empty: one slab, whose capture frame is the luminaire frame (as before).
+  // Otherwise a luminaire folder's orientations, every one a slab of `info`'s layout; light
+  // k * grid.count() + p is position p of orientation k. The shortcuts (shadow-map sharing,
+  // light merging) serve one slab: with several orientations they are refused (BadInput).
+  Renderer(const SlabInfo& info, int width, int height, const RenderOptions& options,
+           const std::vector<LightOrientation>& orientations = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -136,10 +160,15 @@ class Renderer {
   void SetOptions(const RenderOptions& options);
   const RenderOptions& options() const { return options_; }
   void Resize(int width, int height);
-  // Uploads E'_ij (3 channels, slab layout) of position (i, j); it is added at the next Render.
-  void SetPosition(int i, int j, const ImageF& intensity);
-  bool HasPosition(int i, int j) const;
+  // Uploads E'_ij (3 channels, slab layout) of position (i, j) of `orientation`; it is added at
+  // the next Render. An orientation's first position changes the others' blend weights: the
+  // image is summed afresh.
+  void SetPosition(int i, int j, const ImageF& intensity, int orientation = 0);
+  bool HasPosition(int i, int j, int orientation = 0) const;
   int PositionCount() const;
+  // Positions of every orientation (grid.count() x orientations).
+  int LightCount() const { return int(present_.size()); }
+  int OrientationCount() const { return int(orientations_.size()); }
 
   // Brings the accumulated image up to date; returns how many lights it added. glFinish()ed.
   int Render();
@@ -169,6 +198,7 @@ class Renderer {
   // One shadow map: its layer, seen from centre (a position's, or a shared map's block mean).
   struct ShadowJob {
     int layer = 0;
+    int orientation = 0;  // whose capture frame the map is drawn in
     Eigen::Vector2d centre;
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the map texels drawn: [x0, x1) x [y0, y1)
   };
@@ -233,7 +263,25 @@ class Renderer {
   bool TryReproject();
   void Reproject();
 
+  // renderer_orientations.cc: a luminaire folder's orientations.
+  // The orientation of light l; its position in the grid.
+  int OrientationOf(int l) const { return l / info_.grid.count(); }
+  int GridIndexOf(int l) const { return l % info_.grid.count(); }
+  // Capture frame of orientation k from the luminaire frame, [R_k | centre_k] (a single slab:
+  // the identity).
+  Eigen::Matrix4f CaptureFromLuminaire(int k) const;
+  // The light program's orientation uniforms for this pass's orientation (pass_orientation_).
+  void SetOrientationUniforms(unsigned program) const;
+  // Refuses options a luminaire folder cannot have.
+  void CheckOrientationOptions(const RenderOptions& options) const;
+
   SlabInfo info_;
+  // One entry for a single slab (identity, not posed), else the folder's orientations.
+  std::vector<LightOrientation> orientations_;
+  bool posed_ = false;                     // a luminaire folder: the shaders transform and blend
+  std::vector<bool> orientation_present_;  // a position of it is present (it takes part in blends)
+  int pass_orientation_ = 0;               // the orientation of the light pass being drawn
+  int tile_bounds_orientation_ = 0;        // the frame the tiles' bounds were computed in
   int width_, height_;
   RenderOptions options_;
   Eigen::Matrix4f view_projection_ = Eigen::Matrix4f::Identity();
@@ -272,5 +320,11 @@ class Renderer {
   ShortcutState state_;
   Gl* gl_;
 };
+
+// The light program's blend taper (shaders/cone_taper.glsl) at capture-frame unit directions,
+// evaluated by the current GL context: for the test that pins it equal to ConeTaper.
+std::vector<double> ShaderConeTaper(const OrientationCone& cone,
+                                    const std::vector<Eigen::Vector3d>& w_capture,
+                                    double taper_deg = kDefaultTaperDeg);
 
 }  // namespace lumislab

@@ -35,6 +35,7 @@ void Renderer::SetCommonUniforms(unsigned program, Shading shading) {
   }
   const Eigen::Vector2d corner = info_.grid.Centre(info_.grid.nu - 1, info_.grid.nv - 1);
   glUniform2f(Loc(p, "u_grid_half"), float(corner.x()), float(corner.y()));
+  SetOrientationUniforms(p);
   // One shadow texel seen at unit distance, times 1.5: normal offset against self-shadowing.
   glUniform1f(Loc(p, "u_offset_scale"),
               float(1.5 * info_.layout.window_w_mm / info_.distance_mm / options_.shadow_size));
@@ -102,7 +103,9 @@ unsigned Renderer::LightProgram(bool shortcuts, Shading shading) {
       std::to_string(shading == Shading::kResolve) + "\n#define EXACT_LIST " +
       std::to_string(shading == Shading::kExactList) + "\n#define REPROJECT " +
       std::to_string(shading == Shading::kReproject) + "\n#define TILED " +
-      std::to_string(options_.tiled_lights) + "\n#define TILE " + std::to_string(kTile) + "\n";
+      std::to_string(options_.tiled_lights) + "\n#define TILE " + std::to_string(kTile) +
+      "\n#define POSED " + std::to_string(posed_) + "\n#define ORIENTATIONS " +
+      std::to_string(OrientationCount()) + "\n";
   GLuint& program = gl_->light_programs[defines];
   if (!program) {
     const std::string source = WithDefines(shaders::kLightPass, defines);
@@ -116,7 +119,8 @@ void Renderer::LightPass(const std::vector<int>& lights) {
   std::vector<LightEntry> entries;
   for (int l : lights) {
     LightEntry e;
-    e.centre = e.shadow_centre = info_.grid.Centre(l % info_.grid.nu, l / info_.grid.nu);
+    const int p = GridIndexOf(l);
+    e.centre = e.shadow_centre = info_.grid.Centre(p % info_.grid.nu, p / info_.grid.nu);
     e.layer = e.shadow_layer = l;
     e.support = support_[l];
     entries.push_back(e);
@@ -224,17 +228,25 @@ void Renderer::DrawLightPass(Shading shading) {
   }
 }
 
-// The light passes that add `lights`: with the shortcuts, ShortcutPasses; otherwise batches of
-// kLightsPerPass.
+// The light passes that add `lights` (ascending): with the shortcuts, ShortcutPasses (one
+// orientation); otherwise batches of kLightsPerPass, each of one orientation (a pass shades in
+// its capture frame).
 void Renderer::LightPasses(const std::vector<int>& lights) {
   if (lights.empty()) return;
+  pass_orientation_ = 0;
   if (options_.SharesOrMergesLights()) {
     ShortcutPasses(lights);
     return;
   }
-  for (size_t start = 0; start < lights.size(); start += kLightsPerPass) {
-    const size_t end = std::min(lights.size(), start + kLightsPerPass);
+  size_t start = 0;
+  while (start < lights.size()) {
+    pass_orientation_ = OrientationOf(lights[start]);
+    size_t end = start;
+    while (end < lights.size() && end - start < size_t(kLightsPerPass) &&
+           OrientationOf(lights[end]) == pass_orientation_)
+      ++end;
     LightPass(std::vector<int>(lights.begin() + start, lights.begin() + end));
+    start = end;
   }
 }
 

@@ -11,7 +11,7 @@ namespace lumislab {
 
 Renderer::ShadowJob Renderer::ShadowJobFor(int l) const {
   const int size = options_.shadow_size;
-  ShadowJob job{shadow_layer_[l], shadow_centre_[l], 0, 0, size, size};
+  ShadowJob job{shadow_layer_[l], OrientationOf(l), shadow_centre_[l], 0, 0, size, size};
   if (options_.SharesOrMergesLights() || !options_.shadow_scissor)
     return job;  // shared or merged maps: whole
   const std::array<int, 4>& s = support_[l];
@@ -68,8 +68,15 @@ void Renderer::RenderShadowMaps(const std::vector<ShadowJob>& jobs) {
   glPolygonOffset(1.5f, 2.0f);
   const GLuint p = gl_->shadow_program;
   glUseProgram(p);
+  // Each map is drawn in its light's capture frame (a luminaire folder's orientation).
   const Eigen::Matrix4f to_lum = pose_.inverse().matrix().cast<float>();
-  glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_lum.data());
+  auto set_frame = [&](int orientation) {
+    const Eigen::Matrix4f to_capture =
+        posed_ ? Eigen::Matrix4f(CaptureFromLuminaire(orientation) * to_lum) : to_lum;
+    glUniformMatrix4fv(Loc(p, "u_scene_to_luminaire"), 1, GL_FALSE, to_capture.data());
+  };
+  int frame = jobs[0].orientation;
+  set_frame(frame);
   glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
   glUniform2f(Loc(p, "u_window"), float(info_.layout.window_w_mm), float(info_.layout.window_h_mm));
   glUniform2f(Loc(p, "u_depth"), float(kShadowDepthA), float(kShadowDepthB));
@@ -80,8 +87,11 @@ void Renderer::RenderShadowMaps(const std::vector<ShadowJob>& jobs) {
   // PreviewSlabFiles.ShadowCullKeepsTheImage checks that the crypt's image stays within 1 %).
   if (options_.shadow_cull) glEnable(GL_CULL_FACE);
   const size_t batch = gl_->layered_shadows ? size_t(gl_->shadow_batch) : 1;
-  for (size_t b = 0; b < jobs.size(); b += batch) {
-    const size_t n = std::min(batch, jobs.size() - b);
+  for (size_t b = 0, n = 0; b < jobs.size(); b += n) {
+    // A draw's maps share one frame.
+    n = 1;
+    while (n < batch && b + n < jobs.size() && jobs[b + n].orientation == jobs[b].orientation) ++n;
+    if (jobs[b].orientation != frame) set_frame(frame = jobs[b].orientation);
     float u[4 * kShadowBatch];
     for (size_t k = 0; k < n; ++k) {
       const ShadowJob& job = jobs[b + k];
@@ -157,14 +167,14 @@ Eigen::Vector2d MeanCentre(const SamplingGrid& grid, const std::vector<int>& mem
 // occluders, and receivers at a shadow's edge, which the map also sees).
 void Renderer::ChooseShadowGroups() {
   const SamplingGrid& grid = info_.grid;
-  const int lights = grid.count();
-  shadow_valid_.assign(lights, false);
+  // Every orientation's maps (sharing serves one slab: the others keep their own maps).
+  shadow_valid_.assign(LightCount(), false);
   int g = 1;
   state_ = ShortcutState{};
   if (options_.shadow_share_texels > 0) {
     const int centre = grid.Index(grid.nu / 2, grid.nv / 2);
     const int size = options_.shadow_size;
-    RenderShadowMaps({{centre, grid.Centre(grid.nu / 2, grid.nv / 2), 0, 0, size, size}});
+    RenderShadowMaps({{centre, 0, grid.Centre(grid.nu / 2, grid.nv / 2), 0, 0, size, size}});
     std::vector<float> depth(size_t(size) * size);
     glGetTextureSubImage(gl_->shadow, 0, 0, 0, centre, size, size, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
                          GLsizei(depth.size() * sizeof(float)), depth.data());

@@ -19,7 +19,7 @@ void Renderer::TileLists(int lights_per_pass, const float* lights,
                          const std::vector<LightEntry>& entries, int near_end, int far_begin) {
   const int tiles_x = (width_ + kTile - 1) / kTile, tiles_y = (height_ + kTile - 1) / kTile;
   const int count = int(entries.size());
-  if (!tile_bounds_valid_) {
+  if (!tile_bounds_valid_ || tile_bounds_orientation_ != pass_orientation_) {
     if (!gl_->tile_bounds_program) {
       gl_->tile_bounds_program = LinkComputeProgram(
           WithDefines(shaders::kTileBoundsCompute, "#define TILE " + std::to_string(kTile) + "\n"));
@@ -31,11 +31,16 @@ void Renderer::TileLists(int lights_per_pass, const float* lights,
     glUniform1i(Loc(p, "u_gbuffer_position"), 3);
     glUniform1f(Loc(p, "u_d"), float(info_.distance_mm));
     glUniform2i(Loc(p, "u_tiles"), tiles_x, tiles_y);
+    // The bounds are of the points in the pass's capture frame (the luminaire frame for a slab).
+    const Eigen::Matrix4f capture_from_luminaire = CaptureFromLuminaire(pass_orientation_);
+    glUniformMatrix4fv(Loc(p, "u_capture_from_luminaire"), 1, GL_FALSE,
+                       capture_from_luminaire.data());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, gl_->tile_bounds);
     glMemoryBarrier(GL_ALL_BARRIER_BITS);  // the G-buffer drawn before
     glDispatchCompute(GLuint(tiles_x * tiles_y + 63) / 64, 1, 1);
     glActiveTexture(GL_TEXTURE0);
     tile_bounds_valid_ = true;
+    tile_bounds_orientation_ = pass_orientation_;
   }
   GLuint& p = gl_->tile_list_programs[lights_per_pass];
   if (!p) {

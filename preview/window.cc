@@ -216,8 +216,8 @@ void PollSlab(WindowState& s) {
   }
   s.last_poll = Clock::now();
   try {
-    s.info = SlabInfo::Load(s.config.slab_dir);
-    const auto added = LoadNewPositions(s.config.slab_dir, s.info, *s.renderer, s.config.threads);
+    if (!s.source.luminaire) s.info = SlabInfo::Load(s.config.slab_dir);
+    const auto added = LoadNewLights(s.source, s.info, *s.renderer, s.config.threads);
     if (!added.empty()) s.last_arrived = added.back();
   } catch (const Error& e) {
     LogDebug("poll: ", e.what());
@@ -228,10 +228,11 @@ void PollSlab(WindowState& s) {
 // shadow-map size).
 void MakeRenderer(WindowState& s, int fb_w, int fb_h) {
   s.renderer.reset();
-  s.renderer = std::make_unique<Renderer>(s.info, fb_w, fb_h, MakeRenderOptions(s.config, s.setup));
+  s.renderer = std::make_unique<Renderer>(s.info, fb_w, fb_h, MakeRenderOptions(s.config, s.setup),
+                                          RendererOrientations(s.source, s.info));
   s.renderer->SetScene(s.setup.mesh);
   s.renderer->SetPose(PoseFromValues(s.config.scene.pose));
-  const auto arrived = LoadNewPositions(s.config.slab_dir, s.info, *s.renderer, s.config.threads);
+  const auto arrived = LoadNewLights(s.source, s.info, *s.renderer, s.config.threads);
   if (!arrived.empty()) s.last_arrived = arrived.back();
   s.camera_changed = true;
 }
@@ -334,7 +335,7 @@ bool Frame(WindowState& s, GLFWwindow* window, double seconds) {
   }
   // --screenshot: once every position is in and the panel has laid itself out (ImGui sizes a
   // new window over its first frames), save and quit.
-  if (!s.config.screenshot.empty() && s.renderer->PositionCount() == s.info.grid.count() &&
+  if (!s.config.screenshot.empty() && s.renderer->PositionCount() == s.renderer->LightCount() &&
       s.frames >= 3) {
     SaveScreenshot(s, s.config.screenshot, fb_w, fb_h);
     s.quit = true;
@@ -365,12 +366,13 @@ class ImGuiScope {
 
 }  // namespace
 
-int RunWindow(const PreviewConfig& config, const SlabInfo& info) {
+int RunWindow(const PreviewConfig& config, const LightSource& source, const SlabInfo& info) {
   WindowContext context(config.width, config.height, "lumislab-preview");
   GLFWwindow* window = context.window();
   WindowState state;
   state.config = config;
   state.info = info;
+  state.source = source;
   state.setup = MakePreviewSetup(config, info);
   state.config.scene.pose = ValuesFromPose(state.setup.pose);
   state.config.camera = CameraValues(state.setup);

@@ -9,9 +9,10 @@
 
 #include "core/slab.h"
 #include "preview/config.h"
+#include "preview/light_source.h"
 
 namespace lumislab {
 
-int RunWindow(const PreviewConfig& config, const SlabInfo& info);
+int RunWindow(const PreviewConfig& config, const LightSource& source, const SlabInfo& info);
 
 }  // namespace lumislab

@@ -18,7 +18,7 @@ void StatusPanel(WindowState& s) {
   // frame that did (all lights after a camera, pose or option change; new positions otherwise).
   ImGui::Text("%.1f fps (frame %.1f ms)  last render %.0f ms, %d lights",
               s.frame_ms > 0 ? 1000 / s.frame_ms : 0.0, s.frame_ms, s.render_ms, s.render_lights);
-  ImGui::Text("positions %d/%d", s.renderer->PositionCount(), s.info.grid.count());
+  ImGui::Text("positions %d/%d", s.renderer->PositionCount(), s.renderer->LightCount());
   if (s.last_arrived.first >= 0) {
     ImGui::SameLine();
     ImGui::Text(" last %d,%d", s.last_arrived.first, s.last_arrived.second);

@@ -13,6 +13,7 @@
 #include "core/slab.h"
 #include "lib/lightfield/scene_setup.h"
 #include "preview/config.h"
+#include "preview/light_source.h"
 #include "preview/renderer.h"
 
 namespace lumislab {
@@ -24,7 +25,8 @@ struct WindowState {
   // (config.scene.pose, six values), shadows, accumulation, size.
   PreviewConfig config;
   SlabInfo info;
-  SceneSetup setup;  // mesh and plane of the scene; its pose and camera follow the config
+  LightSource source;  // the slab, or the luminaire folder's orientations
+  SceneSetup setup;    // mesh and plane of the scene; its pose and camera follow the config
   std::unique_ptr<Renderer> renderer;
 
   // The picture: the accumulated image, its exposure factor and its sRGB bytes (a texture).

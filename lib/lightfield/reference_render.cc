@@ -274,18 +274,21 @@ ReferenceImage RenderPointSources(const ReferenceScene& view,
                                   const std::vector<PointSource>& sources,
                                   const ReferenceOptions& options) {
   for (const PointSource& source : sources)
-    LUMISLAB_CHECK(source.position_mm.z() < 0, "point sources lie behind S");
+    LUMISLAB_CHECK(options.whole_frame || source.position_mm.z() < 0, "point sources lie behind S");
   return RenderRows(view, options, "analytic", [&](const SurfacePoint& p) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    if (!(p.x.z() > 0)) return sum;
+    if (!options.whole_frame && !(p.x.z() > 0)) return sum;
     for (const PointSource& source : sources) {
       const Eigen::Vector3d rel = p.x - source.position_mm;
       const double r2 = rel.squaredNorm();
       const double r = std::sqrt(r2);
       const double cos_recv = -p.n.dot(rel) / r;
       if (!(cos_recv > 0)) continue;
-      // Where the ray from the source to x crosses S.
-      const Eigen::Vector3d on_s = source.position_mm + rel * (-source.position_mm.z() / rel.z());
+      // Where the ray from the source to x crosses S (the whole frame: the source itself).
+      const Eigen::Vector3d on_s =
+          options.whole_frame
+              ? source.position_mm
+              : Eigen::Vector3d(source.position_mm + rel * (-source.position_mm.z() / rel.z()));
       if (options.visibility && !view.Visible(p.x, on_s)) continue;
       sum += source.intensity_w_sr(rel / r) * (cos_recv / r2 * 1e6);
     }

@@ -65,6 +65,10 @@ struct ReferenceOptions {
   int threads = 1;         // ParallelFor threads over image rows
   bool visibility = true;  // false: V = 1 (no occlusion rays; the preview's --no-shadows)
   bool progress = true;    // a Progress bar on stderr (rows)
+  // RenderPointSources over the whole luminaire frame (a luminaire folder measured from several
+  // orientations, docs/method.md §4.12): sources anywhere, every receiver lit, visible when
+  // nothing lies between it and the source.
+  bool whole_frame = false;
 };
 
 // A rendered view: per pixel the irradiance at the surface (W/m^2, luminaire frame; 0 where no
@@ -109,7 +113,8 @@ struct PointSource {
 // Irradiance straight from point sources: I(w) cos(theta') / r^2 per source, for points in front
 // of S (x_z > 0) only, visible when nothing lies between x and the point where the ray to the
 // source crosses S (the same visibility as the slab's light: the luminaire's own side of S is not
-// part of the scene's shadows). options.samples is not used.
+// part of the scene's shadows); with options.whole_frame, any source and receiver, visibility to
+// the source itself. options.samples is not used.
 ReferenceImage RenderPointSources(const ReferenceScene& view,
                                   const std::vector<PointSource>& sources,
                                   const ReferenceOptions& options);

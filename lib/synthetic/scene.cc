@@ -30,22 +30,24 @@ const char* kDefaultSceneJson = R"({
 // (docs/formats.md §19): six broad lobes along +-x, +-y, +-z of unequal strength (so every
 // overlap of two orientations has gradients to register on), a side lobe towards +x, a little
 // down, and a narrow asymmetric lobe towards C 60, gamma 120 (behind the gamma = 90 plane). Its
-// own origin, centre_mm, 40 mm behind S, every emitter within 4 mm of it; a screen of 2000 mm at
-// 750 mm sees 52 degrees either side of the axis, so the six cube faces overlap.
+// own origin, centre_mm, 8 mm behind S, every emitter within 3.2 mm of it; a screen of 2000 mm
+// at 750 mm sees 52 degrees either side of the axis, so the six cube faces overlap. The grid
+// must hold the light up to the cone's edge: an emitter z behind S sends it through S within
+// z tan(52) of itself, under 18 mm here, and 9 x 9 positions of 5 mm reach 25 mm.
 const char* kFullSphereSceneJson = R"({
   "schema_version": 1,
-  "setup": { "distance_mm": 750, "grid": {"nu": 5, "nv": 5, "spacing_mm": 5},
+  "setup": { "distance_mm": 750, "grid": {"nu": 9, "nv": 9, "spacing_mm": 5},
              "screen_mm": [2000, 2000] },
   "filter": { "k_max": 1 },
-  "luminaire": { "centre_mm": [0, 0, -40], "emitters": [
-    {"position_mm": [0, 0, -38], "axis": [0, 0, 1], "intensity_w_sr": [0.60, 0.60, 0.60], "lobe_exponent": 1.5},
-    {"position_mm": [0, 0, -42], "axis": [0, 0, -1], "intensity_w_sr": [0.35, 0.35, 0.35], "lobe_exponent": 1.5},
-    {"position_mm": [2, 0, -40], "axis": [1, 0, 0], "intensity_w_sr": [0.50, 0.50, 0.50], "lobe_exponent": 2},
-    {"position_mm": [-2, 0, -40], "axis": [-1, 0, 0], "intensity_w_sr": [0.30, 0.30, 0.30], "lobe_exponent": 2},
-    {"position_mm": [0, 2, -40], "axis": [0, 1, 0], "intensity_w_sr": [0.45, 0.45, 0.45], "lobe_exponent": 2.5},
-    {"position_mm": [0, -2, -40], "axis": [0, -1, 0], "intensity_w_sr": [0.25, 0.25, 0.25], "lobe_exponent": 2.5},
-    {"position_mm": [3, -1, -40], "axis": [0.94, 0, -0.34], "intensity_w_sr": [1.0, 0.8, 0.6], "lobe_exponent": 12},
-    {"position_mm": [1, -2, -41], "axis": [0.433, -0.75, -0.5], "intensity_w_sr": [0.8, 0.9, 1.0], "lobe_exponent": 20} ] },
+  "luminaire": { "centre_mm": [0, 0, -8], "emitters": [
+    {"position_mm": [0, 0, -6], "axis": [0, 0, 1], "intensity_w_sr": [0.60, 0.60, 0.60], "lobe_exponent": 1.5},
+    {"position_mm": [0, 0, -10], "axis": [0, 0, -1], "intensity_w_sr": [0.35, 0.35, 0.35], "lobe_exponent": 1.5},
+    {"position_mm": [2, 0, -8], "axis": [1, 0, 0], "intensity_w_sr": [0.50, 0.50, 0.50], "lobe_exponent": 2},
+    {"position_mm": [-2, 0, -8], "axis": [-1, 0, 0], "intensity_w_sr": [0.30, 0.30, 0.30], "lobe_exponent": 2},
+    {"position_mm": [0, 2, -8], "axis": [0, 1, 0], "intensity_w_sr": [0.45, 0.45, 0.45], "lobe_exponent": 2.5},
+    {"position_mm": [0, -2, -8], "axis": [0, -1, 0], "intensity_w_sr": [0.25, 0.25, 0.25], "lobe_exponent": 2.5},
+    {"position_mm": [3, -1, -8], "axis": [0.94, 0, -0.34], "intensity_w_sr": [1.0, 0.8, 0.6], "lobe_exponent": 12},
+    {"position_mm": [1, -2, -9], "axis": [0.433, -0.75, -0.5], "intensity_w_sr": [0.8, 0.9, 1.0], "lobe_exponent": 20} ] },
   "camera": { "size_px": [1600, 1200], "focal_px": 700, "position_mm": [0, -400, 2400],
               "look_at_mm": [0, 0, 750] },
   "effects": []

@@ -82,6 +82,41 @@ layout(rgba32f, binding = 2) uniform image2D u_irradiance;    // o_irradiance's 
 
 #include "srgbe.glsl"
 
+#if POSED
+// A luminaire folder's orientations (docs/method.md §4.12): the G-buffer holds the luminaire
+// frame; this pass's lights are orientation u_orientation's, shaded in its capture frame
+// (x_capture = R x + centre), each sum weighted per direction w = x / |x| (luminaire frame, from
+// its origin) by t_k / sum_j t_j, t_j = ConeTaper(cone_j, R_j w) over the orientations with a
+// position present (.w of u_orientation_cone: 1). Where no cone holds w (all t_j = 0), the
+// orientation with the largest margin (the first of equals) adds its light alone: continuous at
+// the cones' edges, and never twice.
+uniform mat4 u_capture_from_luminaire;
+uniform int u_orientation;
+uniform mat3 u_orientation_rotation[ORIENTATIONS];  // R_j
+uniform vec4 u_orientation_cone[ORIENTATIONS];      // d, half-width, half-height (mm), present
+uniform float u_taper_deg;
+
+#include "cone_taper.glsl"
+
+float BlendWeight(vec3 x) {
+  const vec3 w = normalize(x);
+  float own = 0.0, sum = 0.0, best = -1.0e30;
+  int best_j = -1;
+  for (int j = 0; j < ORIENTATIONS; ++j) {
+    if (u_orientation_cone[j].w == 0.0) continue;
+    const float margin = ConeMarginDeg(u_orientation_cone[j].xyz, u_orientation_rotation[j] * w);
+    const float t = TaperOfMargin(margin, u_taper_deg);
+    sum += t;
+    if (j == u_orientation) own = t;
+    if (margin > best) {
+      best = margin;
+      best_j = j;
+    }
+  }
+  return sum > 0.0 ? own / sum : (best_j == u_orientation ? 1.0 : 0.0);
+}
+#endif
+
 // E'_ij at texture coordinate uv of layer `layer`, reconstructed from the texel centres as
 // --texture-filter says: bilinear through the hardware (the paper's), the nearest texel, or
 // Catmull-Rom (4 x 4 texels, interpolating, cubic in each axis). Edges are clamped as the
@@ -118,17 +153,28 @@ vec3 SampleIntensity(vec2 uv, int layer) {
 }
 
 // Outside every spot light's cone (behind S, or not through the window from any c_ij): no light.
+// x: luminaire frame (POSED: taken to the pass's capture frame first).
 bool Dark(vec3 x) {
+#if POSED
+  x = (u_capture_from_luminaire * vec4(x, 1.0)).xyz;
+#endif
   vec2 reach = 0.5 * u_window + u_grid_half * abs(1.0 - u_d / max(x.z, 1e-6));
   return x.z <= 0.0 || any(greaterThan(abs(x.xy) * (u_d / max(x.z, 1e-6)), reach));
 }
 
-// The sum over this pass's lights at surface point x (normal n), luminaire frame. Every c_ij
+// The sum over this pass's lights at surface point x (normal n), luminaire frame (POSED: taken to
+// the pass's capture frame, the sum weighted by BlendWeight). Every c_ij
 // lies at z = 0, so what depends on x alone is computed once: rel.z = x.z for every light, the
 // point's projection through the window st = c + (x.xy - c) d / z = x.xy d / z + c (1 - d / z)
 // is linear in c, and cos_emit cos_recv / delta^2 = z (n . (c - x)) / delta^4 needs no root.
 vec3 ShadeLights(vec3 x, vec3 n, ivec2 pixel) {
   vec3 sum = vec3(0.0);
+#if POSED
+  const float weight = BlendWeight(x);
+  if (weight == 0.0) return sum;
+  x = (u_capture_from_luminaire * vec4(x, 1.0)).xyz;
+  n = mat3(u_capture_from_luminaire) * n;
+#endif
   if (x.z <= 0.0) return sum;  // behind S: no light reaches it
   const float s = u_d / x.z;
   const vec2 uv_x = vec2(0.5, 0.5) + x.xy * s / vec2(u_window.x, -u_window.y);
@@ -192,6 +238,9 @@ vec3 ShadeLights(vec3 x, vec3 n, ivec2 pixel) {
     vec3 intensity = SampleIntensity(uv, u_light_layers[k].x);
     sum += visible * intensity * (z_scaled * recv / (delta2 * delta2));
   }
+#if POSED
+  sum *= weight;
+#endif
   return sum;
 }
 

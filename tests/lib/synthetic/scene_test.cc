@@ -262,7 +262,7 @@ namespace {
 TEST(SceneFile, FullSphereLuminaireTurnsIntoOrientations) {
   const SynthScene scene = LoadScene("full-sphere");
   const Luminaire& lum = scene.luminaire;
-  EXPECT_EQ(lum.centre_mm, Eigen::Vector3d(0, 0, -40));
+  EXPECT_EQ(lum.centre_mm, Eigen::Vector3d(0, 0, -8));
   const auto intensity = [](const Luminaire& l, const Eigen::Vector3d& w) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const Emitter& e : l.emitters) sum += e.Intensity(w);

@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "calibrate/ceres_options.h"
@@ -179,15 +180,6 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     out.converged = summary.termination_type == ceres::CONVERGENCE;
   }
 
-  // The pairs after the fit, on the final samples.
-  for (RegisteredPair& r : out.pairs)
-    for (const PairSamples& s : pairs)
-      if (s.a == r.a && s.b == r.b) {
-        r.samples = int(s.directions.size());
-        ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
-                    &r.rms_after, &r.ratio);
-      }
-
   // Uncertainty: the Jacobian of the (robustified) relative residuals at the solution, its
   // normal matrix's eigen-decomposition, the covariance sigma^2 H^-1 on the directions the
   // overlaps fix and "unconstrained" on the others (ceres::Covariance's pseudo-inverse would
@@ -244,13 +236,24 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     for (size_t j = 0; j < blocks.size(); ++j)
       Eigen::Map<Eigen::Vector3d>(blocks[j]) -= along * v.segment<3>(3 * long(j));
   }
+  // The pairs after the fit, on the final samples, at the poses reported.
+  for (RegisteredPair& r : out.pairs)
+    for (const PairSamples& s : pairs)
+      if (s.a == r.a && s.b == r.b) {
+        r.samples = int(s.directions.size());
+        ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
+                    &r.rms_after, &r.ratio);
+      }
+
   for (int k = 0; k < count; ++k) {
     RegisteredOrientation& o = out.orientations[size_t(k)];
     o.gauge = k == 0;
     o.rotation = pose(k);
-    const Eigen::Vector3d c(corrections[size_t(k)].data());
-    o.correction_deg = c * kDegPerRad;
-    o.angle_deg = c.norm() * kDegPerRad;
+    // From the rotation itself, so that the angle is within [0, 180] whatever the solver's
+    // parameters became.
+    const Eigen::AngleAxisd c(o.rotation * inputs[size_t(k)].nominal.transpose());
+    o.correction_deg = c.axis() * c.angle() * kDegPerRad;
+    o.angle_deg = c.angle() * kDegPerRad;
     if (k == 0) continue;
     const int j = block_of[size_t(k)];
     if (j < 0) {  // no pair compared: nothing fixes it

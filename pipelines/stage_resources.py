@@ -41,6 +41,7 @@ MARGIN = 2.0
 JOB_MB = 250
 DEFAULT_RESOLUTION = 300  # lumislab-reconstruct's --resolution default
 DEFAULT_PHOTO_MP = 24.0  # when no photo size can be read: the largest measured
+DEFAULT_POSITIONS = 225  # when dataset.json cannot be read: the largest grid measured (15 x 15)
 
 
 def image_megapixels(path):
@@ -69,13 +70,17 @@ def image_megapixels(path):
 
 
 def dataset_size(ds, photo_mp=None):
-    """(positions, photo megapixels) of a dataset folder: the grid less its missing positions;
-    the photos' size from calib/screen.json, else the calibration photo's header (PNG, JPEG),
-    else photo_mp, else 24 MP."""
-    with open(os.path.join(ds, "dataset.json")) as f:
-        d = json.load(f)
-    grid = d["setup"]["grid"]
-    positions = max(1, grid["nu"] * grid["nv"] - len(d.get("missing_positions", [])))
+    """(positions, photo megapixels) of a dataset folder: the grid less its missing positions
+    (225 when dataset.json cannot be read); the photos' size from calib/screen.json, else the
+    calibration photo's header (PNG, JPEG), else photo_mp, else 24 MP."""
+    try:
+        with open(os.path.join(ds, "dataset.json")) as f:
+            d = json.load(f)
+        grid = d["setup"]["grid"]
+        positions = max(1, int(grid["nu"]) * int(grid["nv"]) - len(d.get("missing_positions", [])))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        # Unreadable: the largest measured grid, so that the stage runs and says what is wrong.
+        return DEFAULT_POSITIONS, photo_mp or DEFAULT_PHOTO_MP
     mp = None
     try:
         with open(os.path.join(ds, "calib", "screen.json")) as f:

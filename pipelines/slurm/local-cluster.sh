@@ -87,6 +87,7 @@ end_daemon() {
 stop() {
   if [ -f "$conf" ] && [ -s "$dir/run/slurmctld.pid" ]; then
     scancel --full --quiet --user="$(id -un)" >/dev/null 2>&1 || true
+    # shellcheck disable=SC2016  # expanded by the inner shell, at each try
     until_ok 15 "the jobs to end" bash -c '[ -z "$(squeue -h -o %i 2>/dev/null)" ]' || true
   fi
   # Both at once: each may take seconds to save its state.
@@ -108,10 +109,12 @@ stop() {
 }
 
 status() {
-  [ -s "$dir/run/slurmctld.pid" ] && kill -0 "$(cat "$dir/run/slurmctld.pid")" 2>/dev/null || {
+  local pid=""
+  [ ! -s "$dir/run/slurmctld.pid" ] || pid="$(cat "$dir/run/slurmctld.pid")"
+  if [ -z "$pid" ] || ! kill -0 "$pid" 2>/dev/null; then
     say "not running ($dir)"
     return 1
-  }
+  fi
   sinfo -N -o '%N %T %c %m' && squeue -o '%i %j %T %C %m %l %M'
 }
 
@@ -136,8 +139,9 @@ start() {
   dd if=/dev/urandom of="$dir/munge/munge.key" bs=1024 count=1 status=none
   chmod 400 "$dir/munge/munge.key"
   local sock="$dir/munge/munge.sock"
-  marked munged --socket="$sock" --key-file="$dir/munge/munge.key" --pid-file="$dir/munge/munged.pid" \
-    --log-file="$dir/munge/munged.log" --seed-file="$dir/munge/munged.seed" --force
+  marked munged --socket="$sock" --key-file="$dir/munge/munge.key" \
+    --pid-file="$dir/munge/munged.pid" --log-file="$dir/munge/munged.log" \
+    --seed-file="$dir/munge/munged.seed" --force
   until_ok "$timeout" "munged to answer" bash -c "munge -s x -S '$sock' | unmunge -S '$sock'" ||
     { stop || true; exit 1; }
 
@@ -148,7 +152,8 @@ start() {
   if [ -n "${LUMISLAB_CLUSTER_CPUS:-}" ]; then
     # More CPUs than there are (jobs that mostly wait, as a test's tiny ones): slurmd accepts
     # a node larger than the machine with config_overrides.
-    node="$(sed -E "s/ CPUs=[0-9]+/ CPUs=$LUMISLAB_CLUSTER_CPUS/; s/ (Boards|SocketsPerBoard|CoresPerSocket|ThreadsPerCore)=[0-9]+//g" <<<"$node")"
+    node="$(sed -E "s/ CPUs=[0-9]+/ CPUs=$LUMISLAB_CLUSTER_CPUS/;
+      s/ (Boards|SocketsPerBoard|CoresPerSocket|ThreadsPerCore)=[0-9]+//g" <<<"$node")"
     overrides="SlurmdParameters=config_overrides"
   fi
   name="$(sed -n 's/^NodeName=\([^ ]*\).*/\1/p' <<<"$node")"

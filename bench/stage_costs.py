@@ -13,7 +13,7 @@ is measured by its process tree's rusage (os.wait4: user + system CPU seconds, p
 largest process) and its wall time. Prints the tables, the log-log slope of each series (the
 exponent of the growth) and the least-squares fit of the formulas that pipelines/Snakefile
 uses to request Slurm resources (--mem, --time); writes stage_costs.csv and
-stage_costs_fit.json in --out. Run it under nice: it is a measurement, never a test.
+stage_costs_fit.json and stage_costs.svg (the growth, log-log; docs/images/) in --out. Run it under nice: it is a measurement, never a test.
 
   python3 bench/stage_costs.py --bin build/bin [--out /tmp/stage_costs] [--quick]
 """
@@ -215,6 +215,57 @@ def main():
     report(work, series, rows, throughput)
 
 
+COLOURS = {"calibrate": "#1b9e77", "reconstruct": "#d95f02", "export": "#7570b3",
+           "preview": "#e7298a"}
+
+
+def plot(path, rows):
+    """An SVG of three log-log panels (positions, photo MP, slab texels): each stage's CPU time
+    (solid) and peak memory (dashed) relative to the series' first point, with the lines of
+    slope 1 and 2 (grey) for the complexity expected."""
+    panels = [("positions", "positions"), ("photo", "photo_mp"), ("slab", "resolution")]
+    w, h, pad = 300, 260, 40
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{3 * w}" height="{h + 30}" '
+           'font-family="sans-serif" font-size="11">']
+    for k, (name, key) in enumerate(panels):
+        x0 = k * w
+        pts = [r for r in rows if r["series"] == name]
+        if not pts:
+            continue
+        xs = sorted({r[key] for r in pts})
+        lx0, lx1 = math.log(xs[0]), math.log(xs[-1])
+        ly1 = math.log(64.0)  # the y axis: 1x ... 64x the first point
+
+        def px(x, y):
+            return (x0 + pad + (math.log(x) - lx0) / (lx1 - lx0) * (w - 2 * pad),
+                    h - pad - math.log(max(y, 1e-3)) / ly1 * (h - 2 * pad))
+        out.append(f'<rect x="{x0 + pad}" y="{pad}" width="{w - 2 * pad}" height="{h - 2 * pad}" '
+                   'fill="none" stroke="#999"/>')
+        out.append(f'<text x="{x0 + w / 2}" y="{h - 8}" text-anchor="middle">{key} '
+                   f'({xs[0]:g} … {xs[-1]:g}, log)</text>')
+        out.append(f'<text x="{x0 + pad}" y="{pad - 8}">{name}: cost / first point '
+                   '(1 … 64, log)</text>')
+        for slope_ in (1, 2):
+            xe = min(xs[-1], xs[0] * 64 ** (1 / slope_))
+            (a, b), (c, d) = px(xs[0], 1), px(xe, (xe / xs[0]) ** slope_)
+            out.append(f'<line x1="{a:.1f}" y1="{b:.1f}" x2="{c:.1f}" y2="{d:.1f}" '
+                       'stroke="#ccc" stroke-width="1"/>')
+        for stage, colour in COLOURS.items():
+            sp = sorted((r for r in pts if r["stage"] == stage), key=lambda r: r[key])
+            if len(sp) < 2:
+                continue
+            for field, dash in (("cpu_s", ""), ("peak_mb", ' stroke-dasharray="4 3"')):
+                line = " ".join("%.1f,%.1f" % px(r[key], r[field] / sp[0][field]) for r in sp)
+                out.append(f'<polyline points="{line}" fill="none" stroke="{colour}" '
+                           f'stroke-width="1.5"{dash}/>')
+    for k, (stage, colour) in enumerate(COLOURS.items()):
+        out.append(f'<text x="{pad + 110 * k}" y="{h + 20}" fill="{colour}">{stage}</text>')
+    out.append(f'<text x="{pad + 440}" y="{h + 20}">solid: CPU time, dashed: peak memory; '
+               'grey: slopes 1 and 2</text></svg>')
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
 def read_csv(path):
     with open(path) as f:
         keys = f.readline().strip().split(",")
@@ -260,6 +311,8 @@ def report(work, series, rows, throughput):
         print(f"{stage:12s} cpu_s = {c[0]:.3f} + {c[1]:.4f} M + {c[2]:.4f} P M + {c[3]:.3f} P R2 "
               f"(worst measured/fit {worst_c:.2f});\n{'':12s} peak_mb = {m[0]:.1f} + {m[1]:.1f} M "
               f"min(T,P) + {m[2]:.1f} R2 min(T,P) + {m[3]:.1f} P R2 (worst {worst_m:.2f})")
+    plot(os.path.join(work, "stage_costs.svg"), rows)
+    print(f"wrote {work}/stage_costs.svg")
     if throughput is None:
         return
     with open(os.path.join(work, "stage_costs_fit.json"), "w") as f:

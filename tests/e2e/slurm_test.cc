@@ -142,8 +142,10 @@ class Slurm : public ::testing::Test {
     if (!root_.empty() && !::testing::Test::HasFailure()) fs::remove_all(root_);
   }
 
-  // Why the test cannot run here, or "".
+  // Why the test does not run here, or "" (then the cluster is started).
   static std::string Missing() {
+    if (testing::kSanitized)
+      return "the sanitized build (the tools run many times over: the Release build's)";
     if (getuid() != 0) return "not root (slurmd runs jobs as their users)";
     for (const char* tool : {"slurmctld", "slurmd", "sbatch", "munged", "snakemake"})
       if (std::system(
@@ -193,8 +195,13 @@ testing::TreeSnapshot Outputs(const std::string& root, const std::string& name) 
 
 TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
   if (!skip_.empty()) GTEST_SKIP() << "Slurm test skipped: " << skip_;
-  if (testing::kSanitized) GTEST_SKIP() << "the tools run many times over: the Release build's";
   const auto t0 = std::chrono::steady_clock::now();
+  // The log's time of each phase.
+  auto phase = [&](const char* what) {
+    std::printf("slurm test: %-52s at %5.1f s\n", what,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::fflush(stdout);
+  };
 
   // Ten 3 x 3 datasets (one rendering, copied) of which one has a photo cut short, and a 7 x 7
   // one whose reconstruct lasts long enough to be cancelled; the same again for the local run.
@@ -221,9 +228,11 @@ TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
       Run(root_ + "/local", ShellQuote(Pipelines() + "/batch-convert.sh") +
                                 " data late --out out --jobs 2" + kStageArgs);
   ASSERT_EQ(local.exit_code, 1) << local.output;  // the broken dataset
+  phase("datasets rendered, local run done");
 
   // The whole batch through Slurm: it fails (the broken dataset), the rest converts.
   const CommandResult first = Snakemake("data");
+  phase("first run through Slurm done");
   std::cout << first.output.substr(
       first.output.find("dataset ") == std::string::npos ? 0 : first.output.rfind("dataset "));
   EXPECT_NE(first.exit_code, 0) << first.output;
@@ -236,7 +245,33 @@ TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
 
   // Every job as Slurm recorded it: one CPU (threads=1), the memory and time limit that the
   // cost model gives for its stage and dataset; all completed but the broken reconstruct.
-  std::map<std::string, std::string> expected;  // "<stage> <name>" -> "mem_mb=.. runtime=.."
+  // What the cost model gives each stage of each dataset (pipelines/stage_resources.py, one
+  // Python process): "<stage> <name>" -> "mem_mb=<MB> runtime=<minutes>".
+  std::string script =
+      "import sys; sys.path.insert(0, sys.argv[1]); import stage_resources as s\n"
+      "for a in sys.argv[2:]:\n"
+      "    st, ds = a.split(':', 1); r = s.resources(st, ds, 1, 48)\n"
+      "    print(st, ds.split('/')[-1], 'mem_mb=%d runtime=%d' % (r['mem_mb'], "
+      "r['runtime']))\n";
+  std::string args;
+  for (const char* stage : {"calibrate", "reconstruct", "export", "preview"}) {
+    for (const std::string& name : names)
+      args += " " + ShellQuote(std::string(stage) + ":" + root_ + "/data/" + name);
+    args += " " + ShellQuote(std::string(stage) + ":" + root_ + "/late/lamp_slow");
+  }
+  std::map<std::string, std::string> expected;
+  {
+    const CommandResult model = testing::RunShell("python3 -c " + ShellQuote(script) + " " +
+                                                  ShellQuote(Pipelines()) + args);
+    ASSERT_EQ(model.exit_code, 0) << model.output;
+    std::istringstream in(model.output);
+    for (std::string stage, name, resources; in >> stage >> name >> resources;) {
+      std::string runtime;
+      in >> runtime;
+      expected[stage + " " + name] = resources + " " + runtime + "\n";
+    }
+  }
+  ASSERT_EQ(expected.size(), 44u);
   std::printf("%-6s %-22s %-10s %-10s %4s %7s %5s\n", "job", "name", "dataset", "state", "cpus",
               "mem MB", "min");
   auto check = [&](Job& job) {
@@ -245,16 +280,9 @@ TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
                 job.dataset.substr(job.dataset.find(' ') + 1).c_str(), job.state.c_str(), job.cpus,
                 job.mem_mb, job.time_min);
     const std::string stage = job.dataset.substr(0, job.dataset.find(' '));
-    const std::string name = job.dataset.substr(job.dataset.find(' ') + 1);
     EXPECT_EQ(job.name, "lumislab-" + stage) << job.id;
     EXPECT_EQ(job.cpus, 1) << job.dataset;
-    if (!expected.count(job.dataset)) {
-      const std::string ds = root_ + (name == "lamp_slow" ? "/late/" : "/data/") + name;
-      expected[job.dataset] =
-          testing::RunShell("python3 " + ShellQuote(Pipelines() + "/stage_resources.py") + " " +
-                            stage + " " + ShellQuote(ds) + " --threads 1 --resolution 48")
-              .output;
-    }
+    EXPECT_EQ(expected.count(job.dataset), 1u) << job.dataset;
     EXPECT_EQ(
         "mem_mb=" + std::to_string(job.mem_mb) + " runtime=" + std::to_string(job.time_min) + "\n",
         expected[job.dataset])
@@ -265,14 +293,16 @@ TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
     EXPECT_EQ(job.state, job.dataset == "reconstruct broken" ? "FAILED" : "COMPLETED")
         << job.dataset;
   }
-  // The resources grow with the stage's cost: a preview asks more memory than a calibrate.
-  EXPECT_GT(expected["preview lamp_00"], expected["calibrate lamp_00"]);
+  // The resources follow the stage's cost: a preview asks more memory than a calibrate.
+  auto mem = [](const std::string& resources) { return std::atoi(resources.c_str() + 7); };
+  EXPECT_GT(mem(expected["preview lamp_00"]), mem(expected["calibrate lamp_00"]));
 
   // A rerun submits only what is missing: a lost preview, a lost polar plot (its export), and
   // the broken dataset's reconstruct, which fails again.
   fs::remove(root_ + "/out/lamp_03/preview.png");
   fs::remove(root_ + "/out/lamp_04/polar.png");
   const CommandResult again = Snakemake("data");
+  phase("rerun done");
   EXPECT_NE(again.exit_code, 0) << again.output;
   submitted = SubmittedJobs(again.output);
   std::set<std::string> ran;
@@ -313,7 +343,9 @@ TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
   }
   EXPECT_TRUE(seen_cancelled);
   const size_t before_resume = jobs.size();
+  phase("cancelled run done");
   const CommandResult resumed = Snakemake("late");
+  phase("resumed run done");
   EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
   submitted = SubmittedJobs(resumed.output);
   jobs = Jobs();
@@ -344,8 +376,25 @@ TEST_F(Slurm, ProfileSubmitsDeclaredResourcesReportsFailuresAndResumes) {
   };
   const auto diff = testing::DiffSnapshots(late(root_ + "/local"), late(root_));
   EXPECT_TRUE(diff.empty()) << diff.front();
-  std::printf("slurm test: %.1f s\n",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  phase("outputs compared");
+
+  // The memory asked is a limit (OverMemoryKill): a job that uses 300 MB having asked 50 is
+  // killed, so a model that asks too little shows as failed jobs (status.sh says so), not as a
+  // swapping node.
+  const std::string over_script =
+      "id=$(sbatch --parsable --mem=50 --time=1 --output=over-%j.out --wrap "
+      "'python3 -c \"import time; b = bytearray(300 << 20); time.sleep(20)\"') && "
+      "status=" +
+      ShellQuote(Pipelines() + "/slurm/status.sh") +
+      " && "
+      "while [ \"$($status $id)\" = running ]; do sleep 0.2; done && echo $id $($status $id)";
+  const CommandResult over = Run(root_, "sh -c " + ShellQuote(over_script));
+  EXPECT_NE(over.output.find(" failed"), std::string::npos) << over.output;
+  const std::string over_id = over.output.substr(0, over.output.find(' '));
+  EXPECT_NE(testing::ReadBinaryFile(root_ + "/over-" + over_id + ".out").find("exceeded"),
+            std::string::npos)
+      << over.output;
+  phase("a job above its memory killed");
 }
 
 }  // namespace

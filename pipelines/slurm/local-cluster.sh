@@ -19,7 +19,8 @@
 # what it started, prints the logs' last lines and exits 1. stop cancels the jobs, ends the
 # daemons by their pid files and checks that no process started for the cluster is left (every
 # one carries LUMISLAB_CLUSTER=<dir> in its environment): exit 1 if one is. status prints the
-# node and the queue (exit 1 when the cluster is not running).
+# node and the queue (exit 1 when the cluster is not running). Exit 3: not root, or a command
+# of those packages missing.
 set -euo pipefail
 usage() {
   sed -n '2,/^set /{ /^#/ s/^# \{0,1\}//p; }' "$0" >&2
@@ -27,7 +28,8 @@ usage() {
 }
 [ $# = 2 ] || usage
 action="$1"
-mkdir -p "$2"
+[ "$action" != start ] || mkdir -p "$2"
+[ -d "$2" ] || { echo "local-cluster: no cluster in $2 (no such folder)" >&2; exit 1; }
 dir="$(cd "$2" && pwd)"
 timeout="${LUMISLAB_CLUSTER_TIMEOUT:-30}"
 conf="$dir/slurm.conf"

@@ -19,6 +19,7 @@
 #include <tuple>
 
 #include "acquire/capture_list.h"
+#include "acquire/capture_orientations.h"
 #include "acquire/devices/command_stage.h"
 #include "acquire/devices/operator.h"
 #include "acquire/devices/uri.h"
@@ -224,12 +225,14 @@ class Capture {
   Capture(const Capture&) = delete;
   Capture& operator=(const Capture&) = delete;
 
-  CaptureReport Run(Stage* stage, Camera* camera) {
-    stage_ = stage;
-    camera_ = camera;
-    log_ = std::make_unique<DeviceLog>();  // kept in memory until the folder exists
-    operator_ = std::make_unique<Operator>(log_.get(), o_.operator_program);
-    log_->Note("capture", "started: stage " + stage->uri() + ", camera " + camera->uri());
+  CaptureReport Run(CaptureDevices* devices) {
+    devices_ = devices;
+    stage_ = devices->stage.get();
+    camera_ = devices->camera.get();
+    log_ = devices->log.get();  // kept in memory until the folder exists
+    operator_ = devices->op.get();
+    log_->Note("capture", "started: " + o_.out_dir + ", stage " + stage_->uri() + ", camera " +
+                              camera_->uri());
     // The devices first: one that cannot be used is refused before the folder is made.
     try {
       Connect();
@@ -245,9 +248,10 @@ class Capture {
       LogInfo("going on after ", report.shots_resumed, " finished shots of ", plan_.shots.size(),
               " (", capture_dir_, "/shots.csv)");
     try {
-      if (lab_.stage.home) {
+      if (lab_.stage.home && !devices_->homed) {
         LogInfo("homing the stage");
         stage_->Home();
+        devices_->homed = true;
       }
       ShootBoard();
       ChooseExposure();
@@ -284,8 +288,7 @@ class Capture {
       Close();
       throw;
     }
-    Close();
-    log_->Note("capture", "complete");
+    log_->Note("capture", "complete: " + o_.out_dir);
     report.photos = int(ds_.photos.size());
     return report;
   }
@@ -335,10 +338,7 @@ class Capture {
   }
 
   void Connect() {
-    LogInfo("connecting to the camera ", camera_->uri());
-    camera_->Connect(lab_.camera, log_.get());
-    LogInfo("connecting to the stage ", stage_->uri());
-    stage_->Connect(lab_.stage, log_.get());
+    if (!devices_->connected) devices_->Connect(lab_);
     // The exposure settings, refused before anything moves: times the setup gives must be the
     // camera's; a camera whose times lumislab cannot set needs them given; a bracket must fit
     // the camera's range even from its shortest time.
@@ -373,10 +373,7 @@ class Capture {
                            " stops apart");
   }
 
-  void Close() {
-    if (stage_) stage_->Close();
-    if (camera_) camera_->Close();
-  }
+  void Close() { devices_->Close(); }
 
   void MoveTo(int i, int j) {
     if (at_ && at_->first == i && at_->second == j) return;
@@ -410,6 +407,15 @@ class Capture {
   // The board photo, first: the screen calibration can run while the slides are photographed.
   void ShootBoard() {
     if (journal_.board()) return;
+    if (!o_.board_photo.empty()) {
+      // The camera and the screen stay where they were for an earlier orientation's board.
+      const std::string file = "board" + fs::path(o_.board_photo).extension().string();
+      WriteTextAtomically(photos_dir_ + "/" + file, ReadTextFile(o_.board_photo));
+      CheckPhoto(file);
+      log_->Note("capture", "board photo taken over from " + o_.board_photo);
+      journal_.FinishBoard({0, o_.board_shutter_s, file});
+      return;
+    }
     operator_->Ask("board", "on",
                    "Put the calibration board on the screen (" +
                        std::to_string(setup_.calibration.squares_x) + " x " +
@@ -630,10 +636,11 @@ class Capture {
   std::string photos_dir_, capture_dir_;
   ShotJournal journal_;
   ImportOptions import_;
+  CaptureDevices* devices_ = nullptr;
   Stage* stage_ = nullptr;
   Camera* camera_ = nullptr;
-  std::unique_ptr<DeviceLog> log_;
-  std::unique_ptr<Operator> operator_;
+  DeviceLog* log_ = nullptr;
+  Operator* operator_ = nullptr;
   std::optional<std::pair<int, int>> at_;
   std::optional<bool> slide_;
   std::vector<double> brackets_;
@@ -756,15 +763,15 @@ PhotoLevels MeasurePhotoLevels(const Photo& photo) {
 
 CaptureReport RunCapture(const CaptureOptions& o) {
   o.Check();
+  if (!o.orientations_file.empty()) return RunOrientationsCapture(o);
   // Everything that can be checked is checked before a device is opened or a file written.
   Dataset setup = Dataset::Parse(JsonDocument::Load(o.setup_file), o.out_dir, false);
   LabSetup lab = LoadLabSetup(o.setup_file);
   lab.CheckTravel(setup.grid, o.setup_file);
-  std::unique_ptr<Stage> stage = MakeStage(o.stage_uri);
-  std::unique_ptr<Camera> camera = MakeCamera(o.camera_uri);
-  CapturePlan plan = PlanCapture(setup.grid, lab, o.order, o.lab);
+  CaptureDevices devices = CaptureDevices::Open(o);
   CaptureReport report;
   if (o.dry_run) {
+    const CapturePlan plan = PlanCapture(setup.grid, lab, o.order, o.lab);
     std::fputs(DescribePlan(setup.grid, lab, plan, o.lab).c_str(), stdout);
     report.dry_run = true;
     return report;
@@ -776,8 +783,47 @@ CaptureReport RunCapture(const CaptureOptions& o) {
     return report;
   }
   StopSignalScope stop_scope;
+  report = CaptureDataset(o, std::move(setup), std::move(lab), &devices);
+  devices.Close();
+  return report;
+}
+
+CaptureReport CaptureDataset(const CaptureOptions& o, Dataset setup, LabSetup lab,
+                             CaptureDevices* devices) {
+  CapturePlan plan = PlanCapture(setup.grid, lab, o.order, o.lab);
   Capture capture(o, std::move(setup), std::move(lab), std::move(plan));
-  return capture.Run(stage.get(), camera.get());
+  return capture.Run(devices);
+}
+
+CaptureDevices CaptureDevices::Open(const CaptureOptions& o) {
+  CaptureDevices devices;
+  devices.stage = MakeStage(o.stage_uri);
+  devices.camera = MakeCamera(o.camera_uri);
+  devices.log = std::make_unique<DeviceLog>();
+  devices.op = std::make_unique<Operator>(devices.log.get(), o.operator_program);
+  return devices;
+}
+
+void CaptureDevices::Connect(const LabSetup& lab) {
+  LogInfo("connecting to the camera ", camera->uri());
+  camera->Connect(lab.camera, log.get());
+  LogInfo("connecting to the stage ", stage->uri());
+  stage->Connect(lab.stage, log.get());
+  connected = true;
+}
+
+void CaptureDevices::Close() noexcept {
+  if (stage) stage->Close();
+  if (camera) camera->Close();
+  connected = false;
+  homed = false;
+}
+
+std::optional<JournalBoard> CapturedBoard(const std::string& dataset_dir) {
+  ShotJournal journal(dataset_dir + "/capture/shots.csv");
+  journal.Load();
+  if (!journal.board()) return std::nullopt;
+  return JournalBoard{dataset_dir + "/photos/" + journal.board()->file, journal.board()->shutter_s};
 }
 
 }  // namespace lumislab

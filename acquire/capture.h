@@ -18,10 +18,13 @@
 // taken again.
 #pragma once
 
+#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "acquire/devices/operator.h"
 #include "acquire/lab_setup.h"
 #include "core/dataset.h"
 #include "core/lab_model.h"
@@ -44,6 +47,13 @@ struct CaptureOptions {
   // (acquire/devices/operator.h).
   std::string operator_program;
   LabModel lab;  // the predicted lab time (lumislab-plan's model)
+  // `capture --orientations`: the plan (luminaire.json format), out_dir then being the
+  // luminaire folder (acquire/capture_orientations.h).
+  std::string orientations_file;
+  // The board photo of an earlier orientation of the same run (same camera, same screen): taken
+  // over instead of asking for the board again. Empty: the board is photographed.
+  std::string board_photo;
+  double board_shutter_s = 0;
 
   void Check() const;  // BadInput naming the option
 };
@@ -78,12 +88,44 @@ struct CaptureReport {
   int shots_resumed = 0;  // shots finished by an earlier run
   int photos = 0;         // slide photos in dataset.json
   int reshots = 0;        // photos taken again shorter because they clipped
+  // --orientations: the orientations captured by this run, and those complete before it.
+  int orientations_done = 0;
+  int orientations_resumed = 0;
 };
+
+// The devices of one run, opened from their URIs and connected once: a run of several
+// orientations keeps them connected from one dataset to the next. The log writes to the
+// capture/devices.log of the dataset being captured.
+struct CaptureDevices {
+  std::unique_ptr<Stage> stage;
+  std::unique_ptr<Camera> camera;
+  std::unique_ptr<DeviceLog> log;
+  std::unique_ptr<Operator> op;
+  bool connected = false;
+  bool homed = false;
+
+  // The devices of `options`' URIs, not connected yet (BadInput for a URI that names none).
+  static CaptureDevices Open(const CaptureOptions& options);
+  // Connects the camera, then the stage (BadInput naming the device when one cannot be used).
+  void Connect(const LabSetup& lab);
+  void Close() noexcept;
+};
+
+// The board photo a dataset's capture journal records (capture/shots.csv), if any.
+struct JournalBoard {
+  std::string path;
+  double shutter_s = 0;
+};
+std::optional<JournalBoard> CapturedBoard(const std::string& dataset_dir);
 
 // Runs the capture. BadInput (exit 2) before any device moves for a setup, URI, device or travel
 // that cannot work; DeviceError / DeviceStopped (exit 1) mid-run, with dataset.json as the last
 // complete position left it; IoError (exit 3) when a photo cannot be stored.
 CaptureReport RunCapture(const CaptureOptions& options);
+// RunCapture's work on one dataset after its checks, with `devices` connected here unless they
+// are already; they are closed on an error and left open otherwise.
+CaptureReport CaptureDataset(const CaptureOptions& options, Dataset setup, LabSetup lab,
+                             CaptureDevices* devices);
 
 // What a photo shows: the 99.99th percentile of its largest linear channel (exposure 1, the
 // setup's transfer and levels) and the fraction of its pixels clipped in some channel.

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/log.h"
 #include "core/stop_signal.h"
 #include "lib/synthetic/camera_views.h"
@@ -15,10 +16,33 @@ namespace {
 int PrintScene(const std::string& scene) {
   if (scene == "default") {
     std::fputs(DefaultSceneJson().c_str(), stdout);
+  } else if (scene == "full-sphere") {
+    std::fputs(FullSphereSceneJson().c_str(), stdout);
   } else {
     LoadScene(scene);  // validates
     std::fputs(ReadTextFile(scene).c_str(), stdout);
   }
+  return 0;
+}
+
+int RunSynthOrientationsCommand(const SynthOrientationsOptions& o, const SynthOptions& synth) {
+  LogInfo("parameters: orientations=", o.orientations_file, " mount_error_deg=", o.mount_error_deg,
+          " seed=", o.seed);
+  synth.Check();
+  const SynthOrientationsReport r = RunSynthOrientations(LoadScene(synth.scene), synth, o);
+  if (StopRequested()) {
+    LogWarning(synth.interval_s >= 0
+                   ? "interrupted: the luminaire folder is partial; run the same command again "
+                     "to redo it"
+                   : "interrupted: nothing was written (a previous folder there is unchanged)");
+    return 1;
+  }
+  if (!r.skipped) {
+    int photos = 0;
+    for (const SynthReport& d : r.orientations) photos += d.photos_written;
+    LogInfo("wrote ", r.orientations.size(), " orientation(s), ", photos, " photos");
+  }
+  std::printf("luminaire: %s\n", synth.out_dir.c_str());
   return 0;
 }
 
@@ -30,7 +54,10 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
       "synth",
       "render the photos of a synthetic scene through both filter slides, a "
       "calibration photo, dataset.json and the analytic truth/ into a dataset folder");
-  cmd->add_option("--scene", o.scene, "scene file (JSON) or \"default\"")->required();
+  cmd->add_option("--scene", o.scene,
+                  "scene file (JSON), \"default\" or \"full-sphere\" (a luminaire lighting "
+                  "every direction, for --orientations)")
+      ->required();
   cmd->add_option("--out", o.out_dir, "dataset folder to write");
   cmd->add_option("--interval", o.interval_s,
                   "live acquisition: dataset.json and the calibration photo first, then "
@@ -68,8 +95,22 @@ CLI::App* AddSynthCommand(CLI::App& app, SynthCommand* c, CommonOptions* common)
                       "and photometric exports)")
       ->check(CLI::IsMember({"radiometer", "lux"}))
       ->capture_default_str();
+  cmd->add_option("--orientations", c->orientations.orientations_file,
+                  "capture the scene's luminaire from several orientations (a file in "
+                  "luminaire.json's format, lumislab-plan orientations --out): --out is then a "
+                  "luminaire folder with luminaire.json, one dataset per orientation of the "
+                  "luminaire turned by its pose, and truth/ (true poses, the luminaire in its own "
+                  "frame; docs/formats.md §19)");
+  cmd->add_option("--mount-error-deg", c->orientations.mount_error_deg,
+                  "--orientations: turn every orientation but the first by a further rotation "
+                  "of angle uniform in [A/2, A] degrees about a random axis (truth/"
+                  "orientations.json holds the true poses)")
+      ->check(FiniteIn(0, kMaxMountErrorDeg));
+  cmd->add_option("--seed", c->orientations.seed, "--orientations: the seed of the mounting errors")
+      ->capture_default_str();
   cmd->add_flag("--print-scene", c->print_scene,
-                "print the scene as JSON (the built-in one for --scene default) and exit");
+                "print the scene as JSON (the built-in one for --scene default or full-sphere) "
+                "and exit");
   AddCommonOptions(cmd, common);
   return cmd;
 }
@@ -88,6 +129,10 @@ int RunSynthCommand(const SynthCommand& command, int threads) {
          << " threads=" << synth.threads;
   LogInfo("parameters: ", params.str());
   const StopSignalScope stop_signals;  // Ctrl-C: finish the photos in hand, then stop
+  if (!command.orientations.orientations_file.empty())
+    return RunSynthOrientationsCommand(command.orientations, synth);
+  if (command.orientations.mount_error_deg > 0)
+    throw BadInput("--mount-error-deg: needs --orientations");
   const SynthReport r = RunSynth(synth);
   if (!r.skipped)
     LogInfo("wrote ", r.photos_written, " photos, radiometric scale ", r.radiometric_scale,

@@ -110,6 +110,22 @@ LabSetup ParseLabSetup(const JsonView& lab) {
     s.slide_axis = axis;
   }
 
+  if (lab.Has("rotation_axis")) {
+    const JsonView rotation = lab["rotation_axis"];
+    LabSetup::RotationAxis axis;
+    axis.axis = ParseAxis(rotation["stage_axis"]);
+    if (axis.axis == s.axis_u || axis.axis == s.axis_v ||
+        (s.slide_axis && axis.axis == s.slide_axis->axis))
+      rotation["stage_axis"].Fail("an axis other than the grid's two and the slides'");
+    axis.about_name = rotation["about"].OneOf({"x", "y", "z", "-x", "-y", "-z"});
+    const int k = axis.about_name.back() - 'x';
+    axis.about = Eigen::Vector3d::Unit(k) * (axis.about_name[0] == '-' ? -1 : 1);
+    s.rotation_axis = axis;
+    s.stage.rotary_axis = axis.axis;
+    s.stage.tolerance_deg =
+        rotation.Has("tolerance_deg") ? rotation["tolerance_deg"].NumberIn(1e-4, 10) : 0.05;
+  }
+
   if (lab.Has("camera")) {
     const JsonView camera = lab["camera"];
     s.camera.aperture = camera.StringOr("aperture", "");

@@ -35,6 +35,16 @@ struct LabSetup {
     double p_mm = 0, n_mm = 0;
   };
   std::optional<SlideAxis> slide_axis;
+  // A stage axis that turns the luminaire (docs/formats.md §19, "Capturing orientations in the
+  // lab"): `capture --orientations` moves it to each orientation's axis_deg (absolute degrees)
+  // and asks the operator only to remount. `about` is the capture-frame direction it turns
+  // about, right-handed for growing angles (+x, +y, +z, -x, -y or -z).
+  struct RotationAxis {
+    char axis = 'A';
+    Eigen::Vector3d about{0, 1, 0};
+    std::string about_name = "y";  // as the setup spells it
+  };
+  std::optional<RotationAxis> rotation_axis;
   CameraSettings camera;
   // Photos per slide at each position and the ratio between neighbouring ones (stops); the
   // shortest is chosen by the test shot unless `shutter_s` gives the whole bracket (s).

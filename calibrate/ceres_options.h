@@ -1,7 +1,7 @@
 // The Ceres solver settings the calibrate refiners share (screen/screen_refiner.cc,
-// camera/camera_refiner.cc; of lumislab_calibrate only they include Ceres, which compiles
-// slowly): tight tolerances, because the problems are small and the parameters feed sub-pixel
-// geometry, and no logging.
+// camera/camera_refiner.cc, orientations/registration.cc; of lumislab_calibrate only they
+// include Ceres, which compiles slowly): tight tolerances, because the problems are small and
+// the parameters feed sub-pixel geometry, and no logging.
 #pragma once
 
 #include <ceres/ceres.h>

@@ -7,6 +7,7 @@
 
 #include "calibrate/cli_camera.h"
 #include "calibrate/cli_colour.h"
+#include "calibrate/cli_orientations.h"
 #include "calibrate/cli_radiometric.h"
 #include "calibrate/cli_screen.h"
 #include "core/command_line.h"
@@ -19,7 +20,7 @@ int RunCalibrate(int argc, char** argv) {
       "(docs/formats.md §5, §12 - §16). Order: response, dark, screen, flat, scale (flat "
       "and scale need the screen; colour, from a ColorChecker photo, any time); each later step "
       "decodes its frames with the earlier steps' "
-      "corrections"};
+      "corrections; orientations registers a luminaire folder's orientations (§19)"};
   app.require_subcommand(1);
   CommonOptions common;
   AddCommonOptions(&app, &common);
@@ -31,11 +32,14 @@ int RunCalibrate(int argc, char** argv) {
   AddRadiometricCommands(&app, &common, &radiometric);
   ColourCommand colour;
   AddColourCommand(&app, &common, &colour);
+  OrientationsCommand orientations;
+  AddOrientationsCommand(&app, &common, &orientations);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
   const int threads = StartTool("calibrate", common);
   cv::setNumThreads(threads);
   if (camera.sub->parsed()) return RunCameraCommand(&camera, threads);
   if (colour.sub->parsed()) return RunColourCommand(&colour);
+  if (orientations.sub->parsed()) return RunOrientationsCommand(&orientations, threads);
   if (!screen.sub->parsed()) return RunRadiometricCommand(radiometric);
   return RunScreenCommand(&screen, threads);
 }

@@ -3,7 +3,7 @@
 # polar plot, irradiance at D; TM-25 with --tm25) -> a preview render, several datasets at once.
 #
 #   pipelines/batch-convert.sh <dataset|folder>... [--out batch-out] [--jobs N]
-#       [--distance-mm 1500] [--tm25 [--rays 100000]] [--preview-size 640x360]
+#       [--distance-mm 1500] [--tm25 [--rays 100000]] [--preview-size 640x360] [--resolution N]
 #       [--lab L] [--manufacturer M] [--metadata meta.json] [--dry-run] [--summary-only]
 #
 # A dataset is a folder with dataset.json; any other folder stands for the datasets directly in it.
@@ -36,7 +36,8 @@ while [ $# -gt 0 ]; do
     --tm25) tm25=1; shift ;;
     -n | --dry-run) dry=1; shift ;;
     --summary-only) summary_only=1; shift ;;
-    --out | --jobs | --distance-mm | --rays | --preview-size | --lab | --manufacturer | --metadata)
+    --out | --jobs | --distance-mm | --rays | --preview-size | --resolution | --lab | --manufacturer | \
+      --metadata)
       [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
       case "$1" in
         --out) out="${2%/}" ;;

@@ -3,7 +3,8 @@
 # pipelines/Snakefile both run (one implementation), with the stage's log and time.
 #
 #   pipelines/batch-stage.sh <stage> <dataset> <out> [--threads N] [--distance-mm D]
-#       [--rays N] [--preview-size WxH] [--lab L] [--manufacturer M] [--metadata meta.json]
+#       [--rays N] [--preview-size WxH] [--resolution N] [--lab L] [--manufacturer M]
+#       [--metadata meta.json]
 #
 # <stage>: calibrate | reconstruct | export | tm25 | preview. <out>: the batch's output folder.
 # The dataset's name is its folder's name. What each stage writes (docs/architecture.md §6):
@@ -12,7 +13,8 @@
 #                (lumislab-calibrate scale --reference): <dataset>/reference.json (the lab's,
 #                docs/formats.md) or, for a synthetic dataset, truth/reference.json when its
 #                unit is lux (`acquire synth --meter lux`): IES and EULUMDAT need a lux slab
-#   reconstruct  <dataset>/slab/                    (lumislab-reconstruct)
+#   reconstruct  <dataset>/slab/                    (lumislab-reconstruct; --resolution: its
+#                texels per side, default the tool's)
 #   export       <out>/<name>/<name>.ies, <name>.ldt, polar.png, irradiance_<D>mm.png; the
 #                IES/EULUMDAT name the lab and the maker: --lab and --manufacturer (or
 #                --metadata) are required (exit 2 without), and state their coverage of the
@@ -34,7 +36,7 @@ usage() {
 [ $# -ge 3 ] || usage
 stage="$1" dataset="${2%/}" out="${3%/}"
 shift 3
-threads=0 distance=1500 rays=100000 size=640x360 keywords=()
+threads=0 distance=1500 rays=100000 size=640x360 resolution=() keywords=()
 while [ $# -gt 0 ]; do
   [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
   case "$1" in
@@ -42,6 +44,7 @@ while [ $# -gt 0 ]; do
     --distance-mm) distance="$2" ;;
     --rays) rays="$2" ;;
     --preview-size) size="$2" ;;
+    --resolution) resolution=(--resolution "$2") ;;
     --lab | --manufacturer | --metadata) keywords+=("$1" "$2") ;;
     *) echo "$0: unknown argument: $1" >&2; exit 2 ;;
   esac
@@ -82,7 +85,8 @@ reconstruct() {
     \( ! -newer "$dataset/dataset.json" -o ! -newer "$dataset/calib/screen.json" \) -print -quit)" ]; then
     force=(--force)
   fi
-  run "$bin/lumislab-reconstruct" --dataset "$dataset" --threads "$threads" "${force[@]}"
+  run "$bin/lumislab-reconstruct" --dataset "$dataset" --threads "$threads" "${resolution[@]}" \
+    "${force[@]}"
 }
 
 export_files() {

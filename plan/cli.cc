@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "lib/synthetic/scene.h"
+#include "plan/cli_orientations.h"
 #include "plan/plan.h"
 
 namespace lumislab {
@@ -48,7 +49,9 @@ int RunPlan(int argc, char** argv) {
       "target accuracy of the receiver-plane irradiance at distance D, with the predicted error "
       "per term and the lab time (docs/method.md §4.8). Give the luminaire by --scene or by "
       "--aperture-mm and --depth-mm. Prints a table; --json writes it for machines. A target out "
-      "of reach is a warning (exit 0) with the cheapest setting near the least predicted error."};
+      "of reach is a warning (exit 0) with the cheapest setting near the least predicted error. "
+      "`lumislab-plan orientations` plans the orientations of a luminaire measured from several "
+      "(docs/method.md §4.12)."};
   PlanInput in;
   CommonOptions common;
   AddCommonOptions(&app, &common);
@@ -103,8 +106,11 @@ int RunPlan(int argc, char** argv) {
       ->check(CLI::Range(8, 1000));
   AddLabModelOptions(&app, &in.lab, /*brackets_option=*/true);
   app.add_option("--json", json_out, "also write the plan as JSON to this file");
+  OrientationsCommand orientations;
+  CLI::App* orientations_cmd = AddOrientationsCommand(app, &orientations, &common);
   if (const auto code = ParseCommandLine(app, argc, argv)) return *code;
-  StartTool("plan", common);
+  const int threads = StartTool("plan", common);
+  if (orientations_cmd->parsed()) return RunOrientationsCommand(orientations, threads);
 
   // The target: a fraction or a percentage in (0, 1).
   {

@@ -23,6 +23,9 @@ packages=(
   libimgui-dev libstb-dev
   # pipelines/Snakefile: batch conversion as a workflow that also runs on a cluster
   snakemake
+  # tests/e2e/slurm_test.cc: the Slurm profile on a one-node cluster
+  # (pipelines/slurm/local-cluster.sh: slurmctld, slurmd, the client commands, munge)
+  slurm-wlm munge
   xvfb xauth x11-apps
   # scripts/test.sh's sanitizer and fuzz builds: clang 14, its sanitizer and libFuzzer
   # run-times, llvm-symbolizer for the stack traces (fuzz/README.md)

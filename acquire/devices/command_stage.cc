@@ -40,11 +40,16 @@ class CommandStage : public Stage {
 class ManualStage : public Stage {
  public:
   explicit ManualStage(const std::string& uri) : Stage(uri) {}
-  void Connect(const StageSettings&, DeviceLog* log) override { operator_ = Operator(log); }
+  void Connect(const StageSettings& settings, DeviceLog* log) override {
+    operator_ = Operator(log);
+    rotary_axis_ = settings.rotary_axis;
+  }
   void Home() override { operator_.Ask("home", "", "Home the stage", "homing"); }
   AxisTargets MoveTo(const AxisTargets& target) override {
+    const bool turn = target.size() == 1 && target[0].first == rotary_axis_;
     operator_.Ask("move", DescribeTargets(target),
-                  "Move the stage to " + DescribeTargets(target, ", ") + " (mm)",
+                  (turn ? "Turn the rotation axis to " : "Move the stage to ") +
+                      DescribeTargets(target, ", ") + (turn ? " (degrees)" : " (mm)"),
                   "moving to " + DescribeTargets(target));
     return target;
   }
@@ -52,6 +57,7 @@ class ManualStage : public Stage {
 
  private:
   Operator operator_{nullptr};
+  char rotary_axis_ = '\0';  // lab.rotation_axis: its targets are degrees
 };
 
 }  // namespace

@@ -76,6 +76,10 @@ struct StageSettings {          // setup.json "lab.stage" (docs/formats.md §3)
   double reply_timeout_s = 5;   // a command's reply
   double move_timeout_s = 120;  // one move, from the command to Idle
   double settle_s = 0;          // wait after a move before the photo (vibration)
+  // A rotary axis (lab.rotation_axis), in degrees: its read-back tolerance, and its moves are
+  // rapid (G0) since a linear feed does not apply to it. '\0': none.
+  char rotary_axis = '\0';
+  double tolerance_deg = 0.05;
 };
 
 class Stage {

@@ -253,10 +253,11 @@ void GrblStage::Connect(const StageSettings& settings, DeviceLog* log) {
   log_ = log;
   const std::string doing = "connecting";
   if (!(settings.feed_mm_min > 0) || !(settings.tolerance_mm > 0) ||
-      !(settings.reply_timeout_s > 0) || !(settings.move_timeout_s > 0) ||
-      !(settings.settle_s >= 0)) {
+      !(settings.tolerance_deg > 0) || !(settings.reply_timeout_s > 0) ||
+      !(settings.move_timeout_s > 0) || !(settings.settle_s >= 0)) {
     throw BadInput(uri() + ": " + doing +
-                   ": feed_mm_min, tolerance_mm, reply_timeout_s and move_timeout_s must be "
+                   ": feed_mm_min, tolerance_mm, tolerance_deg, reply_timeout_s and "
+                   "move_timeout_s must be "
                    "positive and settle_s not negative");
   }
   Note("opening " + port_path_ + " at " + std::to_string(baud_) + " baud");
@@ -355,9 +356,12 @@ AxisTargets GrblStage::MoveTo(const AxisTargets& target) {
     Command("G21 G90", doing, settings_.reply_timeout_s);
     modes_set_ = true;
   }
-  std::string line = "G1";
+  // A move of the rotary axis alone is a rapid (G0, the controller's own rate for it, $11x): the
+  // feed rate is a linear one, in mm/min.
+  const bool rapid = target.size() == 1 && target[0].first == settings_.rotary_axis;
+  std::string line = rapid ? "G0" : "G1";
   for (const auto& [axis, mm] : target) line += " " + std::string(1, axis) + Number(mm, "%.3f");
-  line += " F" + Number(settings_.feed_mm_min);
+  if (!rapid) line += " F" + Number(settings_.feed_mm_min);
   // GRBL answers `ok` once the move is planned, not done: the status then tells when it is.
   Command(line, doing, settings_.reply_timeout_s);
   moving_ = true;
@@ -373,7 +377,7 @@ AxisTargets GrblStage::MoveTo(const AxisTargets& target) {
       bool there = true;
       for (size_t k = 0; k < target.size(); ++k) {
         there = there && index[k] < status.work_mm.size() &&
-                std::abs(status.work_mm[index[k]] - target[k].second) <= settings_.tolerance_mm;
+                std::abs(status.work_mm[index[k]] - target[k].second) <= Tolerance(target[k].first);
       }
       if (there || idle_before) break;
       idle_before = true;
@@ -401,16 +405,23 @@ AxisTargets GrblStage::MoveTo(const AxisTargets& target) {
       throw Fail(doing, "the status report has no position for axis " + std::string(1, axis));
     }
     const double mm = status.work_mm[index[k]];
-    if (std::abs(mm - target[k].second) > settings_.tolerance_mm) {
-      throw Fail(doing, std::string(1, axis) + " is at " + Number(mm, "%.3f") +
-                            " mm, not at its target " + Number(target[k].second, "%.3f") +
-                            " mm (tolerance_mm " + Number(settings_.tolerance_mm) + ")");
+    if (std::abs(mm - target[k].second) > Tolerance(axis)) {
+      const bool rotary = axis == settings_.rotary_axis;
+      const char* unit = rotary ? " deg" : " mm";
+      throw Fail(doing, std::string(1, axis) + " is at " + Number(mm, "%.3f") + unit +
+                            ", not at its target " + Number(target[k].second, "%.3f") + unit +
+                            (rotary ? " (lab.rotation_axis.tolerance_deg " : " (tolerance_mm ") +
+                            Number(Tolerance(axis)) + ")");
     }
     actual.emplace_back(axis, mm);
   }
   Note("at " + Describe(actual));
   if (!PauseUnlessStopped(settings_.settle_s)) throw DeviceStopped(uri(), doing);
   return actual;
+}
+
+double GrblStage::Tolerance(char axis) const {
+  return axis == settings_.rotary_axis ? settings_.tolerance_deg : settings_.tolerance_mm;
 }
 
 void GrblStage::Close() noexcept {

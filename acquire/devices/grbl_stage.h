@@ -1,7 +1,9 @@
 // A translation stage driven by a GRBL 1.1 controller on a serial port (URI
 // grbl:/dev/ttyUSB0[?baud=115200]). It speaks GRBL's simple send-response protocol (one line,
 // then its `ok` or `error:N`), moves with absolute G1 in mm, and polls the real-time status
-// report `?` until the stage is at rest (github.com/gnea/grbl, doc/markdown/interface.md).
+// report `?` until the stage is at rest (github.com/gnea/grbl, doc/markdown/interface.md). A
+// fourth, rotary axis (4-axis builds such as grbl-Mega-5X: A in degrees, reported after X Y Z in
+// MPos/WPos) is moved alone with G0 and checked against tolerance_deg.
 #pragma once
 
 #include <memory>
@@ -49,6 +51,8 @@ class GrblStage : public Stage {
   // DeviceError, or BadInput while connecting (a device that cannot be used at all).
   Error Fail(const std::string& doing, const std::string& what) const;
   void LogStatus(const std::string& report);
+  // The read-back tolerance of `axis`: tolerance_deg for the rotary axis, else tolerance_mm.
+  double Tolerance(char axis) const;
   void Note(const std::string& text);
 
   std::string port_path_;

@@ -27,6 +27,13 @@ std::string Format(const char* format, double x, double y, double z) {
   return text;
 }
 
+// "name:v0,v1,...": the first `n` values, three decimals (a status report's position field).
+std::string AxesField(const char* name, const GrblAxes& v, int n) {
+  std::string text = name;
+  for (int i = 0; i < n; ++i) text += (i ? "," : ":") + Format("%.3f", v[i], 0, 0);
+  return text;
+}
+
 }  // namespace
 
 double GrblEmulator::Segment::Distance(double t) const {
@@ -95,16 +102,16 @@ double GrblEmulator::SimNow() const {
   return std::chrono::duration<double>(Clock::now() - epoch_).count() * options_.speed_factor;
 }
 
-std::array<double, 3> GrblEmulator::PositionAt(double t) const {
+GrblAxes GrblEmulator::PositionAt(double t) const {
   if (!in_segment_) return position_;
   const double s = segment_.length > 0 ? segment_.Distance(t) / segment_.length : 1;
-  std::array<double, 3> p{};
-  for (int i = 0; i < 3; ++i)
+  GrblAxes p{};
+  for (int i = 0; i < 4; ++i)
     p[i] = segment_.start[i] + s * (segment_.target[i] - segment_.start[i]);
   return p;
 }
 
-std::array<double, 3> GrblEmulator::Position() const {
+GrblAxes GrblEmulator::Position() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return PositionAt(SimNow());
 }
@@ -160,13 +167,12 @@ void GrblEmulator::Send(const std::string& line) {
   }
 }
 
-void GrblEmulator::StartSegment(const std::array<double, 3>& target, double feed_mm_s, double v0,
-                                double t) {
+void GrblEmulator::StartSegment(const GrblAxes& target, double feed_mm_s, double v0, double t) {
   Segment s;
   s.start = position_;
   s.target = target;
   double squared = 0;
-  for (int i = 0; i < 3; ++i) squared += (target[i] - position_[i]) * (target[i] - position_[i]);
+  for (int i = 0; i < 4; ++i) squared += (target[i] - position_[i]) * (target[i] - position_[i]);
   s.length = std::sqrt(squared);
   if (s.length < 1e-9 || feed_mm_s <= 0) {
     position_ = target;
@@ -255,17 +261,16 @@ void GrblEmulator::Reset(double t) {
 }
 
 void GrblEmulator::SendStatus(double t) {
-  const std::array<double, 3> m = PositionAt(t);
-  const std::array<double, 3>& wco = options_.wco_mm;
+  const GrblAxes m = PositionAt(t);
+  const GrblAxes& wco = options_.wco_mm;
+  GrblAxes w{};
+  for (int i = 0; i < 4; ++i) w[i] = m[i] - wco[i];
+  const int n = options_.axes;
   std::string report = "<" + state_ + "|";
-  if (options_.report_wpos) {
-    report += Format("WPos:%.3f,%.3f,%.3f", m[0] - wco[0], m[1] - wco[1], m[2] - wco[2]);
-  } else {
-    report += Format("MPos:%.3f,%.3f,%.3f", m[0], m[1], m[2]);
-  }
+  report += options_.report_wpos ? AxesField("WPos", w, n) : AxesField("MPos", m, n);
   const double speed = in_segment_ ? segment_.Speed(t) * 60 : 0;  // mm/min
   report += Format("|FS:%.0f,%.0f", speed, 0, 0);
-  if (reports_++ % 10 == 0) report += Format("|WCO:%.3f,%.3f,%.3f", wco[0], wco[1], wco[2]);
+  if (reports_++ % 10 == 0) report += "|" + AxesField("WCO", wco, n);
   Send(report + ">");
 }
 
@@ -281,14 +286,14 @@ void GrblEmulator::OnRealTime(unsigned char byte, double t) {
         SetState("Hold:0");
       } else if (state_ == "Run") {
         // Decelerate along the path to rest; the rest of the move waits for '~'.
-        const std::array<double, 3> at = PositionAt(t);
+        const GrblAxes at = PositionAt(t);
         const double v = segment_.Speed(t);
         const double left = segment_.length - segment_.Distance(t);
         const double stop = std::min(left, v * v / (2 * options_.acceleration_mm_s2));
         held_ = {segment_.target, segment_.feed};
         hold_has_move_ = true;
-        std::array<double, 3> stop_at = at;
-        for (int i = 0; i < 3; ++i) {
+        GrblAxes stop_at = at;
+        for (int i = 0; i < 4; ++i) {
           stop_at[i] += (segment_.target[i] - segment_.start[i]) / segment_.length * stop;
         }
         position_ = at;
@@ -379,13 +384,13 @@ std::string GrblEmulator::ExecuteSystem(const std::string& line, double t) {
     Send(std::string("$10=") + (options_.report_wpos ? "0" : "1"));
     Send(std::string("$20=") + (options_.soft_limits ? "1" : "0"));
     Send("$22=1");
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < options_.axes; ++i) {
       Send("$11" + std::to_string(i) + "=" + Format("%.3f", options_.max_rate_mm_min, 0, 0));
     }
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < options_.axes; ++i) {
       Send("$12" + std::to_string(i) + "=" + Format("%.3f", options_.acceleration_mm_s2, 0, 0));
     }
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < options_.axes; ++i) {
       Send("$13" + std::to_string(i) + "=" + Format("%.3f", max[i] - min[i], 0, 0));
     }
   } else if (line == "$G") {
@@ -395,6 +400,7 @@ std::string GrblEmulator::ExecuteSystem(const std::string& line, double t) {
   } else if (line == "$I") {
     Send("[VER:" + options_.version + ".20190830:]");
     Send("[OPT:V,15,128]");
+    if (options_.axes == 4) Send("[AXS:4:XYZA]");
   } else {
     return "error:3";
   }
@@ -405,8 +411,8 @@ std::string GrblEmulator::ExecuteGcode(const std::string& line, double t) {
   // Read the whole block first: GRBL executes nothing of a block with an error.
   int motion = -1, distance = -1, units = -1;
   double feed = -1;
-  std::array<bool, 3> given{};
-  std::array<double, 3> value{};
+  std::array<bool, 4> given{};
+  GrblAxes value{};
   for (size_t at = 0; at < line.size();) {
     const char letter = line[at++];
     if (letter < 'A' || letter > 'Z') return "error:1";
@@ -455,10 +461,13 @@ std::string GrblEmulator::ExecuteGcode(const std::string& line, double t) {
         if (number < 0) return "error:4";
         feed = number;
         break;
+      case 'A':
+        if (options_.axes < 4) return "error:20";  // no such axis: an unsupported command
+        [[fallthrough]];
       case 'X':
       case 'Y':
       case 'Z': {
-        const int i = letter - 'X';
+        const int i = letter == 'A' ? 3 : letter - 'X';
         if (given[i]) return "error:25";
         given[i] = true;
         value[i] = number;
@@ -475,7 +484,7 @@ std::string GrblEmulator::ExecuteGcode(const std::string& line, double t) {
   const double feed_mm_min = feed >= 0 ? feed * unit : feed_mm_min_;
   const bool absolute = distance >= 0 ? distance == 90 : absolute_;
   const int mode = motion >= 0 ? motion : motion_mode_;
-  const bool moves = given[0] || given[1] || given[2];
+  const bool moves = given[0] || given[1] || given[2] || given[3];
   if (moves && mode == 1 && feed_mm_min <= 0) return "error:22";
   // The block is good: its modes apply.
   inches_ = inches;
@@ -483,14 +492,15 @@ std::string GrblEmulator::ExecuteGcode(const std::string& line, double t) {
   motion_mode_ = mode;
   feed_mm_min_ = feed_mm_min;
   if (!moves) return "ok";
-  std::array<double, 3> target = planned_;  // machine mm
-  for (int i = 0; i < 3; ++i) {
+  GrblAxes target = planned_;  // machine mm (A: degrees, never scaled by G20)
+  for (int i = 0; i < 4; ++i) {
     if (given[i]) {
-      target[i] = absolute ? value[i] * unit + options_.wco_mm[i] : planned_[i] + value[i] * unit;
+      const double scale = i == 3 ? 1 : unit;
+      target[i] = absolute ? value[i] * scale + options_.wco_mm[i] : planned_[i] + value[i] * scale;
     }
   }
   if (options_.soft_limits) {
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < options_.axes; ++i) {
       if (target[i] < options_.travel_min_mm[i] - 1e-6 ||
           target[i] > options_.travel_max_mm[i] + 1e-6) {
         // GRBL: a hold to rest if moving, then ALARM:2 and the critical lock; the line's `ok`
@@ -509,6 +519,15 @@ std::string GrblEmulator::ExecuteGcode(const std::string& line, double t) {
   const double rate =
       mode == 0 ? options_.max_rate_mm_min : std::min(feed_mm_min, options_.max_rate_mm_min);
   planned_ = target;
+  // The fault a_shortfall_deg: A ends short of its target and reports where it is (as a
+  // controller reading an encoder would; open-loop GRBL reports the steps it sent).
+  if (given[3] && options_.a_shortfall_deg != 0) {
+    const double a0 = queue_.empty() ? (in_segment_ ? segment_.target[3] : position_[3])
+                                     : queue_.back().target[3];
+    const double turn = target[3] - a0;
+    if (std::abs(turn) > options_.a_shortfall_deg)
+      target[3] -= std::copysign(options_.a_shortfall_deg, turn);
+  }
   if (state_ == "Idle") {
     StartSegment(target, rate / 60, 0, t);
     if (in_segment_) SetState("Run");

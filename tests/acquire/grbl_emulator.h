@@ -3,7 +3,11 @@
 // opens the slave (SlavePath) as it would /dev/ttyUSB0. It moves three axes (X Y Z, machine
 // frame, mm) over simulated time with a trapezoidal speed profile, answers `?` with status
 // reports, and does what GRBL 1.1 does on feed hold, resume, soft reset, homing, soft limits and
-// the alarm lock (github.com/gnea/grbl doc/markdown/interface.md, commands.md).
+// the alarm lock (github.com/gnea/grbl doc/markdown/interface.md, commands.md). With `axes` = 4
+// it has a fourth, rotary axis A in degrees as 4-axis GRBL 1.1 builds have it (grbl-Mega-5X):
+// reported after X Y Z in MPos/WPos, one more setting per group ($103, $113, $123, $133), named
+// by $I ([AXS:4:XYZA]), not scaled by G20, and planned with the linear axes (its degrees count
+// as millimetres in a move's length).
 #pragma once
 
 #include <array>
@@ -16,14 +20,20 @@
 
 namespace lumislab {
 
+// X Y Z (mm) and A (degrees, with axes = 4).
+using GrblAxes = std::array<double, 4>;
+
 struct GrblEmulatorOptions {
-  double speed_factor = 1;                          // simulated time runs this much faster
-  std::array<double, 3> travel_min_mm = {0, 0, 0};  // soft limits, machine frame
-  std::array<double, 3> travel_max_mm = {300, 300, 100};
-  std::array<double, 3> home_mm = {0, 0, 0};   // machine position after $H
-  std::array<double, 3> start_mm = {0, 0, 0};  // machine position at power-up
-  std::array<double, 3> wco_mm = {0, 0, 0};    // work coordinate offset (WPos = MPos - WCO)
-  double homing_s = 1;                         // duration of $H, simulated
+  double speed_factor = 1;                   // simulated time runs this much faster
+  int axes = 3;                              // 3: X Y Z; 4: X Y Z and the rotary A
+  GrblAxes travel_min_mm = {0, 0, 0, -360};  // soft limits, machine frame (A: degrees)
+  GrblAxes travel_max_mm = {300, 300, 100, 360};
+  GrblAxes home_mm = {0, 0, 0, 0};   // machine position after $H
+  GrblAxes start_mm = {0, 0, 0, 0};  // machine position at power-up
+  GrblAxes wco_mm = {0, 0, 0, 0};    // work coordinate offset (WPos = MPos - WCO)
+  // Fault: A stops this many degrees short of every target (a slipping coupling) and reports it.
+  double a_shortfall_deg = 0;
+  double homing_s = 1;  // duration of $H, simulated
   double acceleration_mm_s2 = 500;
   double max_rate_mm_min = 6000;  // G0's speed, and the most G1's feed can reach
   bool soft_limits = true;        // $20
@@ -51,8 +61,8 @@ class GrblEmulator {
   // A symbolic link at `path` to the slave (replacing a link there); removed by the destructor.
   void Link(const std::string& path);
 
-  // The machine position now (mm, X Y Z), interpolated along the move under way.
-  std::array<double, 3> Position() const;
+  // The machine position now (mm, X Y Z; A in degrees), interpolated along the move under way.
+  GrblAxes Position() const;
   // GRBL's state as its status report names it: "Idle", "Run", "Hold:1", "Alarm", "Home", ...
   std::string State() const;
   std::vector<Event> Events() const;
@@ -68,11 +78,11 @@ class GrblEmulator {
 
  private:
   struct Move {
-    std::array<double, 3> target{};  // machine mm
+    GrblAxes target{};  // machine mm
     double feed_mm_s = 0;
   };
   struct Segment {  // one straight move with a trapezoidal speed profile, simulated time
-    std::array<double, 3> start{}, target{};
+    GrblAxes start{}, target{};
     double feed = 0;  // mm/s, as programmed
     double length = 0, v0 = 0, vp = 0, a = 1;
     double t_start = 0, t1 = 0, t2 = 0, t3 = 0;  // accelerate, cruise, decelerate
@@ -83,8 +93,8 @@ class GrblEmulator {
 
   void Serve();
   double SimNow() const;
-  std::array<double, 3> PositionAt(double t) const;
-  void StartSegment(const std::array<double, 3>& target, double feed_mm_s, double v0, double t);
+  GrblAxes PositionAt(double t) const;
+  void StartSegment(const GrblAxes& target, double feed_mm_s, double v0, double t);
   void Advance(double t);
   void OnRealTime(unsigned char byte, double t);
   void OnLine(const std::string& line, double t);
@@ -105,8 +115,8 @@ class GrblEmulator {
 
   mutable std::mutex mutex_;  // everything below
   std::string state_ = "Idle";
-  std::array<double, 3> position_{};  // at rest; during a segment, PositionAt interpolates
-  std::array<double, 3> planned_{};   // the end of the last planned move (G91 adds to it)
+  GrblAxes position_{};  // at rest; during a segment, PositionAt interpolates
+  GrblAxes planned_{};   // the end of the last planned move (G91 adds to it)
   bool in_segment_ = false;
   Segment segment_;
   std::vector<Move> queue_;  // planned moves after the segment under way

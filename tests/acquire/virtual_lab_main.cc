@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -70,21 +71,28 @@ int Run(int argc, char** argv) {
   GrblEmulatorOptions grbl_options;
   grbl_options.speed_factor = speed_factor;
   for (const LabSetup::Travel& t : lab.travel) {
-    const int axis = t.axis == 'X' ? 0 : t.axis == 'Y' ? 1 : t.axis == 'Z' ? 2 : -1;
+    const int axis = t.axis == 'X'   ? 0
+                     : t.axis == 'Y' ? 1
+                     : t.axis == 'Z' ? 2
+                     : t.axis == 'A' ? 3
+                                     : -1;
     if (axis < 0) continue;
+    if (axis == 3) grbl_options.axes = 4;  // a rotary axis (lab.rotation_axis)
     grbl_options.travel_min_mm[axis] = t.min_mm;
     grbl_options.travel_max_mm[axis] = t.max_mm;
-    grbl_options.start_mm[axis] = t.min_mm;
-    grbl_options.home_mm[axis] = t.min_mm;
+    // The linear axes start and home at their travel's low end, the rotary one at 0 degrees.
+    const double rest = axis == 3 ? std::clamp(0.0, t.min_mm, t.max_mm) : t.min_mm;
+    grbl_options.start_mm[axis] = rest;
+    grbl_options.home_mm[axis] = rest;
   }
   grbl_options.require_homing = lab.stage.home;
   GrblEmulator stage(grbl_options);
   stage.Link(dir + "/grbl");
 
   PtpipCameraEmulator camera(0, [&](const PtpipCameraEmulator::ShotSettings& shot) {
-    const std::array<double, 3> p = stage.Position();
+    const GrblAxes p = stage.Position();
     const virtual_lab::LabPhoto photo =
-        optics.Shoot({{'X', p[0]}, {'Y', p[1]}, {'Z', p[2]}}, shot.exposure_time_s);
+        optics.Shoot({{'X', p[0]}, {'Y', p[1]}, {'Z', p[2]}, {'A', p[3]}}, shot.exposure_time_s);
     return PtpipCameraEmulator::Photo{photo.extension, photo.bytes};
   });
   WriteTextAtomically(dir + "/camera", camera.ptpip_path() + "\n");

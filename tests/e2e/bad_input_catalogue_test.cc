@@ -2377,6 +2377,36 @@ std::vector<Case> CaptureCases() {
                .Args("capture --setup ds/dataset.json --stage manual --camera folder:ds --out "
                      "cap --order random")
                .Names({"--order", "random"})));
+  // capture --orientations (formats.md §19, "Capturing orientations in the lab"): the plan against
+  // the lab's rotation axis, refused before a device is opened or the luminaire folder made.
+  const std::string plan = R"({"schema_version": 1, "coverage": "sphere", "orientations": [
+      {"name": "o00", "dataset": "o00", "rotation_deg": [0, 0, 0], "centre_mm": [0, 0, 0],
+       "mount": 0, "axis_deg": 0},
+      {"name": "o01", "dataset": "o01", "rotation_deg": [ROTATION], "centre_mm": [0, 0, 0],
+       "mount": 0, "axis_deg": ANGLE}]})";
+  auto O = [&](const std::string& name, const std::string& rotation, const std::string& angle) {
+    std::string text = plan;
+    text.replace(text.find("ROTATION"), 8, rotation);
+    text.replace(text.find("ANGLE"), 5, angle);
+    return C("capture_orientations_" + name)
+        .Args(
+            "capture --setup ds/dataset.json --stage manual --camera folder:ds --out lum "
+            "--orientations plan.json")
+        .From(Input::kDataset)
+        .Do(SetRaw(kDs, "/lab", lab))
+        .Do(SetRaw(kDs, "/lab/stage/travel_mm/A", "[-180, 180]"))
+        .Do(SetRaw(kDs, "/lab/rotation_axis", R"({"stage_axis": "A", "about": "y"})"))
+        .Do(WriteText("plan.json", text))
+        .MustNotExist("lum");
+  };
+  v.push_back(tool(O("turned_about_another_axis", "90, 0, 0", "90")
+                       .Names({"plan.json", "orientations[1].rotation_deg", "about y"})));
+  v.push_back(tool(O("beyond_the_axis_travel", "0, 270, 0", "270")
+                       .Names({"plan.json", "orientations[1].axis_deg", "[-180, 180]"})));
+  v.push_back(
+      tool(O("axis_of_the_grid", "0, 90, 0", "90")
+               .Do(SetRaw(kDs, "/lab/rotation_axis", R"({"stage_axis": "X", "about": "y"})"))
+               .Names({kDs, "lab.rotation_axis.stage_axis"})));
   return v;
 }
 

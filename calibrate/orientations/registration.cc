@@ -1,0 +1,309 @@
+#include "calibrate/orientations/registration.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "calibrate/ceres_options.h"
+#include "calibrate/orientations/overlap_cost.h"
+#include "core/error.h"
+#include "core/geometry.h"
+#include "core/log.h"
+
+namespace lumislab {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / kPi;
+// A pair is compared when at least this many sample directions lie in its overlap.
+constexpr int kMinPairSamples = 20;
+// A direction of the corrections' space is unconstrained when its curvature is below this
+// fraction of the largest, or when turning kFreeSigmaDeg about it changes the overlaps'
+// intensities by less than their residual RMS after the fit, i.e. when the residual, were it
+// all systematic, could move it by more than kFreeSigmaDeg: the curvature then comes from the
+// far fields' own errors (a rotationally symmetric overlap still has some), not from the
+// luminaire. No small sigma is reported for what the overlaps do not fix.
+constexpr double kFreeCurvatureRatio = 1e-12;
+constexpr double kFreeSigmaDeg = 10.0;
+
+std::vector<Eigen::Vector3d> FibonacciSphere(int n) {
+  std::vector<Eigen::Vector3d> out(static_cast<size_t>(n));
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < n; ++k) {
+    const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    out[size_t(k)] = Eigen::Vector3d(r * std::cos(golden * k), r * std::sin(golden * k), z);
+  }
+  return out;
+}
+
+// One orientation's far field as Ceres reads it.
+struct Sampler {
+  const RegistrationInput* input;
+  std::unique_ptr<ceres::Grid2D<double, 1>> grid;
+  std::unique_ptr<FarFieldInterpolator> interpolator;
+  double At(const Eigen::Vector3d& w_capture) const {
+    double col = 0, row = 0, value = 0;
+    input->far_field.GridCoordinates(w_capture.data(), &col, &row);
+    interpolator->Evaluate(row, col, &value);
+    return value;
+  }
+};
+
+struct PairSamples {
+  int a = 0, b = 0;
+  double overlap_sr = 0;
+  std::vector<Eigen::Vector3d> directions;  // luminaire frame
+  double scale = 0;                         // mean of (I_a + I_b) / 2 where selected
+};
+
+Eigen::Matrix3d Refined(const RegistrationInput& in, const double* c) {
+  return RotationFromVector(Eigen::Vector3d(c[0], c[1], c[2])) * in.nominal;
+}
+
+// The directions of pair (a, b) both orientations see with margin at poses r_a, r_b.
+PairSamples SelectSamples(const std::vector<Eigen::Vector3d>& sphere, const Sampler& a,
+                          const Eigen::Matrix3d& r_a, const Sampler& b, const Eigen::Matrix3d& r_b,
+                          double margin_deg) {
+  PairSamples out;
+  double sum = 0;
+  for (const Eigen::Vector3d& w : sphere) {
+    const Eigen::Vector3d v_a = r_a * w, v_b = r_b * w;
+    if (a.input->cone.MarginDeg(v_a) < margin_deg || b.input->cone.MarginDeg(v_b) < margin_deg)
+      continue;
+    if (!a.input->far_field.SeenAround(v_a) || !b.input->far_field.SeenAround(v_b)) continue;
+    out.directions.push_back(w);
+    sum += 0.5 * (a.At(v_a) + b.At(v_b));
+  }
+  if (!out.directions.empty()) out.scale = sum / double(out.directions.size());
+  return out;
+}
+
+// Relative RMS of I_a - I_b and the ratio sum I_a / sum I_b over the samples at poses r_a, r_b.
+void ComparePair(const PairSamples& s, const Sampler& a, const Eigen::Matrix3d& r_a,
+                 const Sampler& b, const Eigen::Matrix3d& r_b, double* rms, double* ratio) {
+  double sum_a = 0, sum_b = 0, sum2 = 0;
+  for (const Eigen::Vector3d& w : s.directions) {
+    const double i_a = a.At(r_a * w), i_b = b.At(r_b * w);
+    sum_a += i_a;
+    sum_b += i_b;
+    sum2 += (i_a - i_b) * (i_a - i_b);
+  }
+  const double n = double(s.directions.size()), mean = 0.5 * (sum_a + sum_b) / n;
+  *rms = n > 0 && mean > 0 ? std::sqrt(sum2 / n) / mean : 0;
+  *ratio = sum_b > 0 ? sum_a / sum_b : 0;
+}
+
+}  // namespace
+
+void RegistrationOptions::Check() const {
+  if (directions < 1000)
+    throw BadInput("directions: expected >= 1000, got " + std::to_string(directions));
+  if (!(margin_deg >= 0)) throw BadInput("margin_deg: expected >= 0, got " + Num(margin_deg));
+  if (!(nodes_per_tan >= 4))
+    throw BadInput("nodes_per_tan: expected >= 4, got " + Num(nodes_per_tan));
+  if (!(loss_scale > 0)) throw BadInput("loss_scale: expected > 0, got " + Num(loss_scale));
+  if (!(max_relative_rms > 0))
+    throw BadInput("max_relative_rms: expected > 0, got " + Num(max_relative_rms));
+  if (max_iterations < 1 || threads < 1) throw BadInput("max_iterations, threads: expected >= 1");
+}
+
+Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
+                                  const CoverageReport& coverage,
+                                  const RegistrationOptions& options) {
+  options.Check();
+  const int count = int(inputs.size());
+  LUMISLAB_CHECK(count >= 2, "at least two orientations");
+  std::vector<Sampler> samplers(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) {
+    const FarFieldGrid& g = inputs[size_t(k)].far_field;
+    samplers[size_t(k)].input = &inputs[size_t(k)];
+    samplers[size_t(k)].grid =
+        std::make_unique<ceres::Grid2D<double, 1>>(g.values.data(), 0, g.ny, 0, g.nx);
+    samplers[size_t(k)].interpolator =
+        std::make_unique<FarFieldInterpolator>(*samplers[size_t(k)].grid);
+  }
+  const std::vector<Eigen::Vector3d> sphere = FibonacciSphere(options.directions);
+  std::vector<std::array<double, 3>> corrections(static_cast<size_t>(count), {0.0, 0.0, 0.0});
+  auto pose = [&](int k) { return Refined(inputs[size_t(k)], corrections[size_t(k)].data()); };
+  auto select = [&]() {
+    std::vector<PairSamples> pairs;
+    for (const PairOverlap& p : coverage.pairs) {
+      if (p.overlap_sr < kMinOverlapSr) continue;
+      PairSamples s = SelectSamples(sphere, samplers[size_t(p.a)], pose(p.a), samplers[size_t(p.b)],
+                                    pose(p.b), options.margin_deg);
+      s.a = p.a;
+      s.b = p.b;
+      s.overlap_sr = p.overlap_sr;
+      pairs.push_back(std::move(s));
+    }
+    return pairs;
+  };
+
+  Registration out;
+  std::vector<PairSamples> pairs = select();
+  for (const PairSamples& s : pairs) {
+    RegisteredPair r;
+    r.a = s.a;
+    r.b = s.b;
+    r.overlap_sr = s.overlap_sr;
+    ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
+                &r.rms_before, &r.ratio);
+    out.pairs.push_back(r);
+  }
+
+  // Two rounds: the samples chosen at the nominal poses, then again at the refined ones (a
+  // correction of a few degrees moves directions across the cones' margins).
+  std::unique_ptr<ceres::Problem> problem;
+  for (int round = 0; round < 2; ++round) {
+    if (round > 0) pairs = select();
+    problem = std::make_unique<ceres::Problem>();
+    for (const PairSamples& s : pairs) {
+      if (int(s.directions.size()) < kMinPairSamples || !(s.scale > 0)) continue;
+      const RegistrationInput& a = inputs[size_t(s.a)];
+      const RegistrationInput& b = inputs[size_t(s.b)];
+      for (const Eigen::Vector3d& w : s.directions)
+        problem->AddResidualBlock(
+            OverlapCost::Create(&a.far_field, samplers[size_t(s.a)].interpolator.get(),
+                                a.nominal * w, &b.far_field,
+                                samplers[size_t(s.b)].interpolator.get(), b.nominal * w, s.scale),
+            new ceres::HuberLoss(options.loss_scale), corrections[size_t(s.a)].data(),
+            corrections[size_t(s.b)].data());
+    }
+    if (problem->HasParameterBlock(corrections[0].data()))
+      problem->SetParameterBlockConstant(corrections[0].data());
+    if (problem->NumResidualBlocks() == 0) break;
+    ceres::Solver::Summary summary;
+    ceres::Solve(RefinerSolverOptions(ceres::DENSE_QR, options.max_iterations, options.threads),
+                 problem.get(), &summary);
+    out.iterations += int(summary.iterations.size());
+    out.converged = summary.termination_type == ceres::CONVERGENCE;
+  }
+
+  // Uncertainty: the Jacobian of the (robustified) relative residuals at the solution, its
+  // normal matrix's eigen-decomposition, the covariance sigma^2 H^-1 on the directions the
+  // overlaps fix and "unconstrained" on the others (ceres::Covariance's pseudo-inverse would
+  // give those a zero, i.e. a fake small, variance).
+  out.orientations.resize(static_cast<size_t>(count));
+  std::vector<int> block_of(static_cast<size_t>(count),
+                            -1);  // column block of each free orientation
+  std::vector<double*> blocks;
+  for (int k = 1; k < count; ++k)
+    if (problem && problem->HasParameterBlock(corrections[size_t(k)].data())) {
+      block_of[size_t(k)] = int(blocks.size());
+      blocks.push_back(corrections[size_t(k)].data());
+    }
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(3 * blocks.size(), 3 * blocks.size());
+  Eigen::VectorXd free_weight = Eigen::VectorXd::Zero(3 * blocks.size());
+  std::vector<Eigen::VectorXd> free_vectors;
+  if (!blocks.empty()) {
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = blocks;
+    double cost = 0;
+    std::vector<double> residuals;
+    ceres::CRSMatrix crs;
+    problem->Evaluate(evaluate, &cost, &residuals, nullptr, &crs);
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r)
+      for (int i = crs.rows[size_t(r)]; i < crs.rows[size_t(r) + 1]; ++i)
+        jacobian(r, crs.cols[size_t(i)]) = crs.values[size_t(i)];
+    const int dof = std::max(1, crs.num_rows - crs.num_cols);
+    const double variance = 2.0 * cost / dof;
+    out.residuals = crs.num_rows;
+    out.residual_sigma = std::sqrt(variance);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jacobian.transpose() * jacobian);
+    const double largest = eigen.eigenvalues().maxCoeff();
+    const double free_sigma_rad = kFreeSigmaDeg / kDegPerRad;
+    for (int i = 0; i < eigen.eigenvalues().size(); ++i) {
+      const double lambda = eigen.eigenvalues()(i);
+      const Eigen::VectorXd v = eigen.eigenvectors().col(i);
+      const bool free = !(lambda > kFreeCurvatureRatio * largest) ||
+                        variance * crs.num_rows / lambda > free_sigma_rad * free_sigma_rad;
+      if (free) {
+        free_weight += v.cwiseAbs2();
+        free_vectors.push_back(v);
+      } else {
+        cov += variance / lambda * v * v.transpose();
+      }
+    }
+  }
+  // What the overlaps do not fix stays nominal: the solver's drift along a free direction (its
+  // curvature is the far fields' own errors) is taken out of the corrections.
+  for (const Eigen::VectorXd& v : free_vectors) {
+    double along = 0;
+    for (size_t j = 0; j < blocks.size(); ++j)
+      along += v.segment<3>(3 * long(j)).dot(Eigen::Vector3d(blocks[j]));
+    for (size_t j = 0; j < blocks.size(); ++j)
+      Eigen::Map<Eigen::Vector3d>(blocks[j]) -= along * v.segment<3>(3 * long(j));
+  }
+  // The pairs after the fit, on the final samples, at the poses reported.
+  for (RegisteredPair& r : out.pairs)
+    for (const PairSamples& s : pairs)
+      if (s.a == r.a && s.b == r.b) {
+        r.samples = int(s.directions.size());
+        ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
+                    &r.rms_after, &r.ratio);
+      }
+
+  for (int k = 0; k < count; ++k) {
+    RegisteredOrientation& o = out.orientations[size_t(k)];
+    o.gauge = k == 0;
+    o.rotation = pose(k);
+    // From the rotation itself, so that the angle is within [0, 180] whatever the solver's
+    // parameters became.
+    const Eigen::AngleAxisd c(o.rotation * inputs[size_t(k)].nominal.transpose());
+    o.correction_deg = c.axis() * c.angle() * kDegPerRad;
+    o.angle_deg = c.angle() * kDegPerRad;
+    if (k == 0) continue;
+    const int j = block_of[size_t(k)];
+    if (j < 0) {  // no pair compared: nothing fixes it
+      o.unconstrained = {true, true, true};
+      o.sigma_deg.setConstant(std::numeric_limits<double>::infinity());
+      o.free_axes = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
+      continue;
+    }
+    for (int i = 0; i < 3; ++i) {
+      o.unconstrained[size_t(i)] = free_weight(3 * j + i) > 0.05;
+      o.sigma_deg(i) = o.unconstrained[size_t(i)]
+                           ? std::numeric_limits<double>::infinity()
+                           : std::sqrt(cov(3 * j + i, 3 * j + i)) * kDegPerRad;
+    }
+    // A free direction of the corrections (capture frame of k) is a rotation of the luminaire
+    // about the luminaire-frame axis R_k^T p.
+    for (const Eigen::VectorXd& v : free_vectors) {
+      const Eigen::Vector3d p = v.segment<3>(3 * j);
+      if (p.norm() > 0.3) o.free_axes.push_back((o.rotation.transpose() * p).normalized());
+    }
+  }
+
+  std::vector<int> disagreeing(static_cast<size_t>(count), 0);  // pairs each orientation is in
+  int disagreements = 0;
+  for (const RegisteredPair& r : out.pairs) {
+    if (r.samples < kMinPairSamples || !(r.rms_after > options.max_relative_rms)) continue;
+    // A pair that agreed at the nominal poses was dragged by the fit: not counted for the
+    // culprit below.
+    if (r.rms_before > options.max_relative_rms) {
+      ++disagreements;
+      ++disagreeing[size_t(r.a)];
+      ++disagreeing[size_t(r.b)];
+    }
+    if (!out.disagreement.empty()) out.disagreement += "; ";
+    out.disagreement +=
+        "orientations " + inputs[size_t(r.a)].name + " and " + inputs[size_t(r.b)].name +
+        " disagree over their overlap beyond noise: " + "relative RMS " + Num(r.rms_after) +
+        " after the registration (" + Num(r.rms_before) + " before; threshold " +
+        Num(options.max_relative_rms) + "), intensity ratio " + Num(r.ratio) + " over " +
+        std::to_string(r.samples) + " directions (" + Num(r.overlap_sr) + " sr)";
+  }
+  // One orientation in every pair that disagrees before and after the fit (two or more) is the
+  // likely culprit.
+  for (int k = 0; k < count && disagreements >= 2; ++k)
+    if (disagreeing[size_t(k)] == disagreements)
+      out.disagreement += "; " + inputs[size_t(k)].name +
+                          " is in every pair that disagrees at the nominal poses and after the "
+                          "fit: its slab (another luminaire, another scale) or its nominal pose "
+                          "is the likely cause";
+  return out;
+}
+
+}  // namespace lumislab

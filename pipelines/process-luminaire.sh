@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Process a luminaire folder (docs/formats.md §19: luminaire.json and one dataset folder per
+# orientation) into one light field and its exports, stopping at the first failing stage
+# (set -e); a rerun resumes where it stopped (stages skip finished outputs; --force redoes them).
+#   pipelines/process-luminaire.sh <lum> [--force] [--threads n] [reconstruct's options]
+# Each orientation's dataset goes through pipelines/process-folder.sh (its calibrations,
+# reconstruct, previews; reconstruct's options --resolution, --lambda, ... are passed through),
+# then `lumislab-calibrate orientations` registers the orientations (<lum>/registration.json;
+# exit 2 naming the pair when their overlaps are too small or disagree), then the luminaire's
+# exports are written from the merged light field into <lum>/exports/: luminaire.ies,
+# luminaire.ldt, luminaire.tm25 and report.html (lumislab-export reading a luminaire folder).
+set -euo pipefail
+usage() {
+  awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0" >&2
+  exit 2
+}
+[ $# -ge 1 ] || usage
+case "$1" in -h | --help) usage ;; esac
+here="$(cd "$(dirname "$0")" && pwd)"
+bin="${LUMISLAB_BIN:-$(cd "$here/.." && pwd)/build/bin}"
+lum="${1%/}"
+shift
+force=() threads=() folder_args=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    -h | --help) usage ;;
+    --force) force=(--force); shift ;;
+    --threads)
+      [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
+      threads=(--threads "$2")
+      shift 2
+      ;;
+    --resolution | --lambda | --samples-per-texel | --bracket-ratios | --full-well | --read-noise)
+      [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
+      folder_args+=("$1" "$2")
+      shift 2
+      ;;
+    *) echo "$0: unknown argument: $1" >&2; exit 2 ;;
+  esac
+done
+[ -f "$lum/luminaire.json" ] || { echo "$0: $lum/luminaire.json: not found" >&2; exit 2; }
+
+# The orientations' dataset folders, in luminaire.json's order.
+mapfile -t datasets < <(python3 -c '
+import json, sys
+for o in json.load(open(sys.argv[1]))["orientations"]:
+    print(o["dataset"])' "$lum/luminaire.json")
+[ ${#datasets[@]} -gt 0 ] || { echo "$0: $lum/luminaire.json: no orientations" >&2; exit 2; }
+for d in "${datasets[@]}"; do
+  echo "== orientation dataset $lum/$d"
+  LUMISLAB_BIN="$bin" "$here/process-folder.sh" "$lum/$d" "${folder_args[@]}" "${threads[@]}" \
+    "${force[@]}"
+done
+
+echo "== registration"
+if [ -f "$lum/registration.json" ] && [ ${#force[@]} -eq 0 ]; then
+  echo "$lum/registration.json: exists (--force redoes it)"
+else
+  "$bin/lumislab-calibrate" orientations --luminaire "$lum" "${threads[@]}" "${force[@]}"
+fi
+
+echo "== exports"
+mkdir -p "$lum/exports"
+export_one() {  # export_one <subcommand> <file>: skipped when the file exists, unless --force
+  if [ -f "$lum/exports/$2" ] && [ ${#force[@]} -eq 0 ]; then
+    echo "$lum/exports/$2: exists (--force redoes it)"
+    return
+  fi
+  "$bin/lumislab-export" "$1" --slab "$lum" --out "$lum/exports/$2" "${threads[@]}" "${force[@]}"
+}
+export_one ies luminaire.ies
+export_one ldt luminaire.ldt
+export_one tm25 luminaire.tm25
+export_one report report.html
+echo "registration: $lum/registration.json"
+echo "exports: $lum/exports"

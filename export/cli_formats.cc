@@ -5,6 +5,7 @@
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -15,6 +16,7 @@
 #include "core/slab.h"
 #include "export/complete_slab.h"
 #include "export/coverage.h"
+#include "export/luminaire_source.h"
 #include "export/report_uncertainty.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
@@ -33,14 +35,86 @@ constexpr int64_t kMaxRays = 50000000;  // 1.4 GB of TM-25 rays
 // ---- the slab -----------------------------------------------------------------------------
 
 struct Slab {
-  std::string dir;
-  SlabInfo info;
-  std::vector<SlabPosition> positions;
+  std::string dir;  // the slab folder; a luminaire folder's: the folder itself
+  SlabInfo info;    // a luminaire folder: its first orientation's (units: every one's)
+  std::vector<SlabPosition> positions;  // empty for a luminaire folder
+  // A luminaire folder (docs/formats.md §19): every orientation's slab and pose, merged.
+  std::shared_ptr<const LuminaireSource> luminaire;
 };
 
+// ---- a luminaire folder: the merged light field (lib/lightfield/merged_far_field.h) -------
+
+// A luminaire folder's orientations, each slab complete (checked into its own dataset's
+// checks.json under `stage`), in one unit.
+Slab LoadLuminaireSlab(const std::string& folder, int threads, const std::string& stage) {
+  Slab slab;
+  slab.dir = folder;
+  auto source = std::make_shared<LuminaireSource>(LoadLuminaireSource(folder, threads, stage));
+  slab.info = source->slabs.front().info;
+  LogInfo("luminaire ", folder, ": ", source->Orientations(),
+          "; coverage asked: ", source->set.coverage, ", units ", source->units);
+  slab.luminaire = source;
+  return slab;
+}
+
+// The far field of the slab or, for a luminaire folder, the merged far field (luminaire frame);
+// a single slab's light is checked into `checks` (a merged one's orientations were, each in its
+// dataset, when loaded). `state_scales`: log the orientations' flux ratios over their overlaps
+// (the grid's far field; not again for the cell check's fine one).
+FarField SlabFarField(const Slab& slab, const std::vector<double>& c_deg,
+                      const std::vector<double>& gamma_deg, const FarFieldOptions& options,
+                      CheckLog& checks, bool state_scales = true) {
+  if (!slab.luminaire) {
+    FarField ff = ComputeFarField(slab.info, slab.positions, c_deg, gamma_deg, options);
+    CheckFarFieldLight(ff, slab.info, slab.dir, checks);
+    return ff;
+  }
+  MergedFarField merged = ComputeMergedFarField(slab.luminaire->slabs, c_deg, gamma_deg, options);
+  for (const MergedFarField::PairScale& p : merged.pair_scales)
+    if (state_scales)
+      LogInfo("scale across orientations: ", slab.luminaire->slabs[size_t(p.b)].name, " / ",
+              slab.luminaire->slabs[size_t(p.a)].name, " = ", Num(p.ratio, 4), " over the ",
+              p.directions, " grid directions both weigh");
+  return std::move(merged.ff);
+}
+
+// The coverage against the slab's model: a luminaire folder's truth/ (luminaire frame; without
+// one, an isotropic emitter) or the dataset's (GridCoverage).
+Coverage SlabCoverage(const IntensityDistribution& d, const FarField& ff, const Slab& slab) {
+  return slab.luminaire ? GridCoverageWithTruth(d, ff, slab.info, slab.luminaire->TruthDir(), true)
+                        : GridCoverage(d, ff, slab.info, slab.dir);
+}
+
+// The stated uncertainty of the slab; of a luminaire folder, the largest of its orientations'
+// (by the flux term).
+FarFieldUncertainty SlabUncertainty(const Slab& slab, int samples,
+                                    const UncertaintyOptions& options) {
+  return slab.luminaire
+             ? LuminaireUncertainty(*slab.luminaire, samples, options)
+             : EstimateFarFieldUncertainty(slab.info, DatasetOfSlab(slab.dir), samples, options);
+}
+
+bool Synthetic(const Slab& slab) {
+  return slab.luminaire
+             ? std::filesystem::is_regular_file(slab.luminaire->TruthDir() + "/luminaire.json")
+             : SyntheticSlab(slab.dir);
+}
+
+// The gamma range a grid spans by default: 0-180 for a luminaire folder measured over the sphere,
+// 0-90 (the hemisphere one slab can see) otherwise; `range` "sphere" or "hemisphere" asks for one.
+double GammaSpan(const std::string& slab_path, const std::string& range) {
+  if (range == "sphere") return 180;
+  if (range == "hemisphere") return 90;
+  return IsLuminaireFolder(slab_path) && LoadLuminaireSet(slab_path).coverage == "sphere" ? 180
+                                                                                          : 90;
+}
+
 // The whole slab: a partial one would leave out the light of its missing positions. Its total
-// light is checked into `checks` (a log of the dataset holding the slab, SlabChecks).
-Slab LoadCompleteSlab(const std::string& path, int threads, CheckLog& checks) {
+// light is checked into `checks` (a log of the dataset holding the slab, SlabChecks). A
+// luminaire folder: LoadLuminaireSlab.
+Slab LoadCompleteSlab(const std::string& path, int threads, CheckLog& checks,
+                      const std::string& stage) {
+  if (IsLuminaireFolder(path)) return LoadLuminaireSlab(path, threads, stage);
   Slab slab;
   slab.dir = ResolveSlabDir(path);
   slab.info = SlabInfo::Load(slab.dir);
@@ -57,6 +131,7 @@ Slab LoadCompleteSlab(const std::string& path, int threads, CheckLog& checks) {
 // The checks of `stage` on the slab at `path` (a dataset folder or its slab/), recorded in the
 // dataset's checks.json when the slab is in one.
 CheckLog SlabChecks(const std::string& path, const std::string& stage) {
+  if (IsLuminaireFolder(path)) return CheckLog("", stage);  // each orientation's, when loaded
   return CheckLog(DatasetOfSlab(ResolveSlabDir(path)), stage);
 }
 
@@ -169,6 +244,7 @@ struct FarFieldCommand {
   std::string format;  // "ies" or "ldt"
   std::string slab, out;
   double c_step = 5, gamma_step = 2.5;
+  std::string gamma_range;  // "", "hemisphere" or "sphere" (GammaSpan)
   std::vector<double> c_angles, gamma_angles;
   int samples = 4;
   std::vector<double> opening_mm;
@@ -210,7 +286,8 @@ std::vector<double> Steps(double step, double last, const std::string& option, i
 IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
   IntensityDistribution d;
   d.c_deg = c.c_angles.empty() ? Steps(c.c_step, 360, "--c-step", kMaxCPlanes) : c.c_angles;
-  d.gamma_deg = c.gamma_angles.empty() ? Steps(c.gamma_step, 90, "--gamma-step", kMaxGammaAngles)
+  d.gamma_deg = c.gamma_angles.empty() ? Steps(c.gamma_step, GammaSpan(c.slab, c.gamma_range),
+                                               "--gamma-step", kMaxGammaAngles)
                                        : c.gamma_angles;
   if (d.c_deg.size() > size_t(kMaxCPlanes))
     throw BadInput("--c-angles: expected at most " + std::to_string(kMaxCPlanes) +
@@ -227,6 +304,12 @@ IntensityDistribution DirectionGrid(const FarFieldCommand& c) {
 // IES and EULUMDAT hold candela: only a slab scaled with a lux meter has them. Checked on
 // slab.json alone, before the positions are read.
 void RequireLuxSlab(const std::string& path, const std::string& format) {
+  if (IsLuminaireFolder(path)) {  // every orientation's
+    const LuminaireSet set = LoadLuminaireSet(path);
+    for (size_t k = 0; k < set.orientations.size(); ++k)
+      RequireLuxSlab(set.DatasetFolder(k), format);
+    return;
+  }
   const std::string dir = ResolveSlabDir(path);
   const SlabInfo info = SlabInfo::Load(dir);
   if (info.units == "lux") return;
@@ -288,8 +371,7 @@ GridFarField ComputeGridFarField(const IntensityDistribution& d, const Slab& sla
   GridFarField out;
   const CSymmetry symmetry = d.Symmetry();
   if (symmetry == CSymmetry::kNone) {
-    out.ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
-    CheckFarFieldLight(out.ff, slab.info, slab.dir, checks);
+    out.ff = SlabFarField(slab, d.c_deg, d.gamma_deg, options, checks);
     return out;
   }
   std::vector<std::vector<double>> images(d.c_deg.size());
@@ -302,8 +384,7 @@ GridFarField ComputeGridFarField(const IntensityDistribution& d, const Slab& sla
   all.erase(std::unique(all.begin(), all.end(),
                         [](double a, double b) { return std::abs(a - b) < 1e-9; }),
             all.end());
-  const FarField full = ComputeFarField(slab.info, slab.positions, all, d.gamma_deg, options);
-  CheckFarFieldLight(full, slab.info, slab.dir, checks);
+  const FarField full = SlabFarField(slab, all, d.gamma_deg, options, checks);
   const size_t ng = d.gamma_deg.size();
   out.ff.c_deg = d.c_deg;
   out.ff.gamma_deg = d.gamma_deg;
@@ -357,6 +438,7 @@ constexpr double kMaxCellUnseenShare = 0.001;
 
 CellCheck CheckCells(const IntensityDistribution& d, const Slab& slab,
                      const FarFieldOptions& options) {
+  CheckLog unrecorded("", "");  // the grid's far field was checked
   CellCheck out;
   IntensityDistribution fine;
   for (int k = 0; k < 72; ++k) fine.c_deg.push_back(5.0 * k);
@@ -365,10 +447,12 @@ CellCheck CheckCells(const IntensityDistribution& d, const Slab& slab,
   out.fine_step_deg = n > 0 ? (hi - lo) / n : 0;
   for (int k = 0; k <= n; ++k) fine.gamma_deg.push_back(k == n ? hi : lo + k * out.fine_step_deg);
   const FarField ff =
-      ComputeFarField(slab.info, slab.positions, fine.c_deg, fine.gamma_deg, options);
+      slab.luminaire
+          ? SlabFarField(slab, fine.c_deg, fine.gamma_deg, options, unrecorded, false)
+          : ComputeFarField(slab.info, slab.positions, fine.c_deg, fine.gamma_deg, options);
   fine.values = ff.values;
   for (double& v : fine.values) v = std::max(v, 0.0);
-  out.fine = GridCoverage(fine, ff, slab.info, slab.dir);
+  out.fine = SlabCoverage(fine, ff, slab);
   out.file_flux = d.TotalFlux();
   out.fine_flux = fine.TotalFlux();
   out.flux_deviation = out.fine_flux > 0   ? std::abs(out.file_flux - out.fine_flux) / out.fine_flux
@@ -399,7 +483,7 @@ IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& sla
     d.opening = {(g.nv + 1) * g.spacing_mm, (g.nu + 1) * g.spacing_mm, 0.0};
   }
   const char* unit = d.photometric ? " lm" : " W";
-  Coverage coverage = GridCoverage(d, grid.ff, slab.info, slab.dir);
+  Coverage coverage = SlabCoverage(d, grid.ff, slab);
   if (coverage.unseen == coverage.directions)
     throw BadInput(c.out + ": the capture saw none of the grid's " +
                    std::to_string(coverage.directions) +
@@ -434,7 +518,7 @@ IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& sla
                    Num(d.TotalFlux() / c.input_watts, 4) +
                    " lm/W (above 683 lm/W, the most "
                    "light can give)");
-  *simulation = SyntheticSlab(slab.dir);
+  *simulation = Synthetic(slab);
   LogInfo("far field: ", d.c_deg.size(), " C planes x ", d.gamma_deg.size(), " gamma angles, flux ",
           Num(d.TotalFlux(), 6), unit, " over the seen directions; ", coverage.SeenCone(), "; ",
           coverage.unseen, " of ", coverage.directions, " grid directions not seen; ",
@@ -496,11 +580,14 @@ IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& sla
   // The stated uncertainty (export/report_uncertainty.h, as the report states it): IES as
   // [_UNCERTAINTY]; EULUMDAT, without keywords, in the measurement report field (line 8) after
   // the report number and coverage when the field's 78 bytes hold it.
-  const FarFieldUncertainty u =
-      EstimateFarFieldUncertainty(slab.info, DatasetOfSlab(slab.dir), c.samples, c.uncertainty);
-  LogInfo("uncertainty: ", UncertaintyKeyword(u));
+  const FarFieldUncertainty u = SlabUncertainty(slab, c.samples, c.uncertainty);
+  std::string uncertainty_text = UncertaintyKeyword(u);
+  if (slab.luminaire)
+    uncertainty_text += "; the largest of the " + std::to_string(slab.luminaire->slabs.size()) +
+                        " orientations' (the registration's and the blend's not included)";
+  LogInfo("uncertainty: ", uncertainty_text);
   if (c.format == "ies") {
-    d.keywords.push_back({"_UNCERTAINTY", UncertaintyKeyword(u)});
+    d.keywords.push_back({"_UNCERTAINTY", uncertainty_text});
   } else {
     const std::string text = "U(k=2) flux " + Num(100 * u.FluxExpanded(), 2) + " %, peak " +
                              Num(100 * u.PeakExpanded(), 2) + " %";
@@ -523,9 +610,14 @@ IntensityDistribution SlabDistribution(const FarFieldCommand& c, const Slab& sla
   if (folder.filename() == "slab") folder = folder.parent_path();  // a dataset's slab/
   const std::string name = folder.filename().string();
   std::ostringstream note;
-  note << "lumislab-export " << c.format << " from the light slab of " << name << " (" << g.nu
-       << " x " << g.nv << " positions, h " << g.spacing_mm << " mm, d " << slab.info.distance_mm
-       << " mm)";
+  if (slab.luminaire)
+    note << "lumislab-export " << c.format << " from the merged light field of " << name << ": "
+         << slab.luminaire->Orientations() << "; the first's slab " << g.nu << " x " << g.nv
+         << " positions, h " << g.spacing_mm << " mm, d " << slab.info.distance_mm << " mm";
+  else
+    note << "lumislab-export " << c.format << " from the light slab of " << name << " (" << g.nu
+         << " x " << g.nv << " positions, h " << g.spacing_mm << " mm, d " << slab.info.distance_mm
+         << " mm)";
   d.keywords.push_back({"FILEGENINFO", note.str()});
   return d;
 }
@@ -546,7 +638,7 @@ int RunFarField(const FarFieldCommand& c, int threads) {
   if (c.format == "ies") CheckIesRequiredKeywords(keywords, c.out);
   RequireLuxSlab(c.slab, c.format == "ies" ? "IES" : "EULUMDAT");
   CheckLog checks = SlabChecks(c.slab, "export " + c.format);
-  const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
+  const Slab slab = LoadCompleteSlab(c.slab, threads, checks, "export " + c.format);
   bool simulation = false;
   const IntensityDistribution d = SlabDistribution(c, slab, threads, checks, &simulation);
   checks.Save();
@@ -582,11 +674,19 @@ CLI::App* AddFarFieldCommand(CLI::App& app, const std::string& format, FarFieldC
                                 "slab in lux: candela)"
                               : "the slab's far-field intensity as an EULUMDAT file (a slab in "
                                 "lux: candela)");
-  cmd->add_option("--slab", c->slab, "dataset folder or its slab/")->required();
+  cmd->add_option("--slab", c->slab,
+                  "dataset folder, its slab/, or a luminaire folder (the merged light field of "
+                  "its orientations, docs/formats.md §19)")
+      ->required();
   cmd->add_option("--out", c->out, "file to write")->required();
   cmd->add_option("--c-step", c->c_step, "degrees between C planes, 0-360")->capture_default_str();
-  cmd->add_option("--gamma-step", c->gamma_step, "degrees between gamma angles, 0-90")
+  cmd->add_option("--gamma-step", c->gamma_step,
+                  "degrees between gamma angles, 0-90 (0-180 with --gamma-range sphere)")
       ->capture_default_str();
+  cmd->add_option("--gamma-range", c->gamma_range,
+                  "hemisphere (gamma 0-90) or sphere (0-180) for --gamma-step (default: sphere "
+                  "for a luminaire folder measured over the sphere, else hemisphere)")
+      ->check(CLI::IsMember({"hemisphere", "sphere"}));
   cmd->add_option("--c-angles", c->c_angles,
                   "explicit C planes (degrees, comma separated); a symmetric range (0..90, "
                   "0..180, 90..270, one plane) is the mean of each plane's mirror images")
@@ -646,14 +746,53 @@ struct RayCommand {
 Coverage RayCoverage(const Slab& slab, int threads, CheckLog& checks) {
   IntensityDistribution d;
   d.c_deg = Steps(5, 355, "C", kMaxCPlanes);
-  d.gamma_deg = Steps(2.5, 90, "gamma", kMaxGammaAngles);
+  d.gamma_deg = Steps(2.5, GammaSpan(slab.dir, ""), "gamma", kMaxGammaAngles);
   d.values.assign(d.c_deg.size() * d.gamma_deg.size(), 0.0);
   FarFieldOptions options;
   options.samples = 2;
   options.threads = threads;
-  const FarField ff = ComputeFarField(slab.info, slab.positions, d.c_deg, d.gamma_deg, options);
-  CheckFarFieldLight(ff, slab.info, slab.dir, checks);
-  return GridCoverage(d, ff, slab.info, slab.dir);
+  const FarField ff = SlabFarField(slab, d.c_deg, d.gamma_deg, options, checks);
+  return SlabCoverage(d, ff, slab);
+}
+
+// A luminaire folder's rays (SampleMergedRays): every orientation's, turned into the luminaire
+// frame and thinned by the blend, each ray with its slab's flux per ray.
+int WriteMergedRays(const RayCommand& c, const Slab& slab, const Coverage& coverage,
+                    const std::string& cone, int threads) {
+  const LuminaireSource& lum = *slab.luminaire;
+  const MergedRays merged = SampleMergedRays(lum.slabs, c.rays, c.seed, threads);
+  Tm25RaySet set;
+  set.photometric = Photometric(slab.info);
+  const double nan = std::nan("");
+  set.luminous_flux_lm = set.photometric ? merged.rays.total_flux : nan;
+  set.radiant_flux_w = set.photometric ? nan : merged.rays.total_flux;
+  set.date_time = NowUtc("%Y-%m-%dT%H:%M:%SZ");
+  set.name = c.name;
+  set.manufacturer = c.manufacturer;
+  set.rayfile_creator = "lumislab-export tm25";
+  set.equipment = "lumislab light slabs of a luminaire folder: " + lum.Orientations();
+  set.additional_info =
+      "rays drawn from each orientation's light field, seed " + std::to_string(c.seed) +
+      ", turned into the luminaire frame and kept with the orientation's blend weight; origins "
+      "on each orientation's sampling plane (mm, luminaire frame); coverage: " +
+      (coverage.Partial() ? "partial: " : "complete: ") + cone;
+  set.creation_method = Synthetic(slab) ? 0 : 1;
+  set.rays.reserve(merged.rays.rays.size());
+  for (size_t k = 0; k < merged.rays.rays.size(); ++k) {
+    const SlabRay& r = merged.rays.rays[k];
+    set.rays.push_back({float(r.origin_mm.x()), float(r.origin_mm.y()), float(r.origin_mm.z()),
+                        float(r.direction.x()), float(r.direction.y()), float(r.direction.z()),
+                        merged.ray_flux[k]});
+  }
+  const char* unit = set.photometric ? " lm" : " W";
+  for (size_t k = 0; k < lum.slabs.size(); ++k)
+    LogInfo("rays of ", lum.slabs[k].name, ": ", merged.drawn[k], " drawn of ",
+            Num(merged.slab_flux[k], 6), unit, ", ", merged.kept[k], " kept (the blend keeps ",
+            Num(100 * merged.kept_share[k], 3), " % of its flux)");
+  LogInfo(merged.rays.rays.size(), " rays, total ", Num(merged.rays.total_flux, 6), unit);
+  WriteTm25(set, c.out);
+  std::printf("tm25: %s\n", c.out.c_str());
+  return 0;
 }
 
 int RunRays(const RayCommand& c, int threads) {
@@ -661,18 +800,20 @@ int RunRays(const RayCommand& c, int threads) {
           " force=", c.force ? "yes" : "no", " allow_partial=", c.allow_partial ? "yes" : "no");
   CheckExportOutput(c.out, c.force);
   CheckLog checks = SlabChecks(c.slab, "export tm25");
-  const Slab slab = LoadCompleteSlab(c.slab, threads, checks);
+  const Slab slab = LoadCompleteSlab(c.slab, threads, checks, "export tm25");
   const Coverage coverage = RayCoverage(slab, threads, checks);
   checks.Save();
   const std::string cone =
-      "rays only in the cone the screen saw: " + coverage.SeenCone() +
-      " (5 x 2.5 degree grid); outside it " +
+      (slab.luminaire ? "rays only in the directions some orientation saw: "
+                      : "rays only in the cone the screen saw: ") +
+      coverage.SeenCone() + " (5 x 2.5 degree grid); outside it " +
       (coverage.analytic ? "the analytic luminaire puts " : "the model puts ") +
       Num(100 * coverage.model_unseen_share, 3) + " % of its flux (" + coverage.model + ")";
   LogInfo("coverage: ", cone);
   if (coverage.Partial() && !c.allow_partial)
     throw BadInput(c.out + ": the rays would miss light the capture did not see: " + cone +
                    " (--allow-partial writes them with the cone stated in additional_info)");
+  if (slab.luminaire) return WriteMergedRays(c, slab, coverage, cone, threads);
   const SlabRays drawn = SampleSlabRays(slab.info, slab.positions, c.rays, c.seed, threads);
   Tm25RaySet set;
   set.photometric = Photometric(slab.info);
@@ -690,7 +831,7 @@ int RunRays(const RayCommand& c, int threads) {
   set.additional_info = "rays drawn from the slab's light field, seed " + std::to_string(c.seed) +
                         "; origins on the sampling plane z = 0 (mm, luminaire frame); coverage: " +
                         (coverage.Partial() ? "partial: " : "complete: ") + cone;
-  set.creation_method = SyntheticSlab(slab.dir) ? 0 : 1;  // simulated (synthetic) or measured
+  set.creation_method = Synthetic(slab) ? 0 : 1;  // simulated (synthetic) or measured
   set.rays.reserve(drawn.rays.size());
   for (const SlabRay& r : drawn.rays)
     set.rays.push_back({float(r.origin_mm.x()), float(r.origin_mm.y()), float(r.origin_mm.z()),
@@ -712,7 +853,10 @@ int RunRays(const RayCommand& c, int threads) {
 CLI::App* AddRayCommand(CLI::App& app, RayCommand* c, CommonOptions* common) {
   CLI::App* cmd = app.add_subcommand(
       "tm25", "rays drawn from the slab's light field as an ANSI/IES TM-25 ray file");
-  cmd->add_option("--slab", c->slab, "dataset folder or its slab/")->required();
+  cmd->add_option("--slab", c->slab,
+                  "dataset folder, its slab/, or a luminaire folder (every orientation's rays, "
+                  "turned into the luminaire frame and thinned by the blend)")
+      ->required();
   cmd->add_option("--out", c->out, "ray file to write")->required();
   cmd->add_option("--rays", c->rays, "number of rays")
       ->check(CLI::Range(int64_t(1), kMaxRays))
@@ -744,14 +888,20 @@ struct InfoCommand {
 };
 
 int RunInfo(const InfoCommand& c) {
+  if (IsLuminaireFolder(c.file)) {
+    std::fputs(LuminaireFolderInfo(c.file, c.json).c_str(), stdout);
+    return 0;
+  }
   std::fputs(FormatPhotometricFileInfo(PhotometricFileInfo(c.file), c.json).c_str(), stdout);
   return 0;
 }
 
 CLI::App* AddInfoCommand(CLI::App& app, InfoCommand* c, CommonOptions* common) {
   CLI::App* cmd = app.add_subcommand(
-      "info", "what an IES, EULUMDAT or TM-25 file holds: format, angle grid or rays, flux");
-  cmd->add_option("file", c->file, "the file")->required();
+      "info",
+      "what an IES, EULUMDAT or TM-25 file holds: format, angle grid or rays, flux; of a "
+      "luminaire folder: its orientations, registration and coverage");
+  cmd->add_option("file", c->file, "the file, or a luminaire folder")->required();
   cmd->add_flag("--json", c->json, "print it as JSON (with a flux field)");
   AddCommonOptions(cmd, common);
   return cmd;

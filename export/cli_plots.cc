@@ -9,9 +9,11 @@
 #include "core/dataset.h"
 #include "core/error.h"
 #include "core/exr_io.h"
+#include "core/geometry.h"
 #include "core/log.h"
 #include "core/slab.h"
 #include "export/complete_slab.h"
+#include "export/luminaire_source.h"
 #include "export/plane_irradiance.h"
 #include "lib/lightfield/false_colour.h"
 #include "lib/lightfield/far_field.h"
@@ -45,10 +47,41 @@ std::string Extension(const std::string& path) {
   return std::filesystem::path(path).extension().string();
 }
 
+// A luminaire folder's plane z = D (luminaire frame) is the plane in front of the orientation
+// that looks along the luminaire's gamma = 0 axis (its capture +z nearest the luminaire's +z):
+// what that orientation's slab sees of it, at D + centre_z of its capture frame. The picture's
+// extent (the window seen at D) lies within that orientation's cone, where its slab holds the
+// light; a plane the pose tilts, or a centre off its axis, is warned about.
+void PlaneOfLuminaireFolder(IrradianceOptions* o) {
+  const LuminaireSet set = LoadLuminaireSet(o->slab_dir);
+  const size_t best = FrontOrientation(set);
+  const Orientation& front = set.orientations[best];
+  const double tilt_deg = std::acos(std::clamp(front.rotation(2, 2), -1.0, 1.0)) * 180 / kPi;
+  LogInfo("luminaire ", o->slab_dir, ": the plane z = ", o->distance_mm,
+          " mm of the luminaire frame as orientation ", front.name, " sees it (its axis ",
+          Num(tilt_deg, 3), " deg from gamma = 0), at ", o->distance_mm + front.centre_mm.z(),
+          " mm from its S");
+  if (tilt_deg > 0.5 || front.centre_mm.head<2>().norm() > 1)
+    LogWarning("orientation ", front.name, " looks ", Num(tilt_deg, 3),
+               " deg off the luminaire's gamma = 0 axis, its centre ",
+               Num(front.centre_mm.head<2>().norm(), 3),
+               " mm off its own axis: the picture is its plane, tilted and shifted that much");
+  o->distance_mm += front.centre_mm.z();
+  if (!(o->distance_mm >= kMinDistanceMm))
+    throw InputError("--distance-mm", "",
+                     "a plane beyond the front orientation's S (D + centre_z >= " +
+                         Num(kMinDistanceMm, 3) + " mm)",
+                     Num(o->distance_mm - front.centre_mm.z(), 6));
+  o->slab_dir = ResolveSlabDir(set.DatasetFolder(best));
+}
+
 // The slab's irradiance on the plane z = D by the exact CPU reference (docs/method.md §4.5;
 // nothing in the way, so no visibility rays), through the false colour of docs/method.md §4.9.
 int RunIrradiance(IrradianceOptions o, int threads) {
-  o.slab_dir = ResolveSlabDir(o.slab_dir);
+  if (IsLuminaireFolder(o.slab_dir))
+    PlaneOfLuminaireFolder(&o);
+  else
+    o.slab_dir = ResolveSlabDir(o.slab_dir);
   LogInfo("parameters: slab=", o.slab_dir, " distance_mm=", o.distance_mm,
           " extent_mm=", o.extent_mm, " size=", o.size, " samples=", o.samples, " range=", o.range,
           " scale=", o.scale, " out=", o.out);
@@ -93,28 +126,68 @@ int RunIrradiance(IrradianceOptions o, int threads) {
   return 0;
 }
 
-// The far field in the four half-planes, up to the largest gamma every one of them saw.
-PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
-  const SlabInfo info = SlabInfo::Load(o.slab_dir);
-  RequireCompleteSlab(info, o.slab_dir);
-  const std::vector<SlabPosition> positions = ReadSlabPositions(o.slab_dir, info, threads);
-  CheckLog checks(DatasetOfSlab(o.slab_dir), "export polar");
-  CheckSlabLight(info, positions, o.slab_dir, checks);
+int RunPolar(PolarOptions o, int threads) {
+  if (!IsLuminaireFolder(o.slab_dir)) o.slab_dir = ResolveSlabDir(o.slab_dir);
+  LogInfo("parameters: slab=", o.slab_dir, " gamma_step=", o.gamma_step_deg, " samples=", o.samples,
+          " size=", o.size, " out=", o.out);
+  const std::string ext = Extension(o.out);
+  if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
+  CheckExportOutput(o.out, o.force);
+  PolarPlotData data = PolarData(o.slab_dir, o.gamma_step_deg, o.samples, threads);
+  if (!o.title.empty()) data.title = o.title;
+  const PolarPlot plot = MakePolarPlot(data, o.size);
+  if (ext == ".svg") {
+    WriteTextAtomically(o.out, PolarPlotSvg(plot));
+  } else {
+    const Rgb8Image image = PolarPlotImage(plot);
+    WriteRgb8File(o.out, image.width, image.height, image.rgb);
+  }
+  LogInfo("polar plot -> ", o.out);
+  return 0;
+}
+
+}  // namespace
+
+// The far field in the four half-planes, up to the largest gamma every one of them saw: of the
+// slab (gamma 0-90), or of a luminaire folder the merged far field (gamma 0-180).
+PolarPlotData PolarData(const std::string& slab_dir, double gamma_step_deg, int samples,
+                        int threads) {
+  const bool merged = IsLuminaireFolder(slab_dir);
+  PolarOptions o;
+  o.slab_dir = merged ? slab_dir : ResolveSlabDir(slab_dir);
+  o.gamma_step_deg = gamma_step_deg;
+  o.samples = samples;
   std::vector<double> gamma;
-  for (int k = 0; k * o.gamma_step_deg <= 90 + 1e-9; ++k) gamma.push_back(k * o.gamma_step_deg);
+  const double span = merged ? 180 : 90;
+  for (int k = 0; k * o.gamma_step_deg <= span + 1e-9; ++k) gamma.push_back(k * o.gamma_step_deg);
   FarFieldOptions options;
   options.samples = o.samples;
   options.threads = threads;
   const std::vector<double> planes = {0, 90, 180, 270};
-  const FarField far = ComputeFarField(info, positions, planes, gamma, options);
-  CheckFarFieldLight(far, info, o.slab_dir, checks);
-  checks.Save();
+  SlabInfo info;
+  FarField far;
+  if (merged) {
+    const LuminaireSource source = LoadLuminaireSource(o.slab_dir, threads, "export polar");
+    LogInfo("luminaire ", o.slab_dir, ": ", source.Orientations());
+    info = source.slabs.front().info;
+    far = ComputeMergedFarField(source.slabs, planes, gamma, options).ff;
+  } else {
+    info = SlabInfo::Load(o.slab_dir);
+    RequireCompleteSlab(info, o.slab_dir);
+    const std::vector<SlabPosition> positions = ReadSlabPositions(o.slab_dir, info, threads);
+    CheckLog checks(DatasetOfSlab(o.slab_dir), "export polar");
+    CheckSlabLight(info, positions, o.slab_dir, checks);
+    far = ComputeFarField(info, positions, planes, gamma, options);
+    CheckFarFieldLight(far, info, o.slab_dir, checks);
+    checks.Save();
+  }
   size_t seen = 0;  // gamma[0 .. seen) seen in all four planes
   while (seen < gamma.size() && far.seen[seen] && far.seen[gamma.size() + seen] &&
          far.seen[2 * gamma.size() + seen] && far.seen[3 * gamma.size() + seen])
     ++seen;
   if (seen < 2)
-    throw BadInput(o.slab_dir + ": the slab saw too few directions for a polar plot (gamma 0 to " +
+    throw BadInput(o.slab_dir +
+                   ": the slab(s) saw too few directions for a polar plot (gamma 0 to " +
                    std::to_string(seen == 0 ? 0.0 : gamma[seen - 1]) + " degrees)");
   PolarPlotData data;
   data.gamma_deg.assign(gamma.begin(), gamma.begin() + seen);
@@ -128,31 +201,11 @@ PolarPlotData PolarDataFromSlab(const PolarOptions& o, int threads) {
     }
   if (negative > 0) LogWarning(negative, " negative intensities drawn as 0");
   data.unit = IntensityUnitLabel(info.units);
-  data.title = o.title.empty() ? "Far field (the slab saw \u03B3 = 0 to " +
-                                     FormatTick(data.gamma_deg.back(), o.gamma_step_deg) + "\u00B0)"
-                               : o.title;
+  data.title =
+      std::string(merged ? "Merged far field (the orientations saw" : "Far field (the slab saw") +
+      " \u03B3 = 0 to " + FormatTick(data.gamma_deg.back(), o.gamma_step_deg) + "\u00B0)";
   return data;
 }
-
-int RunPolar(PolarOptions o, int threads) {
-  o.slab_dir = ResolveSlabDir(o.slab_dir);
-  LogInfo("parameters: slab=", o.slab_dir, " gamma_step=", o.gamma_step_deg, " samples=", o.samples,
-          " size=", o.size, " out=", o.out);
-  const std::string ext = Extension(o.out);
-  if (ext != ".svg" && ext != ".png") throw BadInput(o.out + ": --out must end in .svg or .png");
-  CheckExportOutput(o.out, o.force);
-  const PolarPlot plot = MakePolarPlot(PolarDataFromSlab(o, threads), o.size);
-  if (ext == ".svg") {
-    WriteTextAtomically(o.out, PolarPlotSvg(plot));
-  } else {
-    const Rgb8Image image = PolarPlotImage(plot);
-    WriteRgb8File(o.out, image.width, image.height, image.rgb);
-  }
-  LogInfo("polar plot -> ", o.out);
-  return 0;
-}
-
-}  // namespace
 
 ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
   auto irradiance = std::make_shared<IrradianceOptions>();
@@ -162,7 +215,10 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       "frame, by the exact CPU reference: .png false colour (viridis, colour bar in W/m² or lx, "
       "iso-lines at its ticks, a length scale) or .exr linear; +x right, +y up (the plane seen "
       "from behind it, looking back at the luminaire)");
-  irr->add_option("--slab", irradiance->slab_dir, "dataset folder or its slab/")->required();
+  irr->add_option("--slab", irradiance->slab_dir,
+                  "dataset folder, its slab/, or a luminaire folder (the plane z = D of the "
+                  "luminaire frame as the orientation looking along gamma = 0 sees it)")
+      ->required();
   irr->add_option("--distance-mm", irradiance->distance_mm, "D: the plane's distance from S (mm)")
       ->required()
       ->check(FiniteIn(kMinDistanceMm, kMaxDistanceMm));
@@ -191,7 +247,10 @@ ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common) {
       "the far-field polar diagram of the slab (intensity in cd or W/sr against gamma, planes "
       "C0-C180 and C90-C270, C0 (+x) and C90 (-y) on the right, up to the largest gamma the "
       "slab saw in all four)");
-  pol->add_option("--slab", polar->slab_dir, "dataset folder or its slab/")->required();
+  pol->add_option("--slab", polar->slab_dir,
+                  "dataset folder, its slab/, or a luminaire folder (the merged far field, gamma "
+                  "0-180)")
+      ->required();
   pol->add_option("--out", polar->out, ".svg or .png")->required();
   pol->add_option("--gamma-step", polar->gamma_step_deg, "degrees between the curves' points")
       ->check(FiniteIn(0.1, 45))

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "core/command_line.h"
+#include "lib/lightfield/polar_plot.h"
 
 namespace lumislab {
 
@@ -18,6 +19,12 @@ namespace lumislab {
 // when none of the set's subcommands was on the command line. (The same alias as
 // export/cli_formats.h's; a repeated alias of one type is allowed.)
 using ParsedCommand = std::function<std::optional<int>(int threads)>;
+
+// What `polar` draws: the far field of the slab at `slab_dir` (a slab folder, or a luminaire
+// folder: the merged far field, gamma 0-180) in the planes C0, C90, C180 and C270, up to the
+// largest gamma all four saw, every `gamma_step_deg`, with `samples` x `samples` quadrature.
+PolarPlotData PolarData(const std::string& slab_dir, double gamma_step_deg, int samples,
+                        int threads);
 
 // Adds irradiance and polar to `app` (each with the common options bound to `common`).
 ParsedCommand AddPlotCommands(CLI::App& app, CommonOptions* common);

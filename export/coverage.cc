@@ -13,17 +13,15 @@
 namespace lumislab {
 namespace {
 
-std::string TruthLuminaireFile(const std::string& slab_dir) {
+std::string TruthDirOfSlab(const std::string& slab_dir) {
   namespace fs = std::filesystem;
-  return (fs::absolute(slab_dir).lexically_normal().parent_path() / "truth" / "luminaire.json")
-      .string();
+  return (fs::absolute(slab_dir).lexically_normal().parent_path() / "truth").string();
 }
 
 // K (lm/W) of a synthetic dataset's lux meter: truth/reference.json's luminous_efficacy_lm_w
 // (acquire synth --meter lux records it), else the scenes' default.
-double TruthEfficacy(const std::string& slab_dir) {
-  const std::string file =
-      std::filesystem::path(TruthLuminaireFile(slab_dir)).parent_path() / "reference.json";
+double TruthEfficacy(const std::string& truth_dir) {
+  const std::string file = truth_dir + "/reference.json";
   if (std::filesystem::is_regular_file(file)) {
     const JsonDocument doc = JsonDocument::Load(file);
     if (doc.root().Has("luminous_efficacy_lm_w"))
@@ -37,11 +35,17 @@ std::string Pct(double share) { return Num(100 * share, 3) + " %"; }
 }  // namespace
 
 bool SyntheticSlab(const std::string& slab_dir) {
-  return std::filesystem::is_regular_file(TruthLuminaireFile(slab_dir));
+  return std::filesystem::is_regular_file(TruthDirOfSlab(slab_dir) + "/luminaire.json");
 }
 
 Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const SlabInfo& info,
                       const std::string& slab_dir) {
+  return GridCoverageWithTruth(d, ff, info, TruthDirOfSlab(slab_dir));
+}
+
+Coverage GridCoverageWithTruth(const IntensityDistribution& d, const FarField& ff,
+                               const SlabInfo& info, const std::string& truth_dir,
+                               bool isotropic_model) {
   Coverage c;
   const size_t ng = d.gamma_deg.size();
   c.c_deg = d.c_deg;
@@ -55,11 +59,11 @@ Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const 
   // The model on the file's grid; its flux in the unseen directions over its flux on the grid.
   IntensityDistribution model = d;
   const bool lux = info.units == "lux";
-  if (SyntheticSlab(slab_dir)) {
-    const Luminaire luminaire = LoadLuminaire(TruthLuminaireFile(slab_dir));
+  if (std::filesystem::is_regular_file(truth_dir + "/luminaire.json")) {
+    const Luminaire luminaire = LoadLuminaire(truth_dir + "/luminaire.json");
     if (luminaire.ray_sources.empty()) {
       c.analytic = true;
-      const double k = lux ? TruthEfficacy(slab_dir) : 1.0;  // lm = K x W
+      const double k = lux ? TruthEfficacy(truth_dir) : 1.0;  // lm = K x W
       for (size_t ic = 0; ic < d.c_deg.size(); ++ic)
         for (size_t ig = 0; ig < ng; ++ig) {
           const Eigen::Vector3d w = TypeCDirection(d.c_deg[ic], d.gamma_deg[ig]);
@@ -75,7 +79,12 @@ Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const 
       c.model = "the analytic luminaire of the synthetic dataset (truth/luminaire.json)";
     }
   }
-  if (!c.analytic) {
+  if (!c.analytic && isotropic_model) {
+    for (double& v : model.values) v = 1;
+    c.model =
+        "a model, not a measurement: an isotropic emitter (I0 in every direction) matched to the "
+        "seen flux";
+  } else if (!c.analytic) {
     for (size_t ic = 0; ic < d.c_deg.size(); ++ic)
       for (size_t ig = 0; ig < ng; ++ig)
         model.values[ic * ng + ig] = std::max(0.0, std::cos(d.gamma_deg[ig] * kPi / 180));

@@ -50,6 +50,15 @@ struct Coverage {
 Coverage GridCoverage(const IntensityDistribution& d, const FarField& ff, const SlabInfo& info,
                       const std::string& slab_dir);
 
+// The same with the analytic luminaire looked for in `truth_dir` (luminaire.json, reference.json
+// with the lux meter's K): a luminaire folder's <folder>/truth, in the luminaire frame. Without
+// one, the model of a luminaire folder (`isotropic_model`) is an isotropic emitter matched to the
+// seen flux: a luminaire measured from several orientations is one whose light goes beyond a
+// hemisphere, so directions no orientation saw count as missing light.
+Coverage GridCoverageWithTruth(const IntensityDistribution& d, const FarField& ff,
+                               const SlabInfo& info, const std::string& truth_dir,
+                               bool isotropic_model = false);
+
 // True when `slab_dir` belongs to a synthetic dataset (truth/luminaire.json beside it).
 bool SyntheticSlab(const std::string& slab_dir);
 

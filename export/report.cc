@@ -22,6 +22,7 @@
 #include "core/slab.h"
 #include "core/slab_light.h"
 #include "export/complete_slab.h"
+#include "export/luminaire_source.h"
 #include "export/plane_irradiance.h"
 #include "lib/lightfield/far_field.h"
 #include "lib/lightfield/far_field_light.h"
@@ -128,6 +129,25 @@ std::vector<double> Range(double step, double last) {
   const int n = int(std::lround(last / step));
   for (int k = 0; k <= n; ++k) v.push_back(k * step);
   return v;
+}
+
+// A luminaire folder's rows (first in the table): its orientations, their registration
+// (registration.json: correction and 1-sigma per orientation) and the merged coverage; the rows
+// after them are the front orientation's capture.
+void AddLuminaireMetadata(const LuminaireSource& source, size_t front, const std::string& folder,
+                          ReportData* r) {
+  auto add = [&](const std::string& k, const std::string& v) { r->metadata.push_back({k, v}); };
+  add("luminaire folder", folder + " (" + source.set.coverage + " asked)");
+  add("orientations", source.Orientations());
+  if (!source.set.orientations.front().registered)
+    add("registration", "none: nominal poses; " + RegisterCommand(folder) + " refines them");
+  const std::vector<std::string> rows = source.RegistrationRows();
+  for (size_t k = 0; k < rows.size(); ++k) add("orientation " + std::to_string(k), rows[k]);
+  add("merged coverage", Num(100 * r->seen_fraction, 4) + " % of the " + r->Domain() +
+                             " seen by at least one orientation; the far field of each direction "
+                             "is its orientations' blend (docs/method.md §4.12)");
+  add("planes and colour",
+      "orientation " + source.slabs[front].name + " (looking along gamma = 0); D from its S");
 }
 
 // Metadata rows from slab.json and whichever calibration files the dataset has.
@@ -294,26 +314,43 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
     throw InputError("--gamma-step", "", "a step in (0, 10] degrees dividing 90",
                      Num(o.gamma_step, 8));
   ReportData r;
-  r.slab_dir = ResolveSlabDir(o.slab);
+  // A luminaire folder: the merged far field (gamma 0-180 for a sphere), the planes, colour and
+  // capture metadata of its front orientation (FrontOrientation).
+  std::optional<LuminaireSource> luminaire;
+  size_t front = 0;
+  if (IsLuminaireFolder(o.slab)) {
+    luminaire = LoadLuminaireSource(o.slab, threads, "export report");
+    front = FrontOrientation(luminaire->set);
+    r.slab_dir = luminaire->slabs[front].slab_dir;
+    if (luminaire->set.coverage == "sphere") r.gamma_span_deg = 180;
+  } else {
+    r.slab_dir = ResolveSlabDir(o.slab);
+  }
   r.dataset_dir = DatasetOfSlab(r.slab_dir);
   r.info = SlabInfo::Load(r.slab_dir);
   RequireCompleteSlab(r.info, r.slab_dir);
   r.per_klm = o.per_klm;
   r.generated_utc = NowUtc("%Y-%m-%d %H:%M UTC");
   r.software = std::string("lumislab-export ") + LUMISLAB_VERSION;
-  CheckLog checks(r.dataset_dir, "export report");
-  std::vector<SlabPosition> positions = ReadSlabPositions(r.slab_dir, r.info, threads);
-  CheckSlabLight(r.info, positions, r.slab_dir, checks);
+  CheckLog checks(luminaire ? "" : r.dataset_dir, "export report");
+  std::vector<SlabPosition> positions = luminaire ? luminaire->slabs[front].positions
+                                                  : ReadSlabPositions(r.slab_dir, r.info, threads);
+  if (!luminaire) CheckSlabLight(r.info, positions, r.slab_dir, checks);
 
   IntensityDistribution& d = r.distribution;
   d.format = "lumislab far field";
   d.c_deg = Range(o.c_step, 360);
-  d.gamma_deg = Range(o.gamma_step, 90);
+  d.gamma_deg = Range(o.gamma_step, r.gamma_span_deg);
   FarFieldOptions ff_options;
   ff_options.samples = o.samples;
   ff_options.threads = threads;
-  const FarField ff = ComputeFarField(r.info, positions, d.c_deg, d.gamma_deg, ff_options);
-  CheckFarFieldLight(ff, r.info, r.slab_dir, checks);
+  FarField ff;
+  if (luminaire) {
+    ff = ComputeMergedFarField(luminaire->slabs, d.c_deg, d.gamma_deg, ff_options).ff;
+  } else {
+    ff = ComputeFarField(r.info, positions, d.c_deg, d.gamma_deg, ff_options);
+    CheckFarFieldLight(ff, r.info, r.slab_dir, checks);
+  }
   checks.Save();
   d.values = ff.values;
   for (double& v : d.values) v = std::max(v, 0.0);  // the fit's ringing: no negative intensity
@@ -341,9 +378,11 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   r.flux_in_cone = d.FluxWithin(r.seen_cone_deg);
   IntensityDistribution seen_sr = d;  // the zonal sum of 0/1: the seen solid angle
   for (size_t k = 0; k < seen_sr.values.size(); ++k) seen_sr.values[k] = r.seen[k] ? 1 : 0;
-  r.seen_fraction = seen_sr.TotalFlux() / (2 * kPi);
+  r.seen_fraction = seen_sr.TotalFlux() / ((r.gamma_span_deg > 90 ? 4 : 2) * kPi);
 
-  r.uncertainty = EstimateFarFieldUncertainty(r.info, r.dataset_dir, o.samples, o.uncertainty);
+  r.uncertainty =
+      luminaire ? LuminaireUncertainty(*luminaire, o.samples, o.uncertainty)
+                : EstimateFarFieldUncertainty(r.info, r.dataset_dir, o.samples, o.uncertainty);
 
   r.colour = MakeReportColour(r, positions, threads);
   std::vector<ImageF> irradiance;
@@ -353,6 +392,7 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   if (distances.empty())
     distances = {r.info.distance_mm, 2 * r.info.distance_mm, 4 * r.info.distance_mm};
   for (double D : distances) r.planes.push_back(MakePlane(r, irradiance, D, o, threads));
+  if (luminaire) AddLuminaireMetadata(*luminaire, front, o.slab, &r);
   AddMetadata(&r);
   LogInfo("report: flux ", Num(r.summary.total_flux, 6), " ", r.FluxUnit(), ", seen to gamma ",
           Num(r.seen_cone_deg, 4), " deg (", Num(100 * r.seen_fraction, 3),
@@ -367,7 +407,10 @@ ParsedCommand AddReportCommand(CLI::App& app, CommonOptions* common) {
       "the lab report of the slab: one self-contained, printable HTML file (summary, zonal "
       "lumens, polar / linear / iso-candela diagrams, illuminance on planes, the near-field "
       "advantage, candela table, uncertainty, metadata), and a PDF through headless Chromium");
-  cmd->add_option("--slab", o->slab, "dataset folder or its slab/")->required();
+  cmd->add_option("--slab", o->slab,
+                  "dataset folder, its slab/, or a luminaire folder (the merged far field over "
+                  "the sphere; the planes of the orientation looking along gamma = 0)")
+      ->required();
   cmd->add_option("--out", o->out, "the report (.html)")->required();
   cmd->add_option("--pdf", o->pdf, "also print it to this PDF (needs chromium)");
   cmd->add_option("--input-watts", o->input_watts, "the luminaire's input power (W): efficacy")
@@ -378,7 +421,9 @@ ParsedCommand AddReportCommand(CLI::App& app, CommonOptions* common) {
       ->check(FiniteIn(kMinDistanceMm, kMaxDistanceMm));
   cmd->add_option("--c-step", o->c_step, "degrees between C planes of the far field")
       ->capture_default_str();
-  cmd->add_option("--gamma-step", o->gamma_step, "degrees between gamma angles (0-90)")
+  cmd->add_option("--gamma-step", o->gamma_step,
+                  "degrees between gamma angles (0-90; 0-180 for a luminaire folder measured "
+                  "over the sphere)")
       ->capture_default_str();
   cmd->add_option("--samples", o->samples, "N x N quadrature points per position (far field)")
       ->check(CLI::Range(1, 16))

@@ -23,7 +23,7 @@
 namespace lumislab {
 
 struct ReportOptions {
-  std::string slab;  // dataset folder or its slab/
+  std::string slab;  // dataset folder, its slab/, or a luminaire folder (merged far field)
   std::string out;   // .html
   std::string pdf;   // "" or .pdf (headless Chromium)
   double input_watts = 0;
@@ -73,8 +73,11 @@ struct ReportData {
   std::vector<uint8_t> seen;           // per value of `distribution`
   PhotometricSummary summary;
   double seen_cone_deg = 0;  // every direction seen up to this gamma
-  double seen_fraction = 0;  // of the hemisphere's directions (solid angle) seen
-  double flux_in_cone = 0;   // flux within seen_cone_deg
+  double seen_fraction = 0;  // of the hemisphere's (sphere's) directions (solid angle) seen
+  // The far field's gamma range: 90 for a slab, 180 for a luminaire folder measured over the
+  // sphere (its merged far field, docs/formats.md §19).
+  double gamma_span_deg = 90;
+  double flux_in_cone = 0;  // flux within seen_cone_deg
   FarFieldUncertainty uncertainty;
   std::vector<ReportPlane> planes;
   ReportColour colour;
@@ -84,6 +87,7 @@ struct ReportData {
   std::string IntensityUnit() const;    // "cd", "cd/klm", "W/sr"
   std::string FluxUnit() const;         // "lm" or "W"
   std::string IlluminanceUnit() const;  // "lx" or "W/m²"
+  std::string Domain() const { return gamma_span_deg > 90 ? "sphere" : "hemisphere"; }
 };
 
 // Everything the report shows, from the slab (read on `threads` threads).

@@ -64,9 +64,8 @@ void Summary(Page& p) {
                                           " % (k = 2)");
   row("Flux in the measured cone", Fmt(r.flux_in_cone, 5) + " " + flux + " within &gamma; &le; " +
                                        Deg(r.seen_cone_deg) + " (every C seen there)");
-  row("Coverage", Num(100 * r.seen_fraction, 3) +
-                      " % of the hemisphere's solid angle seen; directions beyond are unknown, "
-                      "not dark");
+  row("Coverage", Num(100 * r.seen_fraction, 3) + " % of the " + r.Domain() +
+                      "'s solid angle seen; directions beyond are unknown, not dark");
   row("Peak intensity", Fmt(s.peak, 5) + " " + cd + " at C " + Deg(s.peak_c_deg) + ", &gamma; " +
                             Deg(s.peak_gamma_deg) + " &plusmn; " +
                             Num(100 * r.uncertainty.PeakExpanded(), 2) + " % (k = 2)");
@@ -98,7 +97,7 @@ void Summary(Page& p) {
     row("Luminous efficacy (seen flux)",
         "&ge; " + Fmt(s.efficacy, 4) + " lm/W at " + Fmt(s.input_watts, 4) +
             " W <span class=note>(a lower bound: the flux of the seen directions only, " +
-            Num(100 * r.seen_fraction, 3) + " % of the hemisphere)</span>");
+            Num(100 * r.seen_fraction, 3) + " % of the " + r.Domain() + ")</span>");
   else if (s.efficacy > 0)
     row("Luminous efficacy", Fmt(s.efficacy, 4) + " lm/W at " + Fmt(s.input_watts, 4) + " W");
   else
@@ -202,8 +201,8 @@ void Linear(Page& p) {
   SvgAxes a;
   a.width = 640;
   a.height = 260;
-  a.x0 = -90;
-  a.x1 = 90;
+  a.x0 = -r.gamma_span_deg;
+  a.x1 = r.gamma_span_deg;
   double top = 0;
   std::vector<std::pair<std::vector<double>, std::vector<double>>> curves;
   for (const BeamSpread& b : r.summary.spreads) {
@@ -247,10 +246,11 @@ void IsoCandela(Page& p) {
   const IntensityDistribution& d = r.distribution;
   const double size = 420, cx = size / 2, cy = size / 2, R = size / 2 - 34;
   const int nc = int(d.c_deg.size()), ng = int(d.gamma_deg.size());
-  // Page position of (C, gamma): gamma radially (R at 90 degrees), C counter-clockwise from the
-  // right.
+  // Page position of (C, gamma): gamma radially (R at the grid's last gamma, 90 or 180 degrees),
+  // C counter-clockwise from the right.
+  const double span = r.gamma_span_deg;
   auto at = [&](double c_deg, double g_deg) {
-    const double rr = g_deg / 90 * R, c = c_deg * kPi / 180;
+    const double rr = g_deg / span * R, c = c_deg * kPi / 180;
     return std::make_pair(cx + rr * std::cos(c), cy - rr * std::sin(c));
   };
   auto grid_at = [&](double fx, double fy) {
@@ -284,14 +284,15 @@ void IsoCandela(Page& p) {
         << "Z\" fill=\"#e4e4e4\" stroke=\"#e4e4e4\" stroke-width=\"0.5\"/>\n";
       ig = end;
     }
-  for (int g = 15; g <= 90; g += 15) {
-    h << "<circle cx=\"" << cx << "\" cy=\"" << cy << "\" r=\"" << g / 90.0 * R
+  const int ring = span > 90 ? 30 : 15;
+  for (int g = ring; g <= span + 1e-9; g += ring) {
+    h << "<circle cx=\"" << cx << "\" cy=\"" << cy << "\" r=\"" << g / span * R
       << "\" fill=\"none\" stroke=\"#bbb\"/>\n";
-    h << "<text x=\"" << cx + g / 90.0 * R + 2 << "\" y=\"" << cy - 3 << "\" fill=\"#666\">" << g
+    h << "<text x=\"" << cx + g / span * R + 2 << "\" y=\"" << cy - 3 << "\" fill=\"#666\">" << g
       << "\u00B0</text>\n";
   }
   for (int c = 0; c < 360; c += 30) {
-    const auto e = at(c, 90), t = at(c, 90 + 22 / R * 90);
+    const auto e = at(c, span), t = at(c, span + 22 / R * span);
     h << "<line x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << e.first << "\" y2=\"" << e.second
       << "\" stroke=\"#ccc\"/><text x=\"" << t.first << "\" y=\"" << t.second + 3
       << "\" text-anchor=\"middle\">C" << c << "</text>\n";
@@ -306,7 +307,8 @@ void IsoCandela(Page& p) {
   h << "</svg><figcaption>Iso-candela lines at 10 %, 20 %, &hellip; 90 % of the peak ("
     << Fmt(p.Scale(peak), 4) << " " << r.IntensityUnit()
     << "; blue 10 % to red 90 %, 10 % and 50 % bold): azimuthal map, &gamma; radially (rings "
-       "every 15&deg;), C as labelled. Grey: not seen.</figcaption></figure></section>\n";
+       "every "
+    << ring << "&deg;), C as labelled. Grey: not seen.</figcaption></figure></section>\n";
 }
 
 void Planes(Page& p) {
@@ -513,8 +515,8 @@ void Metadata(Page& p) {
   h << "<tr><th class=l>report generated</th><td class=l>" << p.r.generated_utc << " by "
     << XmlEscape(p.r.software) << "</td></tr>\n";
   h << "<tr><th class=l>far field</th><td class=l>C 0&ndash;360&deg; by "
-    << Num(p.r.distribution.c_deg[1] - p.r.distribution.c_deg[0], 4)
-    << "&deg;, &gamma; 0&ndash;90&deg; by "
+    << Num(p.r.distribution.c_deg[1] - p.r.distribution.c_deg[0], 4) << "&deg;, &gamma; 0&ndash;"
+    << Num(p.r.gamma_span_deg, 4) << "&deg; by "
     << Num(p.r.distribution.gamma_deg[1] - p.r.distribution.gamma_deg[0], 4)
     << "&deg;; &gamma; = 0 along +z (towards the screen), C = 0 towards +x, C = 90 towards "
        "&minus;y (LM-63: counter-clockwise looking along &gamma; = 0)</td></tr>\n";

@@ -323,8 +323,11 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
     front = FrontOrientation(luminaire->set);
     r.slab_dir = luminaire->slabs[front].slab_dir;
     if (luminaire->set.coverage == "sphere") r.gamma_span_deg = 180;
+    r.measured = o.slab + " (luminaire folder: " + luminaire->Orientations() +
+                 "; planes and colour from " + r.slab_dir + ")";
   } else {
     r.slab_dir = ResolveSlabDir(o.slab);
+    r.measured = r.slab_dir;
   }
   r.dataset_dir = DatasetOfSlab(r.slab_dir);
   r.info = SlabInfo::Load(r.slab_dir);
@@ -395,8 +398,9 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   if (luminaire) AddLuminaireMetadata(*luminaire, front, o.slab, &r);
   AddMetadata(&r);
   LogInfo("report: flux ", Num(r.summary.total_flux, 6), " ", r.FluxUnit(), ", seen to gamma ",
-          Num(r.seen_cone_deg, 4), " deg (", Num(100 * r.seen_fraction, 3),
-          " % of the hemisphere), peak ", Num(r.summary.peak, 6), " ", r.IntensityUnit());
+          Num(r.seen_cone_deg, 4), " deg (", Num(100 * r.seen_fraction, 3), " % of the ",
+          r.gamma_span_deg > 90 ? "sphere" : "hemisphere", "), peak ", Num(r.summary.peak, 6), " ",
+          r.IntensityUnit());
   return r;
 }
 

@@ -68,6 +68,9 @@ struct ReportColour {
 
 struct ReportData {
   std::string title, slab_dir, dataset_dir, generated_utc, software;
+  // What the report is of, for its heading: the slab folder, or the luminaire folder with its
+  // orientations and the one whose near field the planes show.
+  std::string measured;
   SlabInfo info;
   IntensityDistribution distribution;  // C 0-360, gamma 0-90 (cd or W/sr)
   std::vector<uint8_t> seen;           // per value of `distribution`

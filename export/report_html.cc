@@ -44,8 +44,14 @@ struct Page {
   }
 };
 
-std::string SpreadText(double angle, double at_least) {
-  return std::isfinite(angle) ? Deg(angle) : "&gt; " + Deg(at_least) + " (edge not seen)";
+// An edge of the pair's spread, or why there is none: beyond the seen cone it is unknown; with
+// every direction to gamma 180 seen (a luminaire folder's sphere) the light never falls to the
+// level there.
+std::string SpreadText(const ReportData& r, double angle, double at_least, const char* level) {
+  if (std::isfinite(angle)) return Deg(angle);
+  if (r.seen_cone_deg >= 180 - 1e-6)
+    return std::string("none (above ") + level + " of the peak to &gamma; 180&deg;)";
+  return "&gt; " + Deg(at_least) + " (edge not seen)";
 }
 
 std::string PairName(double c) { return "C" + Num(c, 4) + "\u2013C" + Num(c + 180, 4); }
@@ -71,8 +77,8 @@ void Summary(Page& p) {
                             Num(100 * r.uncertainty.PeakExpanded(), 2) + " % (k = 2)");
   for (const BeamSpread& b : s.spreads) {
     row("Beam / field angle " + PairName(b.c_deg),
-        SpreadText(b.beam_deg, b.beam_at_least_deg) + " / " +
-            SpreadText(b.field_deg, b.field_at_least_deg) + "; NEMA type " +
+        SpreadText(r, b.beam_deg, b.beam_at_least_deg, "50 %") + " / " +
+            SpreadText(r, b.field_deg, b.field_at_least_deg, "10 %") + "; NEMA type " +
             (std::isfinite(b.field_deg) && NemaBeamType(b.field_deg) > 0
                  ? std::to_string(NemaBeamType(b.field_deg))
                  : std::string("\u2014")));
@@ -127,8 +133,8 @@ void SpreadTable(Page& p) {
     if (!BeamSpreadOfPair(d, r.seen, c, &b)) continue;
     const int nema = NemaBeamType(b.field_deg);
     h << "<tr><td class=l>" << PairName(c) << "</td><td>" << Fmt(p.Scale(b.peak), 4) << "</td><td>"
-      << SpreadText(b.beam_deg, b.beam_at_least_deg) << "</td><td>"
-      << SpreadText(b.field_deg, b.field_at_least_deg) << "</td><td>"
+      << SpreadText(p.r, b.beam_deg, b.beam_at_least_deg, "50 %") << "</td><td>"
+      << SpreadText(p.r, b.field_deg, b.field_at_least_deg, "10 %") << "</td><td>"
       << (nema > 0 ? std::to_string(nema) : "\u2014") << "</td></tr>\n";
   }
   h << "</table><p class=note>Edges: the first crossing of 50 % and 10 % of the pair's peak "
@@ -530,7 +536,7 @@ std::string ReportHtml(const ReportData& data) {
   auto& h = p.html;
   h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
     << XmlEscape(data.title) << "</title><style>" << kCss << "</style></head><body>\n";
-  h << "<h1>" << XmlEscape(data.title) << "</h1><p class=note>" << XmlEscape(data.slab_dir)
+  h << "<h1>" << XmlEscape(data.title) << "</h1><p class=note>" << XmlEscape(data.measured)
     << " &middot; " << data.generated_utc << " &middot; " << XmlEscape(data.software) << "</p>\n";
   Summary(p);
   SpreadTable(p);

@@ -2,13 +2,19 @@
 # Process a luminaire folder (docs/formats.md §19: luminaire.json and one dataset folder per
 # orientation) into one light field and its exports, stopping at the first failing stage
 # (set -e); a rerun resumes where it stopped (stages skip finished outputs; --force redoes them).
-#   pipelines/process-luminaire.sh <lum> [--force] [--threads n] [reconstruct's options]
+#   pipelines/process-luminaire.sh <lum> [--force] [--threads n] [--reference <reading.json>]
+#       [--metadata <keywords.json>] [reconstruct's options]
 # Each orientation's dataset goes through pipelines/process-folder.sh (its calibrations,
-# reconstruct, previews; reconstruct's options --resolution, --lambda, ... are passed through),
+# reconstruct, previews; reconstruct's options --resolution, --lambda, ... are passed through;
+# --reference names each orientation's meter reading relative to its dataset folder, e.g.
+# truth/reference.json of `acquire synth --meter lux`, for calibrate scale: IES and EULUMDAT need
+# lux slabs),
 # then `lumislab-calibrate orientations` registers the orientations (<lum>/registration.json;
 # exit 2 naming the pair when their overlaps are too small or disagree), then the luminaire's
 # exports are written from the merged light field into <lum>/exports/: luminaire.ies,
-# luminaire.ldt, luminaire.tm25 and report.html (lumislab-export reading a luminaire folder).
+# luminaire.ldt, luminaire.tm25 and report.html (lumislab-export reading a luminaire folder),
+# with the file keywords of --metadata (lumislab-export's --metadata: LM-63 requires [TEST],
+# [TESTLAB], [ISSUEDATE], [MANUFAC]).
 set -euo pipefail
 usage() {
   awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0" >&2
@@ -20,7 +26,7 @@ here="$(cd "$(dirname "$0")" && pwd)"
 bin="${LUMISLAB_BIN:-$(cd "$here/.." && pwd)/build/bin}"
 lum="${1%/}"
 shift
-force=() threads=() folder_args=()
+force=() threads=() folder_args=() export_args=() reference=
 while [ $# -gt 0 ]; do
   case "$1" in
     -h | --help) usage ;;
@@ -28,6 +34,11 @@ while [ $# -gt 0 ]; do
     --threads)
       [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
       threads=(--threads "$2")
+      shift 2
+      ;;
+    --reference | --metadata)
+      [ $# -ge 2 ] || { echo "$0: $1 needs a value" >&2; exit 2; }
+      if [ "$1" = --reference ]; then reference="$2"; else export_args=(--metadata "$2"); fi
       shift 2
       ;;
     --resolution | --lambda | --samples-per-texel | --bracket-ratios | --full-well | --read-noise)
@@ -48,8 +59,10 @@ for o in json.load(open(sys.argv[1]))["orientations"]:
 [ ${#datasets[@]} -gt 0 ] || { echo "$0: $lum/luminaire.json: no orientations" >&2; exit 2; }
 for d in "${datasets[@]}"; do
   echo "== orientation dataset $lum/$d"
-  LUMISLAB_BIN="$bin" "$here/process-folder.sh" "$lum/$d" "${folder_args[@]}" "${threads[@]}" \
-    "${force[@]}"
+  reading=()
+  [ -z "$reference" ] || reading=(--reference "$lum/$d/$reference")
+  LUMISLAB_BIN="$bin" "$here/process-folder.sh" "$lum/$d" "${reading[@]}" "${folder_args[@]}" \
+    "${threads[@]}" "${force[@]}"
 done
 
 echo "== registration"
@@ -61,15 +74,16 @@ fi
 
 echo "== exports"
 mkdir -p "$lum/exports"
-export_one() {  # export_one <subcommand> <file>: skipped when the file exists, unless --force
+export_one() {  # export_one <subcommand> <file> [args]: skipped when the file exists, unless --force
   if [ -f "$lum/exports/$2" ] && [ ${#force[@]} -eq 0 ]; then
     echo "$lum/exports/$2: exists (--force redoes it)"
     return
   fi
-  "$bin/lumislab-export" "$1" --slab "$lum" --out "$lum/exports/$2" "${threads[@]}" "${force[@]}"
+  "$bin/lumislab-export" "$1" --slab "$lum" --out "$lum/exports/$2" "${@:3}" "${threads[@]}" \
+    "${force[@]}"
 }
-export_one ies luminaire.ies
-export_one ldt luminaire.ldt
+export_one ies luminaire.ies "${export_args[@]}"
+export_one ldt luminaire.ldt "${export_args[@]}"
 export_one tm25 luminaire.tm25
 export_one report report.html
 echo "registration: $lum/registration.json"

@@ -250,24 +250,11 @@ SynthReport RunSynth(const SynthScene& scene, const SynthOptions& options) {
   }
   // Offline: into a staging folder beside `out`, swapped in when complete, so that a failure, a
   // stop signal or a --force over a good dataset leaves the previous folder as it was.
-  const fs::path parent = fs::absolute(out).parent_path();
-  MakeDirectories(parent.string());
-  if (const int n = RemoveOrphanedTemporaries(parent.string()))
-    LogInfo(parent.string(), ": removed ", n, " staging folder(s) of an interrupted run");
-  const std::string staging = TemporaryPathFor(out);
-  try {
-    report.photos_written = WriteDataset(scene, dataset, staging, options, store, threads);
-    if (StopRequested()) {
-      fs::remove_all(staging);
-      report.photos_written = 0;
-      return report;
-    }
-    ReplaceFolder(staging, out);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(staging, ec);
-    throw;
-  }
+  if (!WriteFolderStaged(out, [&](const std::string& staging) {
+        report.photos_written = WriteDataset(scene, dataset, staging, options, store, threads);
+        return !StopRequested();
+      }))
+    report.photos_written = 0;
   return report;
 }
 

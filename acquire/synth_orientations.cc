@@ -200,24 +200,11 @@ SynthOrientationsReport RunSynthOrientations(const SynthScene& scene, const Synt
     return report;
   }
   // As RunSynth: staged beside `out`, swapped in when complete.
-  const fs::path parent = fs::absolute(out).parent_path();
-  MakeDirectories(parent.string());
-  if (const int n = RemoveOrphanedTemporaries(parent.string()))
-    LogInfo(parent.string(), ": removed ", n, " staging folder(s) of an interrupted run");
-  const std::string staging = TemporaryPathFor(out);
-  try {
-    WriteLuminaireFolder(scene, options, o, set, poses, staging, &report);
-    if (StopRequested()) {
-      fs::remove_all(staging);
-      report.orientations.clear();
-      return report;
-    }
-    ReplaceFolder(staging, out);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(staging, ec);
-    throw;
-  }
+  if (!WriteFolderStaged(out, [&](const std::string& staging) {
+        WriteLuminaireFolder(scene, options, o, set, poses, staging, &report);
+        return !StopRequested();
+      }))
+    report.orientations.clear();
   return report;
 }
 

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/log.h"
 
 namespace fs = std::filesystem;
 
@@ -136,6 +137,28 @@ std::string ReadTextFile(const std::string& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+bool WriteFolderStaged(const std::string& final_dir,
+                       const std::function<bool(const std::string& staging)>& write) {
+  const fs::path parent = fs::absolute(final_dir).parent_path();
+  MakeDirectories(parent.string());
+  if (const int n = RemoveOrphanedTemporaries(parent.string()))
+    LogInfo(parent.string(), ": removed ", n, " staging folder(s) of an interrupted run");
+  const std::string staging = TemporaryPathFor(final_dir);
+  try {
+    if (!write(staging)) {
+      std::error_code ec;
+      fs::remove_all(staging, ec);
+      return false;
+    }
+    ReplaceFolder(staging, final_dir);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(staging, ec);
+    throw;
+  }
+  return true;
 }
 
 void ReplaceFolder(const std::string& staging, const std::string& final_dir) {

@@ -38,6 +38,13 @@ std::string ReadTextFile(const std::string& path);  // IoError when missing/unre
 // Puts the finished folder `staging` where `final_dir` is: an old folder there is moved aside
 // first and removed only once the new one is in place (restored if the move fails; IoError).
 void ReplaceFolder(const std::string& staging, const std::string& final_dir);
+// Writes the folder `final_dir` through a staging folder beside it (orphaned staging folders of
+// interrupted runs there removed first, logged): write(staging) fills it; when it returns true
+// the staging folder replaces `final_dir` (ReplaceFolder); when it returns false (a stop signal)
+// or throws, the staging folder is removed and `final_dir` is left as it was. Returns what
+// write returned.
+bool WriteFolderStaged(const std::string& final_dir,
+                       const std::function<bool(const std::string& staging)>& write);
 bool IsTemporaryName(const std::string& filename);  // starts with '.'
 void MakeDirectories(const std::string& dir);       // IoError on failure
 

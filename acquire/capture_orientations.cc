@@ -62,27 +62,9 @@ class FolderLock {
 }  // namespace
 
 LuminaireSet LoadOrientationPlan(const std::string& plan_file) {
-  // LoadLuminaireSet reads a folder's luminaire.json: the plan is read through a copy in a
-  // scratch folder, and its errors name the plan file.
-  CheckInputFile(plan_file, "orientation plan");
-  const std::string text = ReadTextFile(plan_file);
-  const fs::path scratch =
-      fs::temp_directory_path() / ("lumislab_plan_" + std::to_string(getpid()));
-  MakeDirectories(scratch.string());
-  WriteTextAtomically(LuminaireJsonPath(scratch.string()), text);
-  try {
-    LuminaireSet plan = LoadLuminaireSet(scratch.string());
-    fs::remove_all(scratch);
-    return plan;
-  } catch (const Error& e) {
-    std::error_code ec;
-    fs::remove_all(scratch, ec);
-    std::string what = e.what();
-    const std::string copy = LuminaireJsonPath(scratch.string());
-    for (size_t at = what.find(copy); at != std::string::npos; at = what.find(copy))
-      what.replace(at, copy.size(), plan_file);
-    throw Error(e.code(), what);
-  }
+  const fs::path path(plan_file);
+  return LoadLuminaireSetFile(plan_file,
+                              path.has_parent_path() ? path.parent_path().string() : ".");
 }
 
 void CheckPlanAgainstLab(const LuminaireSet& plan, const std::string& plan_file,

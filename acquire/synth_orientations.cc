@@ -98,29 +98,7 @@ LuminaireSet LoadOrientationsFile(const std::string& file) {
   if (fs::is_directory(path, ec)) return LoadLuminaireSet(file);
   if (path.filename() == "luminaire.json")
     return LoadLuminaireSet(path.has_parent_path() ? path.parent_path().string() : ".");
-  // Another name: read through LoadLuminaireSet from a private folder, its messages naming the
-  // file given.
-  CheckInputFile(file, "orientations file");
-  const std::string folder = TemporaryPathFor(file + ".d");
-  struct Remove {
-    std::string folder;
-    ~Remove() {
-      std::error_code ignored;
-      fs::remove_all(folder, ignored);
-    }
-  } remove{folder};
-  MakeDirectories(folder);
-  WriteTextAtomically(LuminaireJsonPath(folder), ReadTextFile(file));
-  try {
-    LuminaireSet set = LoadLuminaireSet(folder);
-    set.folder = path.has_parent_path() ? path.parent_path().string() : ".";
-    return set;
-  } catch (const Error& e) {
-    std::string message = e.what();
-    for (size_t at; (at = message.find(LuminaireJsonPath(folder))) != std::string::npos;)
-      message.replace(at, LuminaireJsonPath(folder).size(), file);
-    throw Error(e.code(), message);
-  }
+  return LoadLuminaireSetFile(file, path.has_parent_path() ? path.parent_path().string() : ".");
 }
 
 void SynthOrientationsOptions::Check() const {

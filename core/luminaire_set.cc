@@ -120,7 +120,13 @@ bool IsLuminaireFolder(const std::string& folder) {
 }
 
 LuminaireSet LoadLuminaireSet(const std::string& folder) {
-  const std::string path = LuminaireJsonPath(folder);
+  LuminaireSet set = LoadLuminaireSetFile(LuminaireJsonPath(folder), folder);
+  if (std::filesystem::exists(RegistrationJsonPath(folder)))
+    ApplyRegistration(RegistrationJsonPath(folder), &set);
+  return set;
+}
+
+LuminaireSet LoadLuminaireSetFile(const std::string& path, const std::string& folder) {
   CheckInputFile(path, "luminaire file");
   const JsonDocument doc = JsonDocument::Load(path);
   doc.CheckSchemaVersion(kLuminaireSetSchemaVersion);
@@ -151,12 +157,14 @@ LuminaireSet LoadLuminaireSet(const std::string& folder) {
     o.rotation = o.NominalRotation();
     set.orientations.push_back(std::move(o));
   }
-  if (std::filesystem::exists(RegistrationJsonPath(folder)))
-    ApplyRegistration(RegistrationJsonPath(folder), &set);
   return set;
 }
 
 void WriteLuminaireSet(const LuminaireSet& set) {
+  WriteLuminaireSetFile(set, LuminaireJsonPath(set.folder));
+}
+
+void WriteLuminaireSetFile(const LuminaireSet& set, const std::string& file) {
   nlohmann::json list = nlohmann::json::array();
   for (const Orientation& o : set.orientations) {
     nlohmann::json e = {

@@ -87,6 +87,11 @@ bool IsLuminaireFolder(const std::string& folder);
 LuminaireSet LoadLuminaireSet(const std::string& folder);
 // Writes luminaire.json (atomically; the registered poses are not part of it).
 void WriteLuminaireSet(const LuminaireSet& set);
+// The same content under any file name (a plan: `lumislab-plan orientations --out`, read by
+// `acquire synth|capture --orientations`): read with `folder` as the set's folder and no
+// registration, errors naming `file`; written atomically.
+LuminaireSet LoadLuminaireSetFile(const std::string& file, const std::string& folder);
+void WriteLuminaireSetFile(const LuminaireSet& set, const std::string& file);
 // The path of the two files.
 std::string LuminaireJsonPath(const std::string& folder);
 std::string RegistrationJsonPath(const std::string& folder);

@@ -44,25 +44,11 @@ Dataset SetupOf(const OrientationsCommand& c) {
   return ds;
 }
 
-// luminaire.json's content under any file name: WriteLuminaireSet into a private folder beside
-// it, the file then renamed onto `file` (atomic as WriteLuminaireSet is).
+// luminaire.json's content under any file name, its datasets relative to the file's folder.
 void WritePlanFile(LuminaireSet set, const std::string& file) {
   const fs::path path(file);
   set.folder = path.has_parent_path() ? path.parent_path().string() : ".";
-  if (path.filename() == "luminaire.json") return WriteLuminaireSet(set);
-  const std::string folder = TemporaryPathFor(file + ".d");
-  MakeDirectories(folder);
-  set.folder = folder;
-  std::error_code ec;
-  try {
-    WriteLuminaireSet(set);
-    fs::rename(LuminaireJsonPath(folder), path, ec);
-    if (ec) throw IoError(file, "cannot rename " + LuminaireJsonPath(folder) + " onto it");
-  } catch (...) {
-    fs::remove_all(folder, ec);
-    throw;
-  }
-  fs::remove_all(folder, ec);
+  WriteLuminaireSetFile(set, file);
 }
 
 }  // namespace

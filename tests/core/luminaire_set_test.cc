@@ -21,7 +21,7 @@ OrientationCone DefaultCone() { return {750, 600 - 25, 600 - 20}; }
 
 std::vector<Eigen::Matrix3d> CubeFaces() {
   std::vector<Eigen::Matrix3d> poses;
-  for (const Eigen::Vector3d deg :
+  for (const Eigen::Vector3d& deg :
        {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 90, 0), Eigen::Vector3d(0, 180, 0),
         Eigen::Vector3d(0, -90, 0), Eigen::Vector3d(90, 0, 0), Eigen::Vector3d(-90, 0, 0)})
     poses.push_back(RotationZyxDegrees(deg));
@@ -135,7 +135,7 @@ TEST(LuminaireSet, RefusesDatasetsOutsideTheFolder) {
 }
 
 TEST(Geometry, RotationZyxDegreesRoundTrips) {
-  for (const Eigen::Vector3d deg :
+  for (const Eigen::Vector3d& deg :
        {Eigen::Vector3d(10, -20, 30), Eigen::Vector3d(-170, 80, 5), Eigen::Vector3d(0, 0, 0)})
     EXPECT_TRUE(RotationZyxDegreesOf(RotationZyxDegrees(deg)).isApprox(deg, 1e-9)) << deg;
   const Eigen::Matrix3d locked = RotationZyxDegrees({20, 90, 50});

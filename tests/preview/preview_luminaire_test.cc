@@ -206,7 +206,9 @@ TEST(PreviewLuminaire, AllOrientationsLightTheWholeSphere) {
                 v.name, e, Peak(single), Peak(analytic));
     EXPECT_GT(Peak(analytic), 0) << v.name;
     EXPECT_LT(e, 0.01) << v.name;
-    if (std::string(v.name) == "behind") EXPECT_EQ(Peak(single), 0) << "one slab lights behind S";
+    if (std::string(v.name) == "behind") {
+      EXPECT_EQ(Peak(single), 0) << "one slab lights behind S";
+    }
   }
   // The false-colour view of the whole luminaire in a room (shadows: every position's map).
   const std::string png = Scratch("crypt_false_colour.png");

@@ -269,7 +269,7 @@ TEST(SceneFile, FullSphereLuminaireTurnsIntoOrientations) {
     return sum;
   };
   // Light in every direction, behind S included.
-  for (const Eigen::Vector3d w :
+  for (const Eigen::Vector3d& w :
        {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(1, 0, 0),
         Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0)})
     EXPECT_GT(intensity(lum, w).sum(), 0.5) << w.transpose();

@@ -61,7 +61,24 @@ void ApplyRegistration(const std::string& path, LuminaireSet* set) {
     if (!done.insert(name).second) e["name"].Fail("each orientation once");
     it->rotation = RotationMatrix(e["rotation_matrix"]);
     it->registered = true;
-    if (e.Has("correction_deg")) it->correction_deg = Vector3(e["correction_deg"], 180);
+    if (e.Has("correction_deg")) {
+      it->correction_deg = Vector3(e["correction_deg"], 180);
+      // The correction it states must be its rotation over luminaire.json's nominal pose: a
+      // registration made for other nominal poses (luminaire.json edited since) is stale.
+      const Eigen::AngleAxisd stated(it->correction_deg.norm() / kDeg,
+                                     it->correction_deg.norm() > 0
+                                         ? Eigen::Vector3d(it->correction_deg.normalized())
+                                         : Eigen::Vector3d::UnitX());
+      const Eigen::Matrix3d implied = it->rotation * it->NominalRotation().transpose();
+      const double mismatch_deg =
+          Eigen::AngleAxisd(stated.toRotationMatrix().transpose() * implied).angle() * kDeg;
+      if (!(mismatch_deg < 0.01))
+        e["correction_deg"].Fail(
+            "the rotation over luminaire.json's nominal pose of " + name + " (it differs by " +
+            std::to_string(mismatch_deg) +
+            " deg: registration.json was made for other nominal poses; register again with "
+            "lumislab-calibrate orientations --force)");
+    }
     if (e.Has("sigma_deg")) {
       const JsonView s = e["sigma_deg"];
       if (s.Size() != 3) s.Fail("three numbers >= 0 or null (unconstrained)");
@@ -144,12 +161,27 @@ LuminaireSet LoadLuminaireSetFile(const std::string& path, const std::string& fo
     if (o.name.empty() || o.name.size() > 64 || !names.insert(o.name).second)
       e["name"].Fail("a unique name of 1 to 64 characters");
     o.dataset = e["dataset"].String();
+    // A plain relative path of named components ("o00", "a/o00"; a trailing '/' dropped), none
+    // of them the folder's own entries, and one folder per orientation: by name, and on disk
+    // where the folders exist (a symbolic link to another orientation's folder is the same one).
+    while (o.dataset.size() > 1 && o.dataset.back() == '/') o.dataset.pop_back();
     const std::filesystem::path rel(o.dataset);
-    if (o.dataset.empty() || rel.is_absolute() ||
-        std::any_of(rel.begin(), rel.end(),
-                    [](const std::filesystem::path& p) { return p == ".." || p == "."; }) ||
-        !datasets.insert(rel.lexically_normal().string()).second)
-      e["dataset"].Fail("a folder inside the luminaire folder, one per orientation");
+    const std::string first = rel.empty() ? "" : rel.begin()->string();
+    const bool plain = !o.dataset.empty() && !rel.is_absolute() &&
+                       std::none_of(rel.begin(), rel.end(),
+                                    [](const std::filesystem::path& p) {
+                                      return p.empty() || p == ".." || p == ".";
+                                    }) &&
+                       first != "truth" && first != "capture" && first != "exports" &&
+                       first != "luminaire.json" && first != "registration.json";
+    std::error_code ec;
+    const std::filesystem::path on_disk =
+        std::filesystem::weakly_canonical(std::filesystem::path(folder) / rel, ec);
+    if (!plain || !datasets.insert(rel.lexically_normal().string()).second ||
+        (!ec && !datasets.insert("disk:" + on_disk.string()).second))
+      e["dataset"].Fail(
+          "a folder inside the luminaire folder, one per orientation, not truth, capture or "
+          "exports");
     o.rotation_deg = Vector3(e["rotation_deg"], 36000);
     o.centre_mm = Vector3(e["centre_mm"], 1e6);
     if (e.Has("mount")) o.mount = e["mount"].IntIn(0, 1000);

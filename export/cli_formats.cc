@@ -69,7 +69,7 @@ FarField SlabFarField(const Slab& slab, const std::vector<double>& c_deg,
     CheckFarFieldLight(ff, slab.info, slab.dir, checks);
     return ff;
   }
-  MergedFarField merged = ComputeMergedFarField(slab.luminaire->slabs, c_deg, gamma_deg, options);
+  MergedFarField merged = MergedFarFieldChecked(*slab.luminaire, c_deg, gamma_deg, options);
   for (const MergedFarField::PairScale& p : merged.pair_scales)
     if (state_scales)
       LogInfo("scale across orientations: ", slab.luminaire->slabs[size_t(p.b)].name, " / ",

@@ -170,7 +170,7 @@ PolarPlotData PolarData(const std::string& slab_dir, double gamma_step_deg, int 
     const LuminaireSource source = LoadLuminaireSource(o.slab_dir, threads, "export polar");
     LogInfo("luminaire ", o.slab_dir, ": ", source.Orientations());
     info = source.slabs.front().info;
-    far = ComputeMergedFarField(source.slabs, planes, gamma, options).ff;
+    far = MergedFarFieldChecked(source, planes, gamma, options).ff;
   } else {
     info = SlabInfo::Load(o.slab_dir);
     RequireCompleteSlab(info, o.slab_dir);

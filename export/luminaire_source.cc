@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "core/checks.h"
 #include "core/dataset.h"
@@ -20,6 +21,26 @@ std::string Sigma(double sigma_deg) {
 }
 
 }  // namespace
+
+MergedFarField MergedFarFieldChecked(const LuminaireSource& source,
+                                     const std::vector<double>& c_deg,
+                                     const std::vector<double>& gamma_deg,
+                                     const FarFieldOptions& options) {
+  MergedFarField merged = ComputeMergedFarField(source.slabs, c_deg, gamma_deg, options);
+  for (const MergedFarField::PairScale& p : merged.pair_scales) {
+    if (std::abs(p.ratio - 1) <= kMaxPairScaleDeviation) continue;
+    std::ostringstream why;
+    why << source.set.folder << ": orientations " << source.slabs[size_t(p.a)].name << " and "
+        << source.slabs[size_t(p.b)].name
+        << " disagree where both see the luminaire: " << source.slabs[size_t(p.b)].name << " / "
+        << source.slabs[size_t(p.a)].name << " = " << p.ratio << " over " << p.directions
+        << " grid directions (at most " << 100 * kMaxPairScaleDeviation
+        << " % apart): check each one's calib/scale.json and slab, and the poses ("
+        << RegisterCommand(source.set.folder) << ")";
+    throw BadInput(why.str());
+  }
+  return merged;
+}
 
 std::string RegisterCommand(const std::string& folder) {
   return "lumislab-calibrate orientations --luminaire " + folder;

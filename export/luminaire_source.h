@@ -52,6 +52,17 @@ FarFieldUncertainty LuminaireUncertainty(const LuminaireSource& source, int samp
 // text, or JSON with `json`.
 std::string LuminaireFolderInfo(const std::string& folder, bool json);
 
+// The merged far field of the folder's orientations (ComputeMergedFarField) on a C / gamma grid,
+// refused (exit 2 naming the pair, the folder and what to check) when two orientations'
+// intensities over the directions both weigh differ by more than kMaxPairScaleDeviation in flux:
+// a scale calibration, a slab or a pose that does not belong, which the blend would otherwise
+// hide in a wrong total.
+constexpr double kMaxPairScaleDeviation = 0.05;
+MergedFarField MergedFarFieldChecked(const LuminaireSource& source,
+                                     const std::vector<double>& c_deg,
+                                     const std::vector<double>& gamma_deg,
+                                     const FarFieldOptions& options);
+
 // The command that registers `folder` (its registration.json).
 std::string RegisterCommand(const std::string& folder);
 

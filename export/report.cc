@@ -349,7 +349,7 @@ ReportData MakeReportData(const ReportOptions& o, int threads) {
   ff_options.threads = threads;
   FarField ff;
   if (luminaire) {
-    ff = ComputeMergedFarField(luminaire->slabs, d.c_deg, d.gamma_deg, ff_options).ff;
+    ff = MergedFarFieldChecked(*luminaire, d.c_deg, d.gamma_deg, ff_options).ff;
   } else {
     ff = ComputeFarField(r.info, positions, d.c_deg, d.gamma_deg, ff_options);
     CheckFarFieldLight(ff, r.info, r.slab_dir, checks);

@@ -215,7 +215,7 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
       problem->SetParameterBlockConstant(corrections[0].data());
     if (problem->HasParameterBlock(profile.data())) {
       if (!fit_profile) problem->SetParameterBlockConstant(profile.data());
-      // g stays within [0.4, 1.9] over the cones (1 - cos theta <= 0.6): a far field off by more
+      // g stays within [0.5, 1.5] over the cones (1 - cos theta <= 0.6): a far field off by more
       // is not what the profile is for.
       for (int i = 0; i < kGainProfileTerms; ++i) {
         problem->SetParameterLowerBound(profile.data(), i, -0.5);

@@ -76,6 +76,16 @@ void PrintTable(const LuminaireSet& set, const Registration& r) {
                   p.rms_after, p.ratio);
     table << line;
   }
+  if (r.gain_profile_fitted) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "gain profile g(theta) = 1 %+.5f (1 - cos theta) %+.5f (1 - cos theta)^2 "
+                  "(sigma %.5f, %.5f): g(20) = %.4f, g(40) = %.4f, g(%.0f) = %.4f\n",
+                  r.gain_profile[0], r.gain_profile[1], r.gain_profile_sigma[0],
+                  r.gain_profile_sigma[1], r.Gain(20), r.Gain(40), r.gain_profile_theta_max_deg,
+                  r.Gain(r.gain_profile_theta_max_deg));
+    table << line;
+  }
   std::printf("%s", table.str().c_str());
 }
 
@@ -90,6 +100,14 @@ std::string RegistrationJson(const LuminaireSet& set, const Registration& r,
   j["residual_sigma"] = r.residual_sigma;
   j["residuals"] = r.residuals;
   j["converged"] = r.converged;
+  if (r.gain_profile_fitted) {
+    nlohmann::json g;
+    g["model"] = "1 + p1 (1 - cos theta) + p2 (1 - cos theta)^2";
+    g["p"] = {r.gain_profile[0], r.gain_profile[1]};
+    g["sigma"] = {r.gain_profile_sigma[0], r.gain_profile_sigma[1]};
+    g["theta_max_deg"] = r.gain_profile_theta_max_deg;
+    j["gain_profile"] = g;
+  }
   j["orientations"] = nlohmann::json::array();
   for (size_t k = 0; k < r.orientations.size(); ++k) {
     const RegisteredOrientation& o = r.orientations[k];
@@ -134,6 +152,10 @@ void AddOrientationsCommand(CLI::App* app, CommonOptions* common, OrientationsCo
                    "refuse a pair whose relative RMS difference over its overlap stays above "
                    "this after the fit")
       ->capture_default_str();
+  c->sub->add_flag("--gain-profile", c->options.fit_gain_profile,
+                   "also fit a gain profile g(theta) = 1 + p1 (1 - cos theta) + p2 (1 - cos "
+                   "theta)^2 of the angle from the capture axis, shared by every orientation "
+                   "(needs three pairs or more; reported, not applied)");
   c->sub->add_flag("--force", c->force, "replace an existing registration.json");
   AddCommonOptions(c->sub, common);
 }
@@ -144,6 +166,7 @@ int RunOrientationsCommand(OrientationsCommand* c, int threads) {
   c->luminaire = TrimTrailingSlashes(c->luminaire);
   LogInfo("parameters: orientations luminaire=", c->luminaire,
           " max-relative-rms=", Num(c->options.max_relative_rms),
+          " gain-profile=", c->options.fit_gain_profile ? "yes" : "no",
           " force=", c->force ? "yes" : "no");
   const LuminaireSet set = LoadLuminaireSet(c->luminaire);
   const std::string out = RegistrationJsonPath(c->luminaire);

@@ -26,6 +26,12 @@ constexpr int kMinPairSamples = 20;
 // luminaire. No small sigma is reported for what the overlaps do not fix.
 constexpr double kFreeCurvatureRatio = 1e-12;
 constexpr double kFreeSigmaDeg = 10.0;
+// The gain profile is fitted when at least this many pairs are compared. Across one overlap it
+// is seen only as the ratio g(theta_a) / g(theta_b) over one band of directions, which trades
+// off against a tilt of the luminaire's lobes there (and, fitted to the slabs' other errors,
+// would make a rotation the luminaire's symmetry leaves free look constrained); three pairs
+// see each capture angle against several others.
+constexpr int kMinGainProfilePairs = 3;
 
 std::vector<Eigen::Vector3d> FibonacciSphere(int n) {
   std::vector<Eigen::Vector3d> out(static_cast<size_t>(n));
@@ -55,6 +61,7 @@ struct PairSamples {
   double overlap_sr = 0;
   std::vector<Eigen::Vector3d> directions;  // luminaire frame
   double scale = 0;                         // mean of (I_a + I_b) / 2 where selected
+  double theta_max_deg = 0;  // the largest angle from either capture axis among the directions
 };
 
 Eigen::Matrix3d Refined(const RegistrationInput& in, const double* c) {
@@ -74,17 +81,25 @@ PairSamples SelectSamples(const std::vector<Eigen::Vector3d>& sphere, const Samp
     if (!a.input->far_field.SeenAround(v_a) || !b.input->far_field.SeenAround(v_b)) continue;
     out.directions.push_back(w);
     sum += 0.5 * (a.At(v_a) + b.At(v_b));
+    out.theta_max_deg =
+        std::max(out.theta_max_deg, std::acos(std::min({1.0, v_a.z(), v_b.z()})) * kDegPerRad);
   }
   if (!out.directions.empty()) out.scale = sum / double(out.directions.size());
   return out;
 }
 
-// Relative RMS of I_a - I_b and the ratio sum I_a / sum I_b over the samples at poses r_a, r_b.
+// Relative RMS of I_a - I_b and the ratio sum I_a / sum I_b over the samples at poses r_a, r_b,
+// each I divided by the gain profile (overlap_cost.h) at its angle from its capture axis.
 void ComparePair(const PairSamples& s, const Sampler& a, const Eigen::Matrix3d& r_a,
-                 const Sampler& b, const Eigen::Matrix3d& r_b, double* rms, double* ratio) {
+                 const Sampler& b, const Eigen::Matrix3d& r_b, const double* profile, double* rms,
+                 double* ratio) {
   double sum_a = 0, sum_b = 0, sum2 = 0;
   for (const Eigen::Vector3d& w : s.directions) {
-    const double i_a = a.At(r_a * w), i_b = b.At(r_b * w);
+    const Eigen::Vector3d v_a = r_a * w, v_b = r_b * w;
+    const double g_a = GainProfile(profile, v_a.z()), g_b = GainProfile(profile, v_b.z());
+    // As the cost compares them (overlap_cost.h): divided by g, scaled back by the mean gain.
+    const double i_a = a.At(v_a) / g_a * 0.5 * (g_a + g_b);
+    const double i_b = b.At(v_b) / g_b * 0.5 * (g_a + g_b);
     sum_a += i_a;
     sum_b += i_b;
     sum2 += (i_a - i_b) * (i_a - i_b);
@@ -94,7 +109,25 @@ void ComparePair(const PairSamples& s, const Sampler& a, const Eigen::Matrix3d& 
   *ratio = sum_b > 0 ? sum_a / sum_b : 0;
 }
 
+// The symmetric positive semi-definite m's pseudo-inverse on its eigen-directions above
+// kFreeCurvatureRatio of its largest eigenvalue.
+Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(m.rows(), m.cols());
+  if (m.size() == 0) return out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(m);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  for (int i = 0; i < eigen.eigenvalues().size(); ++i)
+    if (eigen.eigenvalues()(i) > kFreeCurvatureRatio * largest)
+      out += eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose() /
+             eigen.eigenvalues()(i);
+  return out;
+}
+
 }  // namespace
+
+double Registration::Gain(double theta_deg) const {
+  return GainProfile(gain_profile.data(), std::cos(theta_deg / kDegPerRad));
+}
 
 void RegistrationOptions::Check() const {
   if (directions < 1000)
@@ -141,6 +174,8 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
   };
 
   Registration out;
+  // The gain profile's coefficients (g = 1 at the start, and throughout when not fitted).
+  std::array<double, kGainProfileTerms> profile = {0.0, 0.0};
   std::vector<PairSamples> pairs = select();
   for (const PairSamples& s : pairs) {
     RegisteredPair r;
@@ -148,15 +183,21 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     r.b = s.b;
     r.overlap_sr = s.overlap_sr;
     ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
-                &r.rms_before, &r.ratio);
+                profile.data(), &r.rms_before, &r.ratio);
     out.pairs.push_back(r);
   }
 
   // Two rounds: the samples chosen at the nominal poses, then again at the refined ones (a
   // correction of a few degrees moves directions across the cones' margins).
   std::unique_ptr<ceres::Problem> problem;
+  bool fit_profile = false;
   for (int round = 0; round < 2; ++round) {
     if (round > 0) pairs = select();
+    int compared = 0;
+    for (const PairSamples& s : pairs)
+      compared += int(s.directions.size()) >= kMinPairSamples && s.scale > 0;
+    fit_profile = options.fit_gain_profile && compared >= kMinGainProfilePairs;
+    if (!fit_profile) profile = {0.0, 0.0};
     problem = std::make_unique<ceres::Problem>();
     for (const PairSamples& s : pairs) {
       if (int(s.directions.size()) < kMinPairSamples || !(s.scale > 0)) continue;
@@ -168,10 +209,19 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
                                 a.nominal * w, &b.far_field,
                                 samplers[size_t(s.b)].interpolator.get(), b.nominal * w, s.scale),
             new ceres::HuberLoss(options.loss_scale), corrections[size_t(s.a)].data(),
-            corrections[size_t(s.b)].data());
+            corrections[size_t(s.b)].data(), profile.data());
     }
     if (problem->HasParameterBlock(corrections[0].data()))
       problem->SetParameterBlockConstant(corrections[0].data());
+    if (problem->HasParameterBlock(profile.data())) {
+      if (!fit_profile) problem->SetParameterBlockConstant(profile.data());
+      // g stays within [0.5, 1.5] over the cones (1 - cos theta <= 0.6): a far field off by more
+      // is not what the profile is for.
+      for (int i = 0; i < kGainProfileTerms; ++i) {
+        problem->SetParameterLowerBound(profile.data(), i, -0.5);
+        problem->SetParameterUpperBound(profile.data(), i, 0.5);
+      }
+    }
     if (problem->NumResidualBlocks() == 0) break;
     ceres::Solver::Summary summary;
     ceres::Solve(RefinerSolverOptions(ceres::DENSE_QR, options.max_iterations, options.threads),
@@ -193,12 +243,14 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
       block_of[size_t(k)] = int(blocks.size());
       blocks.push_back(corrections[size_t(k)].data());
     }
+  fit_profile = fit_profile && !blocks.empty();
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(3 * blocks.size(), 3 * blocks.size());
   Eigen::VectorXd free_weight = Eigen::VectorXd::Zero(3 * blocks.size());
   std::vector<Eigen::VectorXd> free_vectors;
   if (!blocks.empty()) {
     ceres::Problem::EvaluateOptions evaluate;
     evaluate.parameter_blocks = blocks;
+    if (fit_profile) evaluate.parameter_blocks.push_back(profile.data());
     double cost = 0;
     std::vector<double> residuals;
     ceres::CRSMatrix crs;
@@ -211,7 +263,23 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     const double variance = 2.0 * cost / dof;
     out.residuals = crs.num_rows;
     out.residual_sigma = std::sqrt(variance);
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jacobian.transpose() * jacobian);
+    // The rotations' information with the gain profile marginalised out (its Schur complement),
+    // so that their sigmas include what the profile can take of the residuals; the profile's
+    // sigma likewise with the rotations' constrained directions marginalised out.
+    const long nr = 3 * long(blocks.size()), np = fit_profile ? kGainProfileTerms : 0;
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    Eigen::MatrixXd rotation_info = normal.topLeftCorner(nr, nr);
+    if (np > 0) {
+      const Eigen::MatrixXd h_rp = normal.topRightCorner(nr, np);
+      const Eigen::MatrixXd h_pp = normal.bottomRightCorner(np, np);
+      rotation_info -= h_rp * PseudoInverse(h_pp) * h_rp.transpose();
+      const Eigen::MatrixXd profile_cov =
+          variance * PseudoInverse(h_pp - h_rp.transpose() *
+                                              PseudoInverse(normal.topLeftCorner(nr, nr)) * h_rp);
+      for (int i = 0; i < kGainProfileTerms; ++i)
+        out.gain_profile_sigma[size_t(i)] = std::sqrt(std::max(0.0, profile_cov(i, i)));
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(rotation_info);
     const double largest = eigen.eigenvalues().maxCoeff();
     const double free_sigma_rad = kFreeSigmaDeg / kDegPerRad;
     for (int i = 0; i < eigen.eigenvalues().size(); ++i) {
@@ -242,8 +310,12 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
       if (s.a == r.a && s.b == r.b) {
         r.samples = int(s.directions.size());
         ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
-                    &r.rms_after, &r.ratio);
+                    profile.data(), &r.rms_after, &r.ratio);
       }
+  out.gain_profile_fitted = fit_profile;
+  out.gain_profile = profile;
+  for (const PairSamples& s : pairs)
+    out.gain_profile_theta_max_deg = std::max(out.gain_profile_theta_max_deg, s.theta_max_deg);
 
   for (int k = 0; k < count; ++k) {
     RegisteredOrientation& o = out.orientations[size_t(k)];

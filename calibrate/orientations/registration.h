@@ -25,6 +25,11 @@ struct RegistrationOptions {
   double nodes_per_tan = 30;  // far-field grid density (nodes per unit of x/z)
   double loss_scale = 0.05;   // Huber scale of the relative residuals
   double max_relative_rms = kMaxOverlapRelativeRms;
+  // Fit the gain profile g(theta) shared by every orientation (overlap_cost.h) with the
+  // rotations, where at least three pairs are compared; false, or fewer pairs, holds g = 1.
+  // Off by default: the slabs' far-field error that limits the registration is not shared
+  // (docs/method.md §4.12, "Registration", and docs/results.md §13 measure it).
+  bool fit_gain_profile = false;
   int max_iterations = 100;
   int threads = 1;
   void Check() const;  // BadInput naming the field
@@ -54,14 +59,23 @@ struct RegisteredPair {
   double overlap_sr = 0;  // AnalyseCoverage's, at the nominal poses
   int samples = 0;        // directions compared after the fit
   double rms_before = 0;  // relative RMS of I_a - I_b over the pair's mean intensity, nominal
-  double rms_after = 0;   // the same at the refined poses
-  double ratio = 0;       // sum I_a / sum I_b over the samples, refined poses (checked, not fitted)
+  double rms_after = 0;   // the same at the refined poses, each I divided by the gain profile
+  double ratio = 0;       // sum I_a / sum I_b over the samples, refined poses and gain profile
+                          // (checked, not fitted)
 };
 
 struct Registration {
   std::vector<RegisteredOrientation> orientations;
   std::vector<RegisteredPair> pairs;
-  double residual_sigma = 0;  // the relative residuals' standard deviation after the fit
+  // The gain profile g(theta) = 1 + p_1 (1 - cos theta) + p_2 (1 - cos theta)^2 fitted with the
+  // rotations (overlap_cost.h; zeros when not fitted), its 1 sigma, and the largest angle theta
+  // from a capture axis among the samples compared (the profile is known up to there).
+  bool gain_profile_fitted = false;
+  std::array<double, 2> gain_profile = {0.0, 0.0};
+  std::array<double, 2> gain_profile_sigma = {0.0, 0.0};
+  double gain_profile_theta_max_deg = 0;
+  double Gain(double theta_deg) const;  // g(theta)
+  double residual_sigma = 0;            // the relative residuals' standard deviation after the fit
   int residuals = 0;
   int iterations = 0;
   bool converged = false;

@@ -2,8 +2,8 @@
 // --orientations` (docs/formats.md §19, the synthetic luminaire folder) photographs the built-in
 // full-sphere luminaire from three cube faces with mounting errors, each dataset goes through
 // calibrate screen and reconstruct, and the registration's relative rotations are compared with
-// truth/orientations.json. Written against synth's documented command line before it was merged:
-// DISABLED_ until the lead enables it with a measured tolerance (docs/results.md §13).
+// truth/orientations.json. Three faces, not six: six take twice as long for the same errors
+// (docs/results.md §13).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -21,9 +21,10 @@ using testing::FreshDir;
 using testing::RunTool;
 using testing::ShellQuote;
 
-// Not measured yet: the photo chain's far fields are further from the truth than truth slabs'
-// (docs/method.md §4.11: the demo's peak 2.4 %), so the relative rotations may be too.
-constexpr double kToleranceDeg = 0.3;
+// Measured 0.40 and 0.30 degrees (docs/results.md §13), as truth slabs of such datasets give: the
+// slabs' far-field ripple of this geometry (emitters 8 mm behind S, h = 5 mm), not the photo chain,
+// limits them (docs/method.md §4.12, "Registration").
+constexpr double kToleranceDeg = 0.6;
 
 Eigen::Matrix3d Rows(const nlohmann::json& rows) {
   Eigen::Matrix3d r;
@@ -32,7 +33,7 @@ Eigen::Matrix3d Rows(const nlohmann::json& rows) {
   return r;
 }
 
-TEST(OrientationsPhotoChain, DISABLED_ThreeFacesRegisterAgainstTheTruePoses) {
+TEST(OrientationsPhotoChain, ThreeFacesRegisterAgainstTheTruePoses) {
   if (testing::kSanitized) GTEST_SKIP() << "accuracy run: the Release build's";
   const std::string dir = FreshDir("orientations_photo_chain");
   // The built-in scene with smaller photos (the camera's field of view kept).
@@ -42,8 +43,8 @@ TEST(OrientationsPhotoChain, DISABLED_ThreeFacesRegisterAgainstTheTruePoses) {
                                       ShellQuote(dir + "/unused"));
   ASSERT_EQ(scene_json.exit_code, 0) << scene_json.output;
   nlohmann::json scene = nlohmann::json::parse(scene_json.output);
-  scene["camera"]["size_px"] = {800, 600};
-  scene["camera"]["focal_px"] = 350;
+  scene["camera"]["size_px"] = {640, 480};
+  scene["camera"]["focal_px"] = 280;
   std::ofstream(dir + "/scene.json") << scene.dump(2);
   // +z, +x and +y faces (each overlapping the two others), about the scene's luminaire centre.
   const nlohmann::json plan = {{"schema_version", 1},
@@ -63,10 +64,12 @@ TEST(OrientationsPhotoChain, DISABLED_ThreeFacesRegisterAgainstTheTruePoses) {
                                   {"centre_mm", {0, 0, -8}}}}}};
   std::ofstream(dir + "/plan.json") << plan.dump(2);
   const std::string lum = dir + "/lum";
-  const auto synth = RunTool(
-      "lumislab-acquire", "synth --scene " + ShellQuote(dir + "/scene.json") + " --orientations " +
-                              ShellQuote(dir + "/plan.json") +
-                              " --mount-error-deg 2 --seed 3 --threads 2 --out " + ShellQuote(lum));
+  const auto synth =
+      RunTool("lumislab-acquire",
+              "synth --scene " + ShellQuote(dir + "/scene.json") + " --orientations " +
+                  ShellQuote(dir + "/plan.json") +
+                  " --mount-error-deg 2 --seed 3 --truth-resolution 16 --threads 2 --out " +
+                  ShellQuote(lum));
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   for (const char* o : {"o00", "o01", "o02"}) {
     const std::string ds = ShellQuote(lum + "/" + o);

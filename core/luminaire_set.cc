@@ -208,10 +208,9 @@ void WriteLuminaireSetFile(const LuminaireSet& set, const std::string& file) {
     if (o.axis_deg) e["axis_deg"] = *o.axis_deg;
     list.push_back(std::move(e));
   }
-  WriteJsonAtomically(LuminaireJsonPath(set.folder),
-                      {{"schema_version", kLuminaireSetSchemaVersion},
-                       {"coverage", set.coverage},
-                       {"orientations", list}});
+  WriteJsonAtomically(file, {{"schema_version", kLuminaireSetSchemaVersion},
+                             {"coverage", set.coverage},
+                             {"orientations", list}});
 }
 
 CoverageReport AnalyseCoverage(const std::vector<Eigen::Matrix3d>& poses,

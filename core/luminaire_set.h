@@ -25,6 +25,10 @@ constexpr int kRegistrationSchemaVersion = 1;
 // Two orientations overlap enough to register when both see at least this solid angle with a
 // margin (a 10 x 10 degree patch).
 constexpr double kMinOverlapSr = 0.03;
+// Two orientations' intensities over the directions both see may differ by at most this
+// fraction in flux (their ratio within 1 +- 0.05): beyond it a scale calibration, a slab or a
+// pose does not belong, and the registration and the exports refuse the pair.
+constexpr double kMaxPairScaleDeviation = 0.05;
 // The taper's width (degrees of margin inside the cone over which an orientation's weight rises
 // from 0 to 1).
 constexpr double kDefaultTaperDeg = 4.0;

@@ -57,7 +57,6 @@ std::string LuminaireFolderInfo(const std::string& folder, bool json);
 // intensities over the directions both weigh differ by more than kMaxPairScaleDeviation in flux:
 // a scale calibration, a slab or a pose that does not belong, which the blend would otherwise
 // hide in a wrong total.
-constexpr double kMaxPairScaleDeviation = 0.05;
 MergedFarField MergedFarFieldChecked(const LuminaireSource& source,
                                      const std::vector<double>& c_deg,
                                      const std::vector<double>& gamma_deg,

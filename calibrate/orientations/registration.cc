@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/log.h"
+#include "core/luminaire_set.h"
 
 namespace lumislab {
 namespace {
@@ -25,6 +27,15 @@ constexpr int kMinPairSamples = 20;
 // far fields' own errors (a rotationally symmetric overlap still has some), not from the
 // luminaire. No small sigma is reported for what the overlaps do not fix.
 constexpr double kFreeCurvatureRatio = 1e-12;
+// Sample selection and fit repeat until a round changes no correction by more than this (deg),
+// in at most kMaxRounds rounds.
+constexpr double kRoundChangeDeg = 0.005;
+constexpr int kMaxRounds = 6;
+// The residuals are not independent: what remains after the fit is the slabs' far-field error,
+// which varies over tens of degrees (a ripple of period about h / z in tan(theta), docs/results.md
+// §13). Residuals within one cell of this size count as one measurement for the sigmas: the
+// covariance is scaled by (residuals / cells), cells = sum over pairs of overlap_sr / cell.
+constexpr double kCorrelationDeg = 15.0;
 constexpr double kFreeSigmaDeg = 10.0;
 // The gain profile is fitted when at least this many pairs are compared. Across one overlap it
 // is seen only as the ratio g(theta_a) / g(theta_b) over one band of directions, which trades
@@ -187,12 +198,35 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     out.pairs.push_back(r);
   }
 
-  // Two rounds: the samples chosen at the nominal poses, then again at the refined ones (a
-  // correction of a few degrees moves directions across the cones' margins).
+  // Rounds: the samples chosen at the nominal poses, then again at the refined ones (a
+  // correction of a few degrees moves directions across the cones' margins), until a round moves
+  // no correction by more than kRoundChangeDeg (at most kMaxRounds).
   std::unique_ptr<ceres::Problem> problem;
   bool fit_profile = false;
-  for (int round = 0; round < 2; ++round) {
-    if (round > 0) pairs = select();
+  std::vector<std::array<double, 3>> previous = corrections;
+  for (int round = 0; round < kMaxRounds; ++round) {
+    if (round > 0) {
+      double change = 0;
+      for (int k = 0; k < count; ++k)
+        change = std::max(change, (Eigen::Vector3d(corrections[size_t(k)].data()) -
+                                   Eigen::Vector3d(previous[size_t(k)].data()))
+                                          .norm() *
+                                      kDegPerRad);
+      if (round >= 2 && change < kRoundChangeDeg) break;
+      // Data that disagree are not chased further: after the second round, a pair beyond the
+      // threshold ends the rounds (the refusal below names it).
+      bool disagree = false;
+      for (const PairSamples& s : pairs) {
+        if (int(s.directions.size()) < kMinPairSamples || round < 2) continue;
+        double rms = 0, ratio = 1;
+        ComparePair(s, samplers[size_t(s.a)], pose(s.a), samplers[size_t(s.b)], pose(s.b),
+                    profile.data(), &rms, &ratio);
+        disagree = disagree || rms > options.max_relative_rms;
+      }
+      if (disagree) break;
+      previous = corrections;
+      pairs = select();
+    }
     int compared = 0;
     for (const PairSamples& s : pairs)
       compared += int(s.directions.size()) >= kMinPairSamples && s.scale > 0;
@@ -279,6 +313,13 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
       for (int i = 0; i < kGainProfileTerms; ++i)
         out.gain_profile_sigma[size_t(i)] = std::sqrt(std::max(0.0, profile_cov(i, i)));
     }
+    // Correlated residuals (kCorrelationDeg): the covariance of independent ones times the
+    // number of residuals per independent cell.
+    double cells = 0;
+    for (const PairSamples& s : pairs)
+      if (int(s.directions.size()) >= kMinPairSamples)
+        cells += std::max(1.0, s.overlap_sr / std::pow(kCorrelationDeg / kDegPerRad, 2));
+    const double correlation = std::max(1.0, crs.num_rows / std::max(1.0, cells));
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(rotation_info);
     const double largest = eigen.eigenvalues().maxCoeff();
     const double free_sigma_rad = kFreeSigmaDeg / kDegPerRad;
@@ -291,7 +332,7 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
         free_weight += v.cwiseAbs2();
         free_vectors.push_back(v);
       } else {
-        cov += variance / lambda * v * v.transpose();
+        cov += correlation * variance / lambda * v * v.transpose();
       }
     }
   }
@@ -346,6 +387,30 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
       const Eigen::Vector3d p = v.segment<3>(3 * j);
       if (p.norm() > 0.3) o.free_axes.push_back((o.rotation.transpose() * p).normalized());
     }
+  }
+
+  // Radiometric scales that disagree (a calibration of one orientation that does not belong)
+  // would otherwise be taken up by the rotations.
+  for (const RegisteredPair& r : out.pairs) {
+    if (r.samples < kMinPairSamples || std::abs(r.ratio - 1) <= kMaxPairScaleDeviation) continue;
+    if (!out.disagreement.empty()) out.disagreement += "; ";
+    out.disagreement += "orientations " + inputs[size_t(r.a)].name + " and " +
+                        inputs[size_t(r.b)].name + " disagree in scale: intensity ratio " +
+                        Num(r.ratio) + " over their overlap (at most " +
+                        Num(100 * kMaxPairScaleDeviation) +
+                        " % from 1): check each one's calib/scale.json and slab";
+  }
+  // An orientation compared with others whose rotation the overlaps fix in no direction: the
+  // fit cannot place it (its neighbours disagree with it everywhere).
+  for (int k = 1; k < count; ++k) {
+    const RegisteredOrientation& o = out.orientations[size_t(k)];
+    if (block_of[size_t(k)] < 0 ||
+        !(o.unconstrained[0] && o.unconstrained[1] && o.unconstrained[2]))
+      continue;
+    if (!out.disagreement.empty()) out.disagreement += "; ";
+    out.disagreement += "the overlaps fix the rotation of " + inputs[size_t(k)].name +
+                        " in no direction (residual sigma " + Num(out.residual_sigma) +
+                        "): its slab or its nominal pose does not fit its neighbours";
   }
 
   std::vector<int> disagreeing(static_cast<size_t>(count), 0);  // pairs each orientation is in

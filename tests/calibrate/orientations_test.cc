@@ -240,7 +240,10 @@ TEST(Orientations, CubeFacesRecoverTheRelativeRotations) {
                 o.sigma_deg.z());
     EXPECT_LT(error_deg, 0.1) << o.name;
     EXPECT_GT(nominal_error_deg, 1.0) << o.name;
-    for (int i = 0; i < 3; ++i) EXPECT_TRUE(o.sigma_deg(i) > 0 && o.sigma_deg(i) < 0.1) << o.name;
+    // The sigmas count the correlated residuals as few measurements (kCorrelationDeg): the
+    // error within them, and still a fraction of a degree.
+    for (int i = 0; i < 3; ++i) EXPECT_TRUE(o.sigma_deg(i) > 0 && o.sigma_deg(i) < 0.3) << o.name;
+    EXPECT_LT(error_deg, 3 * o.sigma_deg.norm()) << o.name;
   }
   // The file's pairs: the four neighbours of each face, agreeing after the fit.
   std::ifstream in(RegistrationJsonPath(dir));

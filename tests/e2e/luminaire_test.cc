@@ -27,7 +27,8 @@ using testing::RunShell;
 using testing::RunTool;
 using testing::ShellQuote;
 
-// Measured (docs/results.md §13): the relative rotations through photos, 60-texel slabs.
+// Measured (docs/results.md §13): 0.14 - 0.40 deg through photos (64 texels); what limits them
+// is the slabs' far-field ripple, not the fit.
 constexpr double kRotationToleranceDeg = 0.5;
 
 Eigen::Matrix3d Rows(const nlohmann::json& rows) {
@@ -116,10 +117,14 @@ TEST(Luminaire, PlannedOrientationsThroughPhotosGiveTheWholeLuminaire) {
     const Eigen::Matrix3d expected = Rows(truth[k]["rotation"]) * true_0.transpose();
     const double error_deg = Eigen::AngleAxisd(relative * expected.transpose()).angle() * 180 / kPi;
     const double mounting_deg = truth[k]["error_deg"].get<double>();
+    const double sigma_deg = set.orientations[k].sigma_deg.norm();
     std::cout << set.orientations[k].name << ": mounting error " << mounting_deg
-              << " deg, registered to within " << error_deg << " deg\n";
+              << " deg, registered to within " << error_deg << " deg (stated 1-sigma " << sigma_deg
+              << " deg)\n";
     EXPECT_GE(mounting_deg, 1);
     EXPECT_LT(error_deg, kRotationToleranceDeg) << set.orientations[k].name;
+    // The stated uncertainty is honest: the error within three of it.
+    EXPECT_LT(error_deg, 3 * sigma_deg) << set.orientations[k].name;
   }
 
   // The IES file: every direction seen, the flux the analytic luminaire's within 1 %.

@@ -82,7 +82,12 @@ void SlabInfo::Save(const std::string& slab_dir) const {
   for (const auto& [i, jj] : present) list.push_back({i, jj});
   j["present"] = list;
   j["complete"] = Complete();
-  WriteJsonAtomically(slab_dir + "/slab.json", j);
+  // Unchanged content is not rewritten: slab.json's time then says when the slab last changed
+  // (pipelines redo what is older than it: pipelines/process-luminaire.sh).
+  const std::string path = slab_dir + "/slab.json", text = DumpJson(j, path) + "\n";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec) && ReadTextFile(path) == text) return;
+  WriteTextAtomically(path, text);
 }
 
 std::string SlabPositionPath(const std::string& slab_dir, int i, int j) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Process a luminaire folder (docs/formats.md §19: luminaire.json and one dataset folder per
 # orientation) into one light field and its exports, stopping at the first failing stage
-# (set -e); a rerun resumes where it stopped (stages skip finished outputs; --force redoes them).
+# (set -e); a rerun resumes where it stopped (stages skip finished outputs, the registration
+# and the exports are redone when older than what they are made from; --force redoes all).
 #   pipelines/process-luminaire.sh <lum> [--force] [--threads n] [--reference <reading.json>]
 #       [--metadata <keywords.json>] [reconstruct's options]
 # Each orientation's dataset goes through pipelines/process-folder.sh (its calibrations,
@@ -51,11 +52,13 @@ while [ $# -gt 0 ]; do
 done
 [ -f "$lum/luminaire.json" ] || { echo "$0: $lum/luminaire.json: not found" >&2; exit 2; }
 
-# The orientations' dataset folders, in luminaire.json's order.
+# The orientations' dataset folders, in luminaire.json's order: the file checked by the tools'
+# own reader first (exit 2 naming the file and field), so that nothing runs on a bad list.
+info=$("$bin/lumislab-export" info "$lum" --json) || exit $?
 mapfile -t datasets < <(python3 -c '
 import json, sys
-for o in json.load(open(sys.argv[1]))["orientations"]:
-    print(o["dataset"])' "$lum/luminaire.json")
+for o in json.load(sys.stdin)["orientations"]:
+    print(o["dataset"])' <<<"$info")
 [ ${#datasets[@]} -gt 0 ] || { echo "$0: $lum/luminaire.json: no orientations" >&2; exit 2; }
 for d in "${datasets[@]}"; do
   echo "== orientation dataset $lum/$d"
@@ -65,22 +68,39 @@ for d in "${datasets[@]}"; do
     "${threads[@]}" "${force[@]}"
 done
 
+# A result is current when it is newer than everything it is made from; a stale one is redone.
+newer_than_all() {  # newer_than_all <file> <input>...: the file exists and is newer than each
+  local out=$1 input
+  shift
+  [ -f "$out" ] || return 1
+  for input in "$@"; do [ "$out" -nt "$input" ] || return 1; done
+}
+slabs=()
+for d in "${datasets[@]}"; do slabs+=("$lum/$d/slab/slab.json"); done
+
 echo "== registration"
-if [ -f "$lum/registration.json" ] && [ ${#force[@]} -eq 0 ]; then
-  echo "$lum/registration.json: exists (--force redoes it)"
+if [ ${#datasets[@]} -lt 2 ]; then
+  # One orientation has nothing to register against; its exports use its nominal pose.
+  rm -f "$lum/registration.json"
+  echo "one orientation: nothing to register"
+elif [ ${#force[@]} -eq 0 ] && newer_than_all "$lum/registration.json" "$lum/luminaire.json" \
+  "${slabs[@]}"; then
+  echo "$lum/registration.json: current (--force redoes it)"
 else
-  "$bin/lumislab-calibrate" orientations --luminaire "$lum" "${threads[@]}" "${force[@]}"
+  "$bin/lumislab-calibrate" orientations --luminaire "$lum" "${threads[@]}" --force
 fi
 
 echo "== exports"
 mkdir -p "$lum/exports"
-export_one() {  # export_one <subcommand> <file> [args]: skipped when the file exists, unless --force
-  if [ -f "$lum/exports/$2" ] && [ ${#force[@]} -eq 0 ]; then
-    echo "$lum/exports/$2: exists (--force redoes it)"
+inputs=("$lum/luminaire.json" "${slabs[@]}")
+[ ! -f "$lum/registration.json" ] || inputs+=("$lum/registration.json")
+export_one() {  # export_one <subcommand> <file> [args]: skipped when current, unless --force
+  if [ ${#force[@]} -eq 0 ] && newer_than_all "$lum/exports/$2" "${inputs[@]}"; then
+    echo "$lum/exports/$2: current (--force redoes it)"
     return
   fi
   "$bin/lumislab-export" "$1" --slab "$lum" --out "$lum/exports/$2" "${@:3}" "${threads[@]}" \
-    "${force[@]}"
+    --force
 }
 export_one ies luminaire.ies "${export_args[@]}"
 export_one ldt luminaire.ldt "${export_args[@]}"

@@ -116,6 +116,7 @@ int Run(int argc, char** argv) {
           IntensityFromIrradiance(info, i, j, TruthPosition(luminaire, info, i, j).irradiance));
   auto t0 = std::chrono::steady_clock::now();
   renderer.Render();  // includes all 63 shadow maps
+  renderer.Finish();
   const double first_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const ImageF image = renderer.Read();
@@ -124,6 +125,7 @@ int Run(int argc, char** argv) {
     renderer.SetCamera(camera(start_yaw + 2.0 * (f + 1)));
     t0 = std::chrono::steady_clock::now();
     renderer.Render();
+    renderer.Finish();
     moving.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }

@@ -174,6 +174,7 @@ int Run(int argc, char** argv) {
             r.SetCamera(OrbitCamera(moving, 1.0));
             auto start = Clock::now();
             r.Render();
+            r.Finish();
             times[k].cached.push_back(Seconds(start));
             times[k].c_depth.push_back(r.phase_times().depth_ms);
             times[k].c_light.push_back(r.phase_times().light_ms);
@@ -182,6 +183,7 @@ int Run(int argc, char** argv) {
             r.SetPose(setup.pose);  // invalidates every shadow map, as a pose change does
             start = Clock::now();
             r.Render();
+            r.Finish();
             times[k].full.push_back(Seconds(start));
             times[k].f_shadow.push_back(r.phase_times().shadow_ms);
             times[k].f_light.push_back(r.phase_times().light_ms);
@@ -261,6 +263,7 @@ int Run(int argc, char** argv) {
         upload.push_back(Seconds(start));
         start = Clock::now();
         if (r.Render() != 1) throw Failure("live mode added more than the new position");
+        r.Finish();
         add.push_back(Seconds(start));
       }
     }

@@ -60,6 +60,7 @@ void RunBench(const PreviewConfig& config, const SceneSetup& setup, double aspec
     if (!setup.plane) renderer.SetCamera(OrbitCamera(moving, aspect));
     const auto start = std::chrono::steady_clock::now();
     renderer.Render();
+    renderer.Finish();  // the frame's GL work done, not only issued
     seconds.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }

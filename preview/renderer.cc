@@ -104,6 +104,14 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glGenFramebuffers(1, &gl_->shadow_fbo);
   glCreateBuffers(1, &gl_->exact_count);
   glNamedBufferStorage(gl_->exact_count, sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateBuffers(1, &gl_->dispatch_args);
+  glNamedBufferStorage(gl_->dispatch_args, 3 * sizeof(GLuint), nullptr, 0);
+  gl_->exact_args_program = LinkComputeProgram(shaders::kExactArgsCompute);
+  const GLbitfield mapped = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+  glCreateBuffers(1, &gl_->reproject_count);
+  glNamedBufferStorage(gl_->reproject_count, sizeof(GLuint), nullptr, mapped);
+  gl_->reproject_count_map = static_cast<const GLuint*>(
+      glMapNamedBufferRange(gl_->reproject_count, 0, sizeof(GLuint), mapped));
   AllocateTargets();
   if (glGetError() != GL_NO_ERROR) throw Failure("GL error while creating the renderer");
 }
@@ -115,6 +123,11 @@ Renderer::~Renderer() {
   glDeleteFramebuffers(1, &gl_->coarse_fbo);
   glDeleteBuffers(1, &gl_->exact_count);
   glDeleteBuffers(1, &gl_->exact_list);
+  glDeleteBuffers(1, &gl_->dispatch_args);
+  glDeleteProgram(gl_->exact_args_program);
+  if (gl_->reproject_fence) glDeleteSync(gl_->reproject_fence);
+  glUnmapNamedBuffer(gl_->reproject_count);
+  glDeleteBuffers(1, &gl_->reproject_count);
   glDeleteBuffers(1, &gl_->tile_bounds);
   glDeleteBuffers(1, &gl_->tile_lists);
   GLuint textures[] = {gl_->intensity,  gl_->shadow,   gl_->colour,     gl_->packed[0],
@@ -344,6 +357,7 @@ int Renderer::PositionCount() const {
 }
 
 int Renderer::Render() {
+  // Not profiling, the frame neither reads back nor waits (Finish() waits, for timing).
   using Clock = std::chrono::steady_clock;
   auto mark = Clock::now();
   times_ = PhaseTimes{};
@@ -371,11 +385,12 @@ int Renderer::Render() {
   LightPasses(todo);
   for (int l : todo) accumulated_[l] = true;
   if (reprojected || !todo.empty()) lap(&times_.light_ms);
-  glFinish();
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) throw Failure("GL error " + std::to_string(error) + " while rendering");
   return int(todo.size());
 }
+
+void Renderer::Finish() const { glFinish(); }
 
 void Renderer::DrawView() {
   // Clear the sums, then draw the G-buffer (what each pixel sees; the light passes shade it).

@@ -73,7 +73,9 @@ int Run(int argc, char** argv) {
   app.add_option("--shadow-size", shadow_size, "shadow-map side")->capture_default_str();
   app.add_option("--csv", csv, "CSV output")->capture_default_str();
   app.add_flag("--quick", quick, "only crypt 5x5 and cloister 9x7 with shadows, no live");
-  app.add_flag("--profile", profile, "time the phases of each frame (glFinish between them)");
+  app.add_flag("--profile", profile,
+               "time the phases of each frame (GL_TIME_ELAPSED queries where the context has "
+               "them, else glFinish between phases; the output says which)");
   app.add_option("--shadow-share", fast.shadow_share_texels,
                  "on columns: shadow-map sharing, largest edge shift in shadow texels (0: off)")
       ->capture_default_str();
@@ -206,10 +208,13 @@ int Run(int argc, char** argv) {
               on.shortcuts().z_min, on.shortcuts().z_max, 100 * on.ListedLightFraction());
           for (int k = 0; k < 2; ++k) {
             std::printf(
-                "  %s phases (ms): camera move: G-buffer %.1f light %.1f; full: shadow maps %.1f "
-                "light %.1f\n",
-                k ? "on " : "off", Median(times[k].c_depth), Median(times[k].c_light),
-                Median(times[k].f_shadow), Median(times[k].f_light));
+                "  %s phases (ms, %s): camera move: G-buffer %.2f light %.2f; full: shadow maps "
+                "%.2f light %.2f\n",
+                k ? "on " : "off",
+                (k ? on : off).phase_times().gpu_timer ? "GL_TIME_ELAPSED queries"
+                                                       : "wall time, glFinish between phases",
+                Median(times[k].c_depth), Median(times[k].c_light), Median(times[k].f_shadow),
+                Median(times[k].f_light));
           }
         }
         const ShortcutState& state = on.shortcuts();

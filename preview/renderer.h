@@ -96,15 +96,19 @@ struct RenderOptions {
   // non-zero at one of its pixels (a light left out adds E' = 0).
   bool tiled_lights = true;
 
-  // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
+  // Profiling: phase_times() holds each phase's GL time (GL_TIME_ELAPSED queries read after the
+  // frame), or where the context has no timer queries wall times with glFinish() after each.
   bool time_phases = false;
 };
 
-// Wall time of the phases of the last Render() (milliseconds; only with time_phases).
+// Time of the phases of the last Render() (milliseconds; only with time_phases).
 // depth_ms: the G-buffer; shadow_ms: the shadow maps (and, when maps are drawn, a reprojection
 // before them); light_ms: the light passes (and a reprojection without maps drawn).
+// gpu_timer: measured by GL_TIME_ELAPSED queries (the GL's own time of each phase); false: wall
+// time with glFinish() between phases (contexts without timer queries).
 struct PhaseTimes {
   double depth_ms = 0, shadow_ms = 0, light_ms = 0;
+  bool gpu_timer = false;
 };
 
 constexpr int kLightsPerPass = 64;
@@ -172,8 +176,7 @@ class Renderer {
 
   // Brings the accumulated image up to date; returns how many lights it added. Issues the frame's
   // GL work without reading anything back or waiting for it (docs/method.md §4.2, "What a frame
-  // does"), unless time_phases (glFinish between phases); Read() waits for it, Finish() too (for
-  // timing frames).
+  // does"), unless time_phases; Read() waits for it, Finish() too (for timing frames).
   int Render();
   void Finish() const;
   // Shadow maps rendered since construction (to show they are cached).

@@ -49,6 +49,9 @@ struct Renderer::Gl {
   GLuint reproject_count = 0;
   const GLuint* reproject_count_map = nullptr;
   GLsync reproject_fence = nullptr;
+  // --profile: GL_TIME_ELAPSED queries, one per timed phase of a frame (Render()).
+  GLuint phase_queries[4] = {0, 0, 0, 0};
+  bool timer_queries = false;  // the context has them (GL_QUERY_COUNTER_BITS > 0)
   // The lights' sum before albedo (o_irradiance) of the present view, and the last view shaded
   // in full: its sums, positions and normals (what reprojection reuses).
   GLuint irradiance = 0, source[3] = {0, 0, 0};

@@ -177,5 +177,40 @@ TEST(PreviewGlCalls, CallsDoNotGrowWithThePositions) {
   }
 }
 
+// --profile: a profiled frame times its phases with GL_TIME_ELAPSED queries where the context has
+// them (llvmpipe does), read after the frame, and still calls no glFinish.
+TEST(PreviewGlCalls, ProfileUsesTimerQueriesNotGlFinish) {
+  Context();
+  const SlabInfo info = DefaultSlabInfo(3, 3, 20, 24);
+  const SceneSetup setup = MakeSceneSetup("crypt", info);
+  RenderOptions options;
+  options.time_phases = true;
+  Renderer r(info, 96, 96, options);
+  r.SetScene(setup.mesh);
+  r.SetPose(setup.pose);
+  r.SetCamera(OrbitCamera(setup, 1.0));
+  const Luminaire luminaire = DefaultScene().luminaire;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      r.SetPosition(
+          i, j,
+          IntensityFromIrradiance(info, i, j, TruthPosition(luminaire, info, i, j).irradiance));
+  r.Render();
+  r.SetPose(setup.pose);
+  GlCallCounter counter;
+  r.Render();
+  const std::map<std::string, long> calls = counter.Counts();
+  const PhaseTimes& t = r.phase_times();
+  std::printf("profiled full frame: G-buffer %.3f ms, shadow maps %.3f ms, light %.3f ms (%s)\n",
+              t.depth_ms, t.shadow_ms, t.light_ms, t.gpu_timer ? "GL_TIME_ELAPSED" : "glFinish");
+  EXPECT_TRUE(t.gpu_timer);  // llvmpipe has timer queries
+  EXPECT_EQ(calls.count("glFinish"), 0u);
+  EXPECT_EQ(calls.at("glBeginQuery"), 4);  // three phases and the open one after the last
+  EXPECT_EQ(calls.at("glGetQueryObjectui64v"), 3);
+  EXPECT_GT(t.depth_ms, 0);
+  EXPECT_GT(t.shadow_ms, 0);
+  EXPECT_GT(t.light_ms, 0);
+}
+
 }  // namespace
 }  // namespace lumislab

@@ -105,8 +105,9 @@ int RunHeadless(const PreviewConfig& config, const LightSource& source, const Sl
   const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
   const double aspect = double(width) / height;
-  Renderer renderer(info, width, height, MakeRenderOptions(config, setup),
-                    RendererOrientations(source, info));
+  const RenderOptions options = MakeRenderOptions(config, setup);
+  LogInfo(ShortcutChoice(config, options, context.Renderer()));
+  Renderer renderer(info, width, height, options, RendererOrientations(source, info));
   renderer.SetScene(setup.mesh);
   renderer.SetPose(setup.pose);
   renderer.SetCamera(setup.plane ? PlaneView(setup.plane_z, setup.extent)

@@ -18,6 +18,7 @@
 #include "lib/lightfield/light_field.h"
 #include "lib/lightfield/scene_setup.h"
 #include "lib/synthetic/truth.h"
+#include "preview/config.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
 
@@ -210,6 +211,29 @@ TEST(PreviewGlCalls, ProfileUsesTimerQueriesNotGlFinish) {
   EXPECT_GT(t.depth_ms, 0);
   EXPECT_GT(t.shadow_ms, 0);
   EXPECT_GT(t.light_ms, 0);
+}
+
+// The log line of the shortcuts chosen (docs/method.md §4.2, "Shortcuts by backend"): software or
+// hardware by GL_RENDERER, the values in use and why; the choice itself is the same on both.
+TEST(PreviewShortcutChoice, SaysWhichAndWhyByBackend) {
+  EXPECT_TRUE(IsSoftwareRenderer("llvmpipe (LLVM 15.0.6, 256 bits)"));
+  EXPECT_TRUE(IsSoftwareRenderer("softpipe"));
+  EXPECT_FALSE(IsSoftwareRenderer("NVIDIA H200/PCIe/SSE2"));
+  PreviewConfig config;
+  const SlabInfo info = DefaultSlabInfo(3, 3, 20, 24);
+  const SceneSetup setup = MakeSceneSetup("crypt", info);
+  const RenderOptions options = MakeRenderOptions(config, setup);
+  EXPECT_EQ(options.coarse_tolerance, 0.1);  // the llvmpipe defaults, unchanged
+  EXPECT_EQ(options.reproject_tolerance, 0.1);
+  const std::string software = ShortcutChoice(config, options, "llvmpipe (LLVM 15.0.6)");
+  const std::string hardware = ShortcutChoice(config, options, "NVIDIA H200/PCIe/SSE2");
+  std::printf("%s\n%s\n", software.c_str(), hardware.c_str());
+  EXPECT_NE(software.find("software renderer"), std::string::npos);
+  EXPECT_NE(software.find("coarse shading 0.1 (auto)"), std::string::npos);
+  EXPECT_NE(software.find("reprojection 0.1"), std::string::npos);
+  EXPECT_NE(software.find("Table 1"), std::string::npos);
+  EXPECT_NE(hardware.find("hardware renderer"), std::string::npos);
+  EXPECT_NE(hardware.find("unmeasured"), std::string::npos);
 }
 
 }  // namespace

@@ -309,6 +309,7 @@ bool Frame(WindowState& s, GLFWwindow* window, double seconds) {
   const auto start = Clock::now();
   const int added = s.renderer->Render();
   if (added > 0) {
+    s.renderer->Finish();  // "last render" is the GL's work, not only its issue (rare: new light)
     s.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     s.render_lights = added;
   }

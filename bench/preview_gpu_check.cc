@@ -3,7 +3,10 @@
 // with shadows, and prints the GL renderer, frame times and the relative difference between the
 // two contexts' images. Both GL libraries are opened at run time (dlopen), so this binary runs on
 // machines that have only one of them (a GPU node has libEGL, not OSMesa).
-//   preview_gpu_check --context egl|osmesa [--out image.exr] [--reference other.exr] [--frames N]
+// --size takes a list of WxH (default 400x400; issue 32's GPU check: 400x400,1920x1080,3840x2160),
+// each rendered by its own renderer; --out and --reference need a single size.
+//   preview_gpu_check --context egl|osmesa [--size WxH[,WxH...]] [--out image.exr]
+//                     [--reference other.exr] [--frames N]
 #include <dlfcn.h>
 #include <glad/gl.h>
 
@@ -13,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -60,41 +64,28 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-int Run(int argc, char** argv) {
-  std::string context = "egl", out, reference;
-  int frames = 10;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    if (a == "--context" && k + 1 < argc)
-      context = argv[++k];
-    else if (a == "--out" && k + 1 < argc)
-      out = argv[++k];
-    else if (a == "--reference" && k + 1 < argc)
-      reference = argv[++k];
-    else if (a == "--frames" && k + 1 < argc)
-      frames = std::max(1, std::atoi(argv[++k]));
-    else
-      throw BadInput(
-          "usage: preview_gpu_check --context egl|osmesa [--out x.exr] "
-          "[--reference y.exr] [--frames N]");
+// "WxH[,WxH...]": the sizes to render (each side 1..8192).
+std::vector<std::pair<int, int>> ParseSizes(const std::string& text) {
+  std::vector<std::pair<int, int>> sizes;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    int w = 0, h = 0;
+    char x = 0;
+    std::stringstream one(item);
+    if (!(one >> w >> x >> h) || x != 'x' || w < 1 || h < 1 || w > 8192 || h > 8192 || !one.eof())
+      throw InputError("--size", "size", "WxH[,WxH...], e.g. 1920x1080,3840x2160", text);
+    sizes.emplace_back(w, h);
   }
-  // EGL: any device, Mesa's software one included, so that EGL and OSMesa can be compared
-  // where there is no GPU.
-  std::unique_ptr<EglContext> egl;
-  if (context == "egl") {
-    egl = std::make_unique<EglContext>(EglContext::Device::kAnyDevice);
-    std::printf("%s\n", egl->Version().c_str());
-  } else {
-    MakeOsmesaContext();
-    if (!gladLoadGL(LoadProc)) throw Failure("gladLoadGL failed");
-  }
-  std::printf("context %s: GL_RENDERER %s, GL_VERSION %s\n", context.c_str(),
-              reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
-              reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+  if (sizes.empty()) throw InputError("--size", "size", "WxH[,WxH...]", text);
+  return sizes;
+}
 
+// The crypt of the 9x7 slab at w x h with shadows, as lumislab-preview draws it (every position
+// exact): the first frame and the median camera move printed; returns the first frame's image.
+ImageF RenderCrypt(int w, int h, int frames) {
   const SlabInfo info = DefaultSlabInfo(9, 7, 5, 300);
   const Luminaire luminaire = DefaultScene().luminaire;
-  const int w = 400, h = 400;
   // The crypt as lumislab-preview sets it up: mesh, luminaire pose, orbit camera, culling.
   SceneSetup setup = MakeSceneSetup("crypt", info);
   RenderOptions options;
@@ -116,6 +107,7 @@ int Run(int argc, char** argv) {
           IntensityFromIrradiance(info, i, j, TruthPosition(luminaire, info, i, j).irradiance));
   auto t0 = std::chrono::steady_clock::now();
   renderer.Render();  // includes all 63 shadow maps
+  renderer.Finish();
   const double first_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const ImageF image = renderer.Read();
@@ -124,13 +116,57 @@ int Run(int argc, char** argv) {
     renderer.SetCamera(camera(start_yaw + 2.0 * (f + 1)));
     t0 = std::chrono::steady_clock::now();
     renderer.Render();
+    renderer.Finish();
     moving.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   }
   std::printf(
-      "crypt 9x7 400x400 shadows: first frame (63 shadow maps + lights) %.2f ms; camera "
-      "moving median %.3f ms = %.1f fps (paper: 1.2 fps)\n",
-      first_ms, Median(moving), 1000 / Median(moving));
+      "crypt 9x7 %dx%d shadows: first frame (63 shadow maps + lights) %.2f ms; camera "
+      "moving median %.3f ms = %.1f fps (paper: 1.2 fps at 400x400)\n",
+      w, h, first_ms, Median(moving), 1000 / Median(moving));
+  return image;
+}
+
+int Run(int argc, char** argv) {
+  std::string context = "egl", out, reference;
+  std::string size_text = "400x400";
+  int frames = 10;
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    if (a == "--context" && k + 1 < argc)
+      context = argv[++k];
+    else if (a == "--out" && k + 1 < argc)
+      out = argv[++k];
+    else if (a == "--reference" && k + 1 < argc)
+      reference = argv[++k];
+    else if (a == "--frames" && k + 1 < argc)
+      frames = std::max(1, std::atoi(argv[++k]));
+    else if (a == "--size" && k + 1 < argc)
+      size_text = argv[++k];
+    else
+      throw BadInput(
+          "usage: preview_gpu_check --context egl|osmesa [--size WxH[,WxH...]] [--out x.exr] "
+          "[--reference y.exr] [--frames N]");
+  }
+  const std::vector<std::pair<int, int>> sizes = ParseSizes(size_text);
+  if (sizes.size() > 1 && !(out.empty() && reference.empty()))
+    throw BadInput("preview_gpu_check: --out and --reference need a single --size");
+  // EGL: any device, Mesa's software one included, so that EGL and OSMesa can be compared
+  // where there is no GPU.
+  std::unique_ptr<EglContext> egl;
+  if (context == "egl") {
+    egl = std::make_unique<EglContext>(EglContext::Device::kAnyDevice);
+    std::printf("%s\n", egl->Version().c_str());
+  } else {
+    MakeOsmesaContext();
+    if (!gladLoadGL(LoadProc)) throw Failure("gladLoadGL failed");
+  }
+  std::printf("context %s: GL_RENDERER %s, GL_VERSION %s\n", context.c_str(),
+              reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+              reinterpret_cast<const char*>(glGetString(GL_VERSION)));
+
+  ImageF image;
+  for (const auto& [w, h] : sizes) image = RenderCrypt(w, h, frames);
   if (!out.empty()) WriteExr(out, image, {"R", "G", "B"});
   if (!reference.empty()) {
     const ImageF ref = ReadExr(reference, {"R", "G", "B"});

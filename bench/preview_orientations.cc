@@ -147,12 +147,14 @@ int Run(int argc, char** argv) {
       renderer.SetCamera(OrbitCamera(moving, 1.0));
       start = Clock::now();
       renderer.Render();
+      renderer.Finish();
       camera.push_back(Seconds(start) * 1000);
       moving.camera_yaw_deg += 2;
       renderer.SetCamera(OrbitCamera(moving, 1.0));
       renderer.SetPose(setup.pose);  // every shadow map redrawn
       start = Clock::now();
       renderer.Render();
+      renderer.Finish();
       full.push_back(Seconds(start) * 1000);
     }
     const int lights = renderer.LightCount();

@@ -1,4 +1,5 @@
-// The paper's Table 1 (Granier et al. 2003) redone on this machine through OSMesa at 400x400:
+// The paper's Table 1 (Granier et al. 2003) redone on this machine through OSMesa (or a GPU
+// through EGL: --backend egl) at 400x400 (--size WxH):
 // crypt and cloister; 5x5, 7x7 and 9x7 slabs at 300x300; with and without shadows. Reports the
 // median fps of frames with a moving camera (shadow maps cached: what the window does while
 // orbiting) and of full frames that also re-render every shadow map (what the paper did each
@@ -15,6 +16,7 @@
 #include "lib/lightfield/scene_setup.h"
 #include "lib/lightfield/tone_map.h"
 #include "lib/synthetic/truth.h"
+#include "preview/cli.h"
 #include "preview/gl_context.h"
 #include "preview/renderer.h"
 
@@ -58,8 +60,8 @@ void UploadAll(const Slab& slab, Renderer& r) {
 }
 
 int Run(int argc, char** argv) {
-  int frames = 7, size = 400, shadow_size = 512;
-  std::string csv = "preview_table1.csv";
+  int frames = 7, shadow_size = 512;
+  std::string csv = "preview_table1.csv", size_text = "400x400", backend = "osmesa";
   bool quick = false, profile = false, no_cull = false;
   RenderOptions fast;  // the shortcuts' settings of the "on" columns (defaults: the tool's)
   fast.shadow_share_texels = 0;
@@ -67,13 +69,21 @@ int Run(int argc, char** argv) {
   fast.merge_error = 0.05;
   fast.coarse_tolerance = -1;  // auto, as lumislab-preview: 0.1 with shadows, off without
   fast.reproject_tolerance = 0.1;
-  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa (docs/testing.md)"};
+  CLI::App app{"preview_table1: the paper's Table 1 through OSMesa or EGL (docs/testing.md)"};
   app.add_option("--frames", frames, "frames per cell (median)")->capture_default_str();
-  app.add_option("--size", size, "image side")->capture_default_str();
+  app.add_option("--size", size_text, "image size WxH (or one side N: N x N)")
+      ->capture_default_str();
+  app.add_option("--backend", backend,
+                 "osmesa (llvmpipe) or egl (a GPU; exit 1 where EGL finds none, as "
+                 "lumislab-preview --backend egl)")
+      ->check(CLI::IsMember({"osmesa", "egl"}))
+      ->capture_default_str();
   app.add_option("--shadow-size", shadow_size, "shadow-map side")->capture_default_str();
   app.add_option("--csv", csv, "CSV output")->capture_default_str();
   app.add_flag("--quick", quick, "only crypt 5x5 and cloister 9x7 with shadows, no live");
-  app.add_flag("--profile", profile, "time the phases of each frame (glFinish between them)");
+  app.add_flag("--profile", profile,
+               "time the phases of each frame (GL_TIME_ELAPSED queries where the context has "
+               "them, else glFinish between phases; the output says which)");
   app.add_option("--shadow-share", fast.shadow_share_texels,
                  "on columns: shadow-map sharing, largest edge shift in shadow texels (0: off)")
       ->capture_default_str();
@@ -98,9 +108,15 @@ int Run(int argc, char** argv) {
     return code == 0 ? 0 : static_cast<int>(ExitCode::kBadInput);
   }
   SetLogTool("preview_table1");
-  OffscreenContext context(16, 16);
-  std::printf("renderer: %s, %dx%d, shadow maps %d^2, median of %d frames\n",
-              context.Renderer().c_str(), size, size, shadow_size, frames);
+  int width = 0, height = 0;
+  const std::string size_wxh =
+      size_text.find('x') == std::string::npos ? size_text + "x" + size_text : size_text;
+  if (!ParseSize(size_wxh, &width, &height))
+    throw InputError("--size", "size", "WxH, each 1..8192, e.g. 1920x1080", size_text);
+  const double aspect = double(width) / height;
+  const HeadlessContext context(backend == "egl");
+  std::printf("backend %s, renderer: %s, %dx%d, shadow maps %d^2, median of %d frames\n",
+              backend.c_str(), context.Renderer().c_str(), width, height, shadow_size, frames);
   struct Paper {
     int nu, nv;
     double crypt, crypt_ns, cloister, cloister_ns;
@@ -151,12 +167,12 @@ int Run(int argc, char** argv) {
             fast.coarse_tolerance >= 0 ? fast.coarse_tolerance : (shadows ? 0.1 : 0);
         options_on.reproject_tolerance = fast.reproject_tolerance;
         options_on.shadow_cull = setup.closed_room && !no_cull;  // as lumislab-preview
-        Renderer off(slab.info, size, size, options), on(slab.info, size, size, options_on);
+        Renderer off(slab.info, width, height, options), on(slab.info, width, height, options_on);
         for (Renderer* r : {&off, &on}) {
           r->SetScene(setup.mesh);
           r->SetPose(setup.pose);
           UploadAll(slab, *r);
-          r->SetCamera(OrbitCamera(setup, 1.0));
+          r->SetCamera(OrbitCamera(setup, aspect));
           r->Render();  // warm-up: shaders, shadow maps
         }
         const ImageDifference error = CompareImages(on.Read(), off.Read());
@@ -171,17 +187,19 @@ int Run(int argc, char** argv) {
             // Each frame a new view, 2 degrees on; the same views for both renderers.
             const double step = 2.0 * (2 * f + 1);
             moving.camera_yaw_deg = setup.camera_yaw_deg + step;
-            r.SetCamera(OrbitCamera(moving, 1.0));
+            r.SetCamera(OrbitCamera(moving, aspect));
             auto start = Clock::now();
             r.Render();
+            r.Finish();
             times[k].cached.push_back(Seconds(start));
             times[k].c_depth.push_back(r.phase_times().depth_ms);
             times[k].c_light.push_back(r.phase_times().light_ms);
             moving.camera_yaw_deg = setup.camera_yaw_deg + step + 2;
-            r.SetCamera(OrbitCamera(moving, 1.0));
+            r.SetCamera(OrbitCamera(moving, aspect));
             r.SetPose(setup.pose);  // invalidates every shadow map, as a pose change does
             start = Clock::now();
             r.Render();
+            r.Finish();
             times[k].full.push_back(Seconds(start));
             times[k].f_shadow.push_back(r.phase_times().shadow_ms);
             times[k].f_light.push_back(r.phase_times().light_ms);
@@ -193,7 +211,7 @@ int Run(int argc, char** argv) {
         for (int m = 1; m <= 3; ++m) {
           moving.camera_yaw_deg = setup.camera_yaw_deg + 2.0 * (2 * frames) + 2.0 * m;
           for (Renderer* r : {&off, &on}) {
-            r->SetCamera(OrbitCamera(moving, 1.0));
+            r->SetCamera(OrbitCamera(moving, aspect));
             r->Render();
           }
           move_error = std::max(move_error, CompareImages(on.Read(), off.Read()).relative_l2);
@@ -204,10 +222,13 @@ int Run(int argc, char** argv) {
               on.shortcuts().z_min, on.shortcuts().z_max, 100 * on.ListedLightFraction());
           for (int k = 0; k < 2; ++k) {
             std::printf(
-                "  %s phases (ms): camera move: G-buffer %.1f light %.1f; full: shadow maps %.1f "
-                "light %.1f\n",
-                k ? "on " : "off", Median(times[k].c_depth), Median(times[k].c_light),
-                Median(times[k].f_shadow), Median(times[k].f_light));
+                "  %s phases (ms, %s): camera move: G-buffer %.2f light %.2f; full: shadow maps "
+                "%.2f light %.2f\n",
+                k ? "on " : "off",
+                (k ? on : off).phase_times().gpu_timer ? "GL_TIME_ELAPSED queries"
+                                                       : "wall time, glFinish between phases",
+                Median(times[k].c_depth), Median(times[k].c_light), Median(times[k].f_shadow),
+                Median(times[k].f_light));
           }
         }
         const ShortcutState& state = on.shortcuts();
@@ -246,10 +267,10 @@ int Run(int argc, char** argv) {
     const SceneSetup setup = MakeSceneSetup("crypt", slab.info);
     RenderOptions options;
     options.shadow_size = shadow_size;
-    Renderer r(slab.info, size, size, options);
+    Renderer r(slab.info, width, height, options);
     r.SetScene(setup.mesh);
     r.SetPose(setup.pose);
-    r.SetCamera(OrbitCamera(setup, 1.0));
+    r.SetCamera(OrbitCamera(setup, aspect));
     r.Render();
     std::vector<double> upload, add;
     const Luminaire luminaire = DefaultScene().luminaire;
@@ -261,6 +282,7 @@ int Run(int argc, char** argv) {
         upload.push_back(Seconds(start));
         start = Clock::now();
         if (r.Render() != 1) throw Failure("live mode added more than the new position");
+        r.Finish();
         add.push_back(Seconds(start));
       }
     }

@@ -100,6 +100,15 @@ int MergeGroup(const PreviewConfig& config);
 // Coarse shading's tolerance: --coarse-shading, or auto: 0.1 in a room with shadows; 0 without
 // them and on the plane (its irradiance is a measurement, written in W/m^2).
 double CoarseTolerance(const PreviewConfig& config, const SceneSetup& setup);
+// A software rasteriser by its GL_RENDERER string (llvmpipe, softpipe, swrast): the shortcuts'
+// defaults were measured to pay there (docs/results.md, Table 1).
+bool IsSoftwareRenderer(const std::string& gl_renderer);
+// The log line that says which shortcuts `options` hold for the context's GL_RENDERER and why
+// (docs/method.md §4.2, "Shortcuts by backend"). The choice is the same on every backend: the
+// one GPU measured (issue 32) still ran faster with them; whether a GPU path without them is
+// faster there is unmeasured.
+std::string ShortcutChoice(const PreviewConfig& config, const RenderOptions& options,
+                           const std::string& gl_renderer);
 
 // Loads every slab position present on disk that the renderer lacks into it, as positions of
 // `orientation` (E' derived on `threads` threads); returns the positions loaded. (--slab's

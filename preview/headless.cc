@@ -60,6 +60,7 @@ void RunBench(const PreviewConfig& config, const SceneSetup& setup, double aspec
     if (!setup.plane) renderer.SetCamera(OrbitCamera(moving, aspect));
     const auto start = std::chrono::steady_clock::now();
     renderer.Render();
+    renderer.Finish();  // the frame's GL work done, not only issued
     seconds.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
@@ -104,8 +105,9 @@ int RunHeadless(const PreviewConfig& config, const LightSource& source, const Sl
   const int width = config.width;  // plane mode is square
   const int height = setup.plane ? config.width : config.height;
   const double aspect = double(width) / height;
-  Renderer renderer(info, width, height, MakeRenderOptions(config, setup),
-                    RendererOrientations(source, info));
+  const RenderOptions options = MakeRenderOptions(config, setup);
+  LogInfo(ShortcutChoice(config, options, context.Renderer()));
+  Renderer renderer(info, width, height, options, RendererOrientations(source, info));
   renderer.SetScene(setup.mesh);
   renderer.SetPose(setup.pose);
   renderer.SetCamera(setup.plane ? PlaneView(setup.plane_z, setup.extent)

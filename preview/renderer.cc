@@ -104,6 +104,18 @@ Renderer::Renderer(const SlabInfo& info, int width, int height, const RenderOpti
   glGenFramebuffers(1, &gl_->shadow_fbo);
   glCreateBuffers(1, &gl_->exact_count);
   glNamedBufferStorage(gl_->exact_count, sizeof(GLuint), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  glCreateBuffers(1, &gl_->dispatch_args);
+  glNamedBufferStorage(gl_->dispatch_args, 3 * sizeof(GLuint), nullptr, 0);
+  gl_->exact_args_program = LinkComputeProgram(shaders::kExactArgsCompute);
+  const GLbitfield mapped = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+  glCreateBuffers(1, &gl_->reproject_count);
+  glNamedBufferStorage(gl_->reproject_count, sizeof(GLuint), nullptr, mapped);
+  gl_->reproject_count_map = static_cast<const GLuint*>(
+      glMapNamedBufferRange(gl_->reproject_count, 0, sizeof(GLuint), mapped));
+  glGenQueries(4, gl_->phase_queries);
+  GLint timer_bits = 0;
+  glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &timer_bits);
+  gl_->timer_queries = timer_bits > 0;
   AllocateTargets();
   if (glGetError() != GL_NO_ERROR) throw Failure("GL error while creating the renderer");
 }
@@ -115,6 +127,12 @@ Renderer::~Renderer() {
   glDeleteFramebuffers(1, &gl_->coarse_fbo);
   glDeleteBuffers(1, &gl_->exact_count);
   glDeleteBuffers(1, &gl_->exact_list);
+  glDeleteBuffers(1, &gl_->dispatch_args);
+  glDeleteProgram(gl_->exact_args_program);
+  if (gl_->reproject_fence) glDeleteSync(gl_->reproject_fence);
+  glUnmapNamedBuffer(gl_->reproject_count);
+  glDeleteBuffers(1, &gl_->reproject_count);
+  glDeleteQueries(4, gl_->phase_queries);
   glDeleteBuffers(1, &gl_->tile_bounds);
   glDeleteBuffers(1, &gl_->tile_lists);
   GLuint textures[] = {gl_->intensity,  gl_->shadow,   gl_->colour,     gl_->packed[0],
@@ -344,12 +362,26 @@ int Renderer::PositionCount() const {
 }
 
 int Renderer::Render() {
+  // --profile (time_phases): each phase inside a GL_TIME_ELAPSED query, read after the frame's
+  // last call; where the context has no timer queries, wall time with glFinish between phases.
+  // Not profiling, the frame neither reads back nor waits (Finish() waits, for timing).
   using Clock = std::chrono::steady_clock;
   auto mark = Clock::now();
   times_ = PhaseTimes{};
-  // Adds the time since the last mark to *ms (after glFinish) when phases are timed.
+  const bool timed = options_.time_phases, queries = timed && gl_->timer_queries;
+  times_.gpu_timer = queries;
+  double* phase_of_query[4] = {nullptr, nullptr, nullptr, nullptr};
+  int query = 0;
+  if (queries) glBeginQuery(GL_TIME_ELAPSED, gl_->phase_queries[0]);
+  // Ends the phase running since the last mark, adding its time to *ms.
   auto lap = [&](double* ms) {
-    if (!options_.time_phases) return;
+    if (!timed) return;
+    if (queries) {
+      glEndQuery(GL_TIME_ELAPSED);
+      phase_of_query[query++] = ms;
+      glBeginQuery(GL_TIME_ELAPSED, gl_->phase_queries[query]);
+      return;
+    }
     glFinish();
     const auto now = Clock::now();
     *ms += std::chrono::duration<double, std::milli>(now - mark).count();
@@ -371,11 +403,20 @@ int Renderer::Render() {
   LightPasses(todo);
   for (int l : todo) accumulated_[l] = true;
   if (reprojected || !todo.empty()) lap(&times_.light_ms);
-  glFinish();
+  if (queries) {
+    glEndQuery(GL_TIME_ELAPSED);  // the open one after the last phase: not a phase
+    for (int k = 0; k < query; ++k) {
+      GLuint64 ns = 0;
+      glGetQueryObjectui64v(gl_->phase_queries[k], GL_QUERY_RESULT, &ns);
+      *phase_of_query[k] += double(ns) * 1e-6;
+    }
+  }
   const GLenum error = glGetError();
   if (error != GL_NO_ERROR) throw Failure("GL error " + std::to_string(error) + " while rendering");
   return int(todo.size());
 }
+
+void Renderer::Finish() const { glFinish(); }
 
 void Renderer::DrawView() {
   // Clear the sums, then draw the G-buffer (what each pixel sees; the light passes shade it).

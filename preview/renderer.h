@@ -96,15 +96,19 @@ struct RenderOptions {
   // non-zero at one of its pixels (a light left out adds E' = 0).
   bool tiled_lights = true;
 
-  // Profiling: glFinish() after each phase of Render() so that phase_times() holds wall times.
+  // Profiling: phase_times() holds each phase's GL time (GL_TIME_ELAPSED queries read after the
+  // frame), or where the context has no timer queries wall times with glFinish() after each.
   bool time_phases = false;
 };
 
-// Wall time of the phases of the last Render() (milliseconds; only with time_phases).
+// Time of the phases of the last Render() (milliseconds; only with time_phases).
 // depth_ms: the G-buffer; shadow_ms: the shadow maps (and, when maps are drawn, a reprojection
 // before them); light_ms: the light passes (and a reprojection without maps drawn).
+// gpu_timer: measured by GL_TIME_ELAPSED queries (the GL's own time of each phase); false: wall
+// time with glFinish() between phases (contexts without timer queries).
 struct PhaseTimes {
   double depth_ms = 0, shadow_ms = 0, light_ms = 0;
+  bool gpu_timer = false;
 };
 
 constexpr int kLightsPerPass = 64;
@@ -170,8 +174,11 @@ class Renderer {
   int LightCount() const { return int(present_.size()); }
   int OrientationCount() const { return int(orientations_.size()); }
 
-  // Brings the accumulated image up to date; returns how many lights it added. glFinish()ed.
+  // Brings the accumulated image up to date; returns how many lights it added. Issues the frame's
+  // GL work without reading anything back or waiting for it (docs/method.md §4.2, "What a frame
+  // does"), unless time_phases; Read() waits for it, Finish() too (for timing frames).
   int Render();
+  void Finish() const;
   // Shadow maps rendered since construction (to show they are cached).
   int ShadowMapRenders() const { return shadow_renders_; }
   // Shadow-map texels drawn so far (the scissor rectangles' areas).
@@ -180,7 +187,9 @@ class Renderer {
   // The last light pass with tiled_lights: the lights listed per tile, as a fraction of the
   // pass's lights times the tiles (1 without tiled_lights).
   double ListedLightFraction() const;
-  const ShortcutState& shortcuts() const { return state_; }
+  // Reprojection's share of pixels shaded exactly is read here (waiting for the last frame if
+  // need be), not in the frame.
+  const ShortcutState& shortcuts() const;
   // The accumulated image (radiance or irradiance, W/m^2 [/sr]), 3 channels, row 0 on top.
   ImageF Read() const;
   // Draws the accumulation tone-mapped (exposure factor, sRGB) into framebuffer 0.
@@ -298,9 +307,9 @@ class Renderer {
   Eigen::Matrix4f drawn_view_projection_ = Eigen::Matrix4f::Identity();
   Eigen::Matrix4f source_view_projection_ = Eigen::Matrix4f::Identity();
   std::vector<bool> source_lights_;
-  bool view_shaded_in_full_ = false, source_valid_ = false, reproject_next_ = true;
+  bool view_shaded_in_full_ = false, source_valid_ = false;
+  mutable bool reproject_next_ = true;  // set where reprojection's count is read (const)
   bool list_only_ = false;
-  unsigned exact_listed_ = 0;       // pixels the last RESOLVE or REPROJECT pass listed
   bool tile_bounds_valid_ = false;  // the tiles' bounds are of the present G-buffer
   int tile_stride_ = 0;             // uints per tile in the light lists
   int tile_list_lights_ = 0;        // the last lists' lights (near and far)
@@ -317,7 +326,14 @@ class Renderer {
   std::vector<bool> merged_valid_;
   std::vector<double> merged_z_;  // z_G times the error bound (mm)
   int merged_group_size_ = 0;
-  ShortcutState state_;
+  // mutable: shortcuts() fills in reprojected_exact when the frame that counted it is done.
+  mutable ShortcutState state_;
+  // Reprojection's count is being copied (Gl::reproject_fence): read it once the fence passed.
+  mutable bool reproject_count_pending_ = false;
+  // Reads the copied count when its fence has passed (wait: until it has), and with it whether
+  // the next move may reproject from the source; false if not yet.
+  bool ReadReprojectCount(bool wait) const;
+  void DropReprojectCount();
   Gl* gl_;
 };
 

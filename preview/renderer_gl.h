@@ -40,6 +40,18 @@ struct Renderer::Gl {
   // Coarse shading's samples (RGBA32F, every second pixel of every second row), and the list
   // of the pixels shaded exactly (ExactCount, ExactList in light_pass.glsl).
   GLuint coarse = 0, coarse_fbo = 0, exact_count = 0, exact_list = 0;
+  // The EXACT_LIST dispatch's size, written on the GPU from exact_count (exact_args.comp), so that
+  // no frame reads the count back.
+  GLuint dispatch_args = 0, exact_args_program = 0;
+  // Reprojection's count of pixels listed, copied after its pass into a buffer mapped once
+  // (persistent, coherent) and read when its fence has passed: the next camera move's choice
+  // (reproject_next_) and shortcuts() without a read-back in a frame.
+  GLuint reproject_count = 0;
+  const GLuint* reproject_count_map = nullptr;
+  GLsync reproject_fence = nullptr;
+  // --profile: GL_TIME_ELAPSED queries, one per timed phase of a frame (Render()).
+  GLuint phase_queries[4] = {0, 0, 0, 0};
+  bool timer_queries = false;  // the context has them (GL_QUERY_COUNTER_BITS > 0)
   // The lights' sum before albedo (o_irradiance) of the present view, and the last view shaded
   // in full: its sums, positions and normals (what reprojection reuses).
   GLuint irradiance = 0, source[3] = {0, 0, 0};

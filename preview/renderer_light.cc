@@ -180,9 +180,9 @@ void Renderer::DrawLightPass(Shading shading) {
     glBindImageTexture(0, gl_->colour, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, gl_->packed[ping_], 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindImageTexture(2, gl_->irradiance, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    // Work groups of 64 in rows of at most 65535, the smallest GL_MAX_COMPUTE_WORK_GROUP_COUNT.
-    const GLuint groups = (exact_listed_ + 63) / 64, row = std::min<GLuint>(groups, 65535);
-    if (groups > 0) glDispatchCompute(row, (groups + row - 1) / row, 1);
+    // Sized on the GPU from the listing pass's count (exact_args.comp): no read-back.
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, gl_->dispatch_args);
+    glDispatchComputeIndirect(0);
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
     return;
   }
@@ -222,9 +222,13 @@ void Renderer::DrawLightPass(Shading shading) {
   glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glColorMaski(2, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   if (options_.srgbe) ping_ = 1 - ping_;
-  if (listing) {  // how many it listed (sizes the compute passes' dispatch)
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    glGetNamedBufferSubData(gl_->exact_count, 0, sizeof(exact_listed_), &exact_listed_);
+  if (listing) {  // how many it listed sizes the EXACT_LIST dispatch, on the GPU
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(gl_->exact_args_program);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl_->exact_count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, gl_->dispatch_args);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   }
 }
 

@@ -92,16 +92,21 @@ void Renderer::RenderShadowMaps(const std::vector<ShadowJob>& jobs) {
     n = 1;
     while (n < batch && b + n < jobs.size() && jobs[b + n].orientation == jobs[b].orientation) ++n;
     if (jobs[b].orientation != frame) set_frame(frame = jobs[b].orientation);
+    // The draw's maps and their scissor rectangles, one call each (not one per map).
     float u[4 * kShadowBatch];
+    GLint scissors[4 * kShadowBatch];
     for (size_t k = 0; k < n; ++k) {
       const ShadowJob& job = jobs[b + k];
       u[4 * k] = float(job.centre.x());
       u[4 * k + 1] = float(job.centre.y());
       u[4 * k + 2] = float(job.layer);
       u[4 * k + 3] = 0;
-      glScissorIndexed(GLuint(k), job.x0, job.y0, std::max(0, job.x1 - job.x0),
-                       std::max(0, job.y1 - job.y0));
+      scissors[4 * k] = job.x0;
+      scissors[4 * k + 1] = job.y0;
+      scissors[4 * k + 2] = std::max(0, job.x1 - job.x0);
+      scissors[4 * k + 3] = std::max(0, job.y1 - job.y0);
     }
+    glScissorArrayv(0, GLsizei(n), scissors);
     if (!gl_->layered_shadows) {
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, gl_->shadow, 0, jobs[b].layer);
       glClear(GL_DEPTH_BUFFER_BIT);  // inside the scissor rectangle

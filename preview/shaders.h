@@ -16,5 +16,6 @@ extern const char* const kTileBoundsCompute;      // tile_bounds.comp
 extern const char* const kTileListsCompute;       // tile_lists.comp
 extern const char* const kDisplayFragment;        // display.frag
 extern const char* const kConeTaperCheckCompute;  // cone_taper_check.comp: the blend taper alone
+extern const char* const kExactArgsCompute;       // exact_args.comp: EXACT_LIST's dispatch size
 
 }  // namespace lumislab::shaders

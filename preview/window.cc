@@ -228,7 +228,11 @@ void PollSlab(WindowState& s) {
 // shadow-map size).
 void MakeRenderer(WindowState& s, int fb_w, int fb_h) {
   s.renderer.reset();
-  s.renderer = std::make_unique<Renderer>(s.info, fb_w, fb_h, MakeRenderOptions(s.config, s.setup),
+  const RenderOptions options = MakeRenderOptions(s.config, s.setup);
+  const GLubyte* gl_renderer = glGetString(GL_RENDERER);
+  LogInfo(ShortcutChoice(s.config, options,
+                         gl_renderer ? reinterpret_cast<const char*>(gl_renderer) : ""));
+  s.renderer = std::make_unique<Renderer>(s.info, fb_w, fb_h, options,
                                           RendererOrientations(s.source, s.info));
   s.renderer->SetScene(s.setup.mesh);
   s.renderer->SetPose(PoseFromValues(s.config.scene.pose));
@@ -305,6 +309,7 @@ bool Frame(WindowState& s, GLFWwindow* window, double seconds) {
   const auto start = Clock::now();
   const int added = s.renderer->Render();
   if (added > 0) {
+    s.renderer->Finish();  // "last render" is the GL's work, not only its issue (rare: new light)
     s.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     s.render_lights = added;
   }

@@ -164,6 +164,19 @@ SynthOrientationsReport RunSynthOrientations(const SynthScene& scene, const Synt
   const std::vector<TruePose> poses = TruePoses(set, o.mount_error_deg, o.seed);
   CheckBehindS(scene.luminaire, set, poses, o.orientations_file);
   if (!options.force && !options.camera_folder && LuminaireFolderComplete(out)) {
+    // Only the same plan is a finished job: another one is refused, not skipped.
+    const LuminaireSet done = LoadLuminaireSet(out);
+    bool same = done.orientations.size() == set.orientations.size();
+    for (size_t k = 0; same && k < set.orientations.size(); ++k)
+      same = done.orientations[k].name == set.orientations[k].name &&
+             done.orientations[k].dataset == set.orientations[k].dataset &&
+             done.orientations[k].rotation_deg.isApprox(set.orientations[k].rotation_deg) &&
+             done.orientations[k].centre_mm.isApprox(set.orientations[k].centre_mm);
+    if (!same)
+      throw BadInput(LuminaireJsonPath(out) + ": orientations: expected those of " +
+                     o.orientations_file +
+                     " (the folder holds a capture of another plan), got others: use --force to "
+                     "capture this plan over it, or another --out");
     LogInfo("a complete luminaire folder is already in ", out, " (use --force to redo it)");
     report.skipped = true;
     return report;

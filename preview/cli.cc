@@ -324,7 +324,7 @@ int Run(const PreviewConfig& config, bool write_test_slab) {
     if (std::filesystem::is_directory(folder)) RemoveOrphanedTemporaries(folder);
   }
   const StopSignalScope stop_signals;
-  const LightSource source = OpenLightSource(config.slab_dir);
+  const LightSource source = OpenLightSource(config.slab_dir, config.watch);
   const std::optional<SlabInfo> info = WaitForFirstSlab(config, source);
   if (!info) {
     LogInfo("stopped before ", config.slab_dir,

@@ -34,15 +34,30 @@ std::string LayoutText(const SlabInfo& s) {
 
 }  // namespace
 
-LightSource OpenLightSource(const std::string& folder) {
+LightSource OpenLightSource(const std::string& folder, bool watch) {
   LightSource source;
   source.folder = folder;
-  source.luminaire = IsLuminaireFolder(folder);
+  // While the lab driver captures (acquire capture --orientations), luminaire.json lists only the
+  // orientations already complete and capture/plan.json all of them: --watch follows the plan.
+  const std::string plan = folder + "/capture/plan.json";
+  std::error_code ec;
+  const bool capturing = watch && std::filesystem::is_regular_file(plan, ec);
+  source.luminaire = IsLuminaireFolder(folder) || capturing;
   if (!source.luminaire) {
     source.slab_dirs = {folder};
     return source;
   }
-  source.set = LoadLuminaireSet(folder);
+  if (capturing) {
+    LuminaireSet planned = LoadLuminaireSetFile(plan, folder);
+    source.set = IsLuminaireFolder(folder) ? LoadLuminaireSet(folder) : planned;
+    if (planned.orientations.size() > source.set.orientations.size()) {
+      LogInfo(plan, ": following the capture's plan of ", planned.orientations.size(),
+              " orientations (", source.set.orientations.size(), " complete), nominal poses");
+      source.set = std::move(planned);
+    }
+  } else {
+    source.set = LoadLuminaireSet(folder);
+  }
   if (int(source.set.orientations.size()) > kMaxOrientations)
     throw InputError(LuminaireJsonPath(folder), "orientations",
                      "at most " + std::to_string(kMaxOrientations) + " (the preview's limit)",

@@ -26,8 +26,9 @@ struct LightSource {
 };
 
 // Opens --slab: a luminaire folder (luminaire.json read and checked, exit 2 naming the file and
-// field) or a slab folder.
-LightSource OpenLightSource(const std::string& folder);
+// field) or a slab folder. With `watch`, a folder the lab driver is capturing into
+// (capture/plan.json) is opened with all the plan's orientations, which join as they arrive.
+LightSource OpenLightSource(const std::string& folder, bool watch = false);
 
 // The renderer's orientations: none for one slab; a luminaire folder's poses and each one's cone
 // (ConeOfDataset of the slab layout every orientation shares).

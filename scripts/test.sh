@@ -30,7 +30,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
-fuzz_seconds=${LUMISLAB_FUZZ_SECONDS:-10}
+fuzz_seconds=${LUMISLAB_FUZZ_SECONDS:-5}
 # The sanitizer and fuzz builds: -O2 with line tables (readable stack traces). Not -O1: Eigen
 # needs its inlining: at -O1 under ASan the calibrate tests run many times slower than Release.
 # Unity builds and lld, as scripts/setup.sh's.

@@ -85,8 +85,8 @@ TEST(Luminaire, PlannedOrientationsThroughPhotosGiveTheWholeLuminaire) {
               "synth --scene full-sphere --print-scene --out " + ShellQuote(dir + "/unused"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   nlohmann::json scene = nlohmann::json::parse(r.output);
-  scene["camera"]["size_px"] = {800, 600};
-  scene["camera"]["focal_px"] = 350;
+  scene["camera"]["size_px"] = {640, 480};
+  scene["camera"]["focal_px"] = 280;
   testing::WriteFile(dir + "/scene.json", scene.dump(2));
   r = RunTool("lumislab-acquire", "synth --scene " + ShellQuote(dir + "/scene.json") +
                                       " --orientations " + ShellQuote(dir + "/plan.json") +
@@ -100,7 +100,7 @@ TEST(Luminaire, PlannedOrientationsThroughPhotosGiveTheWholeLuminaire) {
   r = RunShell("bash " +
                ShellQuote(std::string(LUMISLAB_SOURCE_DIR) + "/pipelines/process-luminaire.sh") +
                " " + ShellQuote(lum) +
-               " --resolution 64 --threads 2 --reference truth/reference.json --metadata " +
+               " --resolution 48 --threads 2 --reference truth/reference.json --metadata " +
                ShellQuote(dir + "/keywords.json") + " 2>&1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
 

@@ -303,8 +303,8 @@ OrientationPlan PlanOrientations(const OrientationPlanInput& in) {
     } else if (covered < in.min_coverage) {
       std::ostringstream why;
       why << plan.orientations.size() << " orientation(s) on " << step << " degree turns cover "
-          << CoveragePercent(covered) << " of the " << region << " (requested " << CoveragePercent(in.min_coverage)
-          << ")";
+          << CoveragePercent(covered) << " of the " << region << " (requested "
+          << CoveragePercent(in.min_coverage) << ")";
       if (int(chosen.size()) >= in.max_orientations) {
         why << ": the limit of " << in.max_orientations << " orientations";
       } else if (stall) {
@@ -387,7 +387,8 @@ std::string OrientationPlanTable(const OrientationPlanInput& in, const Orientati
         Fixed(o.rotation_deg.z(), 1).c_str(), p.mount, Fixed(p.mount_tilt_deg, 0).c_str(),
         in.rotation_axis ? Fixed(p.axis_deg, 0).c_str() : "-", Fixed(cg.x(), 0).c_str(),
         Fixed(cg.y(), 0).c_str(),
-        k < plan.cumulative_coverage.size() ? CoveragePercent(plan.cumulative_coverage[k]).c_str() : "-");
+        k < plan.cumulative_coverage.size() ? CoveragePercent(plan.cumulative_coverage[k]).c_str()
+                                            : "-");
     out << row;
     for (const PairOverlap& pair : plan.coverage.pairs) {
       if (pair.overlap_sr < kMinOverlapSr || (pair.a != int(k) && pair.b != int(k))) continue;
@@ -396,8 +397,9 @@ std::string OrientationPlanTable(const OrientationPlanInput& in, const Orientati
     }
     out << '\n';
   }
-  out << "coverage " << CoveragePercent(plan.coverage.covered_fraction) << " of the " << set.coverage
-      << " (unseen " << Fixed(plan.coverage.unseen_sr, 4) << " sr); every orientation "
+  out << "coverage " << CoveragePercent(plan.coverage.covered_fraction) << " of the "
+      << set.coverage << " (unseen " << Fixed(plan.coverage.unseen_sr, 4)
+      << " sr); every orientation "
       << (plan.coverage.overlap_problem.empty() ? "connected to o00 through overlaps >= "
                                                 : "NOT connected: ")
       << (plan.coverage.overlap_problem.empty() ? Fixed(kMinOverlapSr, 2) + " sr"

@@ -16,8 +16,9 @@ namespace lumislab {
 namespace {
 
 // A 1-sigma of registration.json: infinite where the overlaps do not constrain the component.
+// "0.38 deg", or "unconstrained" for a direction the overlaps do not fix.
 std::string Sigma(double sigma_deg) {
-  return std::isfinite(sigma_deg) ? Num(sigma_deg, 2) : std::string("unconstrained");
+  return std::isfinite(sigma_deg) ? Num(sigma_deg, 2) + " deg" : std::string("unconstrained");
 }
 
 }  // namespace
@@ -98,7 +99,7 @@ std::string LuminaireSource::Orientations() const {
     sigma = std::max(sigma, o.sigma_deg.maxCoeff());
   }
   return s + "registered: corrections up to " + Num(worst, 3) + " deg (" + worst_name +
-         "), 1-sigma up to " + Sigma(sigma) + " deg";
+         "), 1-sigma up to " + Sigma(sigma);
 }
 
 std::vector<std::string> LuminaireSource::RegistrationRows() const {

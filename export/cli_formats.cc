@@ -790,6 +790,16 @@ int WriteMergedRays(const RayCommand& c, const Slab& slab, const Coverage& cover
             Num(merged.slab_flux[k], 6), unit, ", ", merged.kept[k], " kept (the blend keeps ",
             Num(100 * merged.kept_share[k], 3), " % of its flux)");
   LogInfo(merged.rays.rays.size(), " rays, total ", Num(merged.rays.total_flux, 6), unit);
+  // Thinning by the blend keeps each ray with its weight: the kept sum estimates the blended
+  // flux with a sampling error that few rays make large.
+  double expected = 0;
+  for (size_t k = 0; k < lum.slabs.size(); ++k)
+    expected += merged.slab_flux[k] * merged.kept_share[k];
+  const double off = expected > 0 ? merged.rays.total_flux / expected - 1 : 0;
+  if (std::abs(off) > 0.01)
+    LogWarning("the rays carry ", Num(100 * off, 3), " % of the blended flux (", Num(expected, 6),
+               unit, "): the blend's thinning of ", c.rays,
+               " rays leaves that sampling error; give more --rays");
   WriteTm25(set, c.out);
   std::printf("tm25: %s\n", c.out.c_str());
   return 0;
@@ -891,6 +901,15 @@ int RunInfo(const InfoCommand& c) {
   if (IsLuminaireFolder(c.file)) {
     std::fputs(LuminaireFolderInfo(c.file, c.json).c_str(), stdout);
     return 0;
+  }
+  // A luminaire folder's own luminaire.json names the folder (not an EULUMDAT file).
+  const std::filesystem::path given(c.file);
+  if (given.filename() == "luminaire.json") {
+    const std::string folder = given.has_parent_path() ? given.parent_path().string() : ".";
+    if (IsLuminaireFolder(folder)) {
+      std::fputs(LuminaireFolderInfo(folder, c.json).c_str(), stdout);
+      return 0;
+    }
   }
   std::fputs(FormatPhotometricFileInfo(PhotometricFileInfo(c.file), c.json).c_str(), stdout);
   return 0;

@@ -152,10 +152,16 @@ std::string LuminaireFolderInfo(const std::string& folder, bool json) {
     const std::string slab_dir = dataset + "/slab";
     if (std::filesystem::is_regular_file(slab_dir + "/slab.json")) {
       const SlabInfo info = SlabInfo::Load(slab_dir);
-      e["slab"] = info.Complete() ? "complete" : "partial";
+      // What slab.json lists, and whether each listed position's file is there.
+      int missing = 0;
+      for (const auto& [i, jj] : info.present)
+        missing += !std::filesystem::is_regular_file(SlabPositionPath(slab_dir, i, jj));
+      const std::string state = missing > 0 ? std::to_string(missing) + " position file(s) missing"
+                                : info.Complete() ? "complete"
+                                                  : "partial";
+      e["slab"] = state;
       e["units"] = info.units;
-      line += "; slab " + std::string(info.Complete() ? "complete" : "partial") + ", units " +
-              info.units;
+      line += "; slab " + state + ", units " + info.units;
     } else {
       e["slab"] = "none";
       line += "; no slab yet";

@@ -81,8 +81,9 @@ format_stage() {
 }
 
 tests_stage() {
-  # One job more than cores: several e2e tests mostly wait (the Slurm cluster's polling, the
-  # virtual lab's stage and camera emulators), and their slots would otherwise idle a core.
+  # One job more than cores (here and under the sanitizers): several e2e tests mostly wait (the
+  # Slurm cluster's polling, the virtual lab's stage and camera emulators), and their slots
+  # would otherwise idle a core.
   scripts/setup.sh && ctest_jobs=$((jobs + 1)) run_ctest build
 }
 
@@ -90,7 +91,7 @@ sanitizers_stage() {
   cmake -S . -B build-asan "${clang_args[@]}" -DLUMISLAB_SANITIZE=address,undefined \
     -DLUMISLAB_BUILD_BENCH=OFF -DLUMISLAB_TEST_SKIP_TIERS=accuracy >/dev/null &&
     cmake --build build-asan -j "$jobs" &&
-    (source fuzz/sanitizers/env.sh && run_ctest build-asan -LE accuracy)
+    (source fuzz/sanitizers/env.sh && ctest_jobs=$((jobs + 1)) run_ctest build-asan -LE accuracy)
 }
 
 fuzz_stage() {

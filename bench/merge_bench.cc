@@ -75,13 +75,7 @@ int Main(int argc, char** argv) {
   ParallelFor(info.grid.count(), threads, [&](int k) {
     positions[size_t(k)] = TruthPosition(turned, info, k % info.grid.nu, k / info.grid.nu);
   });
-  Dataset dataset;  // the setup the cone is of (ConeOfDataset)
-  dataset.distance_mm = info.distance_mm;
-  dataset.grid = info.grid;
-  dataset.screen_w_mm = info.layout.window_w_mm;
-  dataset.screen_h_mm = info.layout.window_h_mm;
-  dataset.filter = info.filter;
-  const OrientationCone cone = ConeOfDataset(dataset);
+  const OrientationCone cone = ConeOfSlab(info);
   std::vector<double> c, gamma;
   for (int k = 0; k < 72; ++k) c.push_back(5.0 * k);
   for (int k = 0; k <= 72; ++k) gamma.push_back(2.5 * k);

@@ -83,13 +83,7 @@ int Run(int argc, char** argv) {
   for (const Emitter& e : luminaire.emitters)
     reach = std::max(reach, (e.position_mm - luminaire.centre_mm).norm());
   const Eigen::Vector3d centre(0, 0, -(reach + 6));  // behind S in every orientation
-  Dataset dataset;
-  dataset.distance_mm = info.distance_mm;
-  dataset.grid = info.grid;
-  dataset.screen_w_mm = info.layout.window_w_mm;
-  dataset.screen_h_mm = info.layout.window_h_mm;
-  dataset.filter = info.filter;
-  const OrientationCone cone = ConeOfDataset(dataset);
+  const OrientationCone cone = ConeOfSlab(info);
   // Every face's E' (the six faces once; rows take the first K).
   std::vector<std::vector<ImageF>> faces(6);
   for (int k = 0; k < 6; ++k) {

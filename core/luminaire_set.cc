@@ -17,6 +17,7 @@
 #include "core/geometry.h"
 #include "core/input_file.h"
 #include "core/json.h"
+#include "core/slab.h"
 
 namespace lumislab {
 namespace {
@@ -103,13 +104,37 @@ double OrientationCone::MarginDeg(const Eigen::Vector3d& w) const {
   return std::min(lx - ax, ly - ay) * kDeg;
 }
 
-OrientationCone ConeOfDataset(const Dataset& dataset) {
-  const SamplingGrid& g = dataset.grid;
+namespace {
+
+// d and the screen's half-sizes less the positions' support on S (grid half-extent plus h).
+OrientationCone ConeOf(double distance_mm, const SamplingGrid& g, double screen_w_mm,
+                       double screen_h_mm) {
   OrientationCone cone;
-  cone.distance_mm = dataset.distance_mm;
-  cone.half_w_mm = 0.5 * dataset.screen_w_mm - (0.5 * (g.nu - 1) + 1) * g.spacing_mm;
-  cone.half_h_mm = 0.5 * dataset.screen_h_mm - (0.5 * (g.nv - 1) + 1) * g.spacing_mm;
+  cone.distance_mm = distance_mm;
+  cone.half_w_mm = 0.5 * screen_w_mm - (0.5 * (g.nu - 1) + 1) * g.spacing_mm;
+  cone.half_h_mm = 0.5 * screen_h_mm - (0.5 * (g.nv - 1) + 1) * g.spacing_mm;
   return cone;
+}
+
+}  // namespace
+
+OrientationCone ConeOfDataset(const Dataset& dataset) {
+  return ConeOf(dataset.distance_mm, dataset.grid, dataset.screen_w_mm, dataset.screen_h_mm);
+}
+
+OrientationCone ConeOfSlab(const SlabInfo& info) {
+  return ConeOf(info.distance_mm, info.grid, info.layout.window_w_mm, info.layout.window_h_mm);
+}
+
+std::vector<Eigen::Vector3d> FibonacciDirections(int n, bool hemisphere) {
+  const double golden = kPi * (3 - std::sqrt(5.0));
+  std::vector<Eigen::Vector3d> out(static_cast<size_t>(std::max(0, n)));
+  for (int i = 0; i < n; ++i) {
+    const double z = hemisphere ? 1 - (i + 0.5) / n : 1 - 2 * (i + 0.5) / n;
+    const double r = std::sqrt(std::max(0.0, 1 - z * z));
+    out[size_t(i)] = Eigen::Vector3d(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return out;
 }
 
 double ConeTaper(const OrientationCone& cone, const Eigen::Vector3d& w, double taper_deg) {
@@ -219,16 +244,12 @@ CoverageReport AnalyseCoverage(const std::vector<Eigen::Matrix3d>& poses,
   LUMISLAB_CHECK(poses.size() == cones.size() && !poses.empty() && samples > 0,
                  "one cone per pose, at least one");
   const size_t n = poses.size();
-  // Fibonacci lattice over the sphere, or over the hemisphere z >= 0 (equal areas either way).
-  const double golden = kPi * (3 - std::sqrt(5.0));
   const double total_sr = hemisphere ? 2 * kPi : 4 * kPi;
+  const std::vector<Eigen::Vector3d> lattice = FibonacciDirections(samples, hemisphere);
   std::vector<int> pair_count(n * n, 0);
   int covered = 0;
   std::vector<size_t> seen_by;
-  for (int i = 0; i < samples; ++i) {
-    const double z = hemisphere ? 1 - (i + 0.5) / samples : 1 - 2 * (i + 0.5) / samples;
-    const double r = std::sqrt(std::max(0.0, 1 - z * z));
-    const Eigen::Vector3d w(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  for (const Eigen::Vector3d& w : lattice) {
     seen_by.clear();
     for (size_t k = 0; k < n; ++k)
       if (cones[k].MarginDeg(poses[k] * w) > 0) seen_by.push_back(k);

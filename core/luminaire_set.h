@@ -19,6 +19,8 @@
 namespace lumislab {
 
 struct Dataset;
+struct SamplingGrid;
+struct SlabInfo;
 
 constexpr int kLuminaireSetSchemaVersion = 1;
 constexpr int kRegistrationSchemaVersion = 1;
@@ -48,6 +50,13 @@ struct OrientationCone {
 // The cone of a dataset: d, and the screen's half-sizes (the slab window) less the positions'
 // support on S as the far field integrates it (the grid's half-extent plus h, a bell's reach).
 OrientationCone ConeOfDataset(const Dataset& dataset);
+// The same from a slab's layout (its window is the screen; every orientation of a folder shares
+// it): what the preview and the benches have in hand.
+OrientationCone ConeOfSlab(const SlabInfo& info);
+
+// n directions of equal solid angle over the sphere (or the hemisphere z >= 0): a Fibonacci
+// lattice, the sampling of AnalyseCoverage and of the registration's overlaps.
+std::vector<Eigen::Vector3d> FibonacciDirections(int n, bool hemisphere = false);
 
 // The taper of an orientation at a capture-frame direction: 0 outside the cone, smoothstep
 // 3t^2 - 2t^3 of t = margin / taper_deg inside, 1 beyond taper_deg. The preview's shader

@@ -71,14 +71,7 @@ std::vector<LightOrientation> RendererOrientations(const LightSource& source,
                                                    const SlabInfo& info) {
   std::vector<LightOrientation> out;
   if (!source.luminaire) return out;
-  // What each orientation sees, from the layout they share (the slab window is the screen).
-  Dataset dataset;
-  dataset.distance_mm = info.distance_mm;
-  dataset.grid = info.grid;
-  dataset.screen_w_mm = info.layout.window_w_mm;
-  dataset.screen_h_mm = info.layout.window_h_mm;
-  dataset.filter = info.filter;
-  const OrientationCone cone = ConeOfDataset(dataset);
+  const OrientationCone cone = ConeOfSlab(info);
   for (const Orientation& o : source.set.orientations) {
     LightOrientation light;
     light.capture_from_luminaire = o.rotation;

@@ -44,16 +44,6 @@ constexpr double kFreeSigmaDeg = 10.0;
 // see each capture angle against several others.
 constexpr int kMinGainProfilePairs = 3;
 
-std::vector<Eigen::Vector3d> FibonacciSphere(int n) {
-  std::vector<Eigen::Vector3d> out(static_cast<size_t>(n));
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
-  for (int k = 0; k < n; ++k) {
-    const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    out[size_t(k)] = Eigen::Vector3d(r * std::cos(golden * k), r * std::sin(golden * k), z);
-  }
-  return out;
-}
-
 // One orientation's far field as Ceres reads it.
 struct Sampler {
   const RegistrationInput* input;
@@ -167,7 +157,7 @@ Registration RegisterOrientations(const std::vector<RegistrationInput>& inputs,
     samplers[size_t(k)].interpolator =
         std::make_unique<FarFieldInterpolator>(*samplers[size_t(k)].grid);
   }
-  const std::vector<Eigen::Vector3d> sphere = FibonacciSphere(options.directions);
+  const std::vector<Eigen::Vector3d> sphere = FibonacciDirections(options.directions);
   std::vector<std::array<double, 3>> corrections(static_cast<size_t>(count), {0.0, 0.0, 0.0});
   auto pose = [&](int k) { return Refined(inputs[size_t(k)], corrections[size_t(k)].data()); };
   auto select = [&]() {
